@@ -1,0 +1,181 @@
+//! Clipping a lot outline to a band of depth behind its frontage, in the frontage frame.
+//!
+//! In the frame (u along the street, v into the lot) a house occupies the part of the lot with
+//! `lo <= v <= hi`. For convex lots (nearly all town lots) two half-plane clips do it exactly
+//! and cheaply; other lots go through geo's boolean operations.
+
+use geo::BooleanOps;
+use geo_types::{Coord, LineString, Polygon, Rect};
+
+/// A polygon in the frontage frame: (u, v) pairs, counter-clockwise, not closed.
+pub type LocalRing = Vec<[f64; 2]>;
+
+/// The parts of `ring` with `lo <= v <= hi` (infinite bounds allowed).
+pub fn clip_band(ring: &[[f64; 2]], lo: f64, hi: f64) -> Vec<LocalRing> {
+    if is_convex(ring) {
+        let mut r = ring.to_vec();
+        if lo.is_finite() {
+            r = clip_half(&r, lo, true);
+        }
+        if hi.is_finite() {
+            r = clip_half(&r, hi, false);
+        }
+        let r = dedup(r);
+        if r.len() >= 3 && area(&r) > 1e-9 {
+            vec![r]
+        } else {
+            Vec::new()
+        }
+    } else {
+        clip_boolean(ring, lo, hi)
+    }
+}
+
+/// Sutherland-Hodgman against one line `v = c`, keeping `v >= c` (`above`) or `v <= c`.
+/// Points made on the line get `v = c` exactly, so two halves split at the same line share
+/// their cut points bit for bit.
+fn clip_half(ring: &[[f64; 2]], c: f64, above: bool) -> LocalRing {
+    let g = |p: [f64; 2]| if above { p[1] - c } else { c - p[1] };
+    let n = ring.len();
+    let mut out = Vec::with_capacity(n + 2);
+    for i in 0..n {
+        let p = ring[i];
+        let q = ring[(i + 1) % n];
+        let (gp, gq) = (g(p), g(q));
+        if gp >= 0.0 {
+            out.push(p);
+        }
+        if (gp >= 0.0) != (gq >= 0.0) && gp != gq {
+            let t = gp / (gp - gq);
+            out.push([p[0] + t * (q[0] - p[0]), c]);
+        }
+    }
+    out
+}
+
+fn clip_boolean(ring: &[[f64; 2]], lo: f64, hi: f64) -> Vec<LocalRing> {
+    let (mut umin, mut umax, mut vmin, mut vmax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in ring {
+        umin = umin.min(p[0]);
+        umax = umax.max(p[0]);
+        vmin = vmin.min(p[1]);
+        vmax = vmax.max(p[1]);
+    }
+    let lo = if lo.is_finite() { lo } else { vmin - 1.0 };
+    let hi = if hi.is_finite() { hi } else { vmax + 1.0 };
+    if hi <= lo {
+        return Vec::new();
+    }
+    let poly = Polygon::new(
+        LineString(ring.iter().map(|p| Coord { x: p[0], y: p[1] }).collect()),
+        vec![],
+    );
+    let band = Rect::new(
+        Coord {
+            x: umin - 1.0,
+            y: lo,
+        },
+        Coord {
+            x: umax + 1.0,
+            y: hi,
+        },
+    )
+    .to_polygon();
+    poly.intersection(&band)
+        .0
+        .into_iter()
+        .filter_map(|p| {
+            let ext = &p.exterior().0;
+            let mut r: LocalRing = ext[..ext.len().saturating_sub(1)]
+                .iter()
+                .map(|c| [c.x, c.y])
+                .collect();
+            if area(&r) < 0.0 {
+                r.reverse();
+            }
+            let r = dedup(r);
+            (r.len() >= 3 && area(&r) > 1e-9).then_some(r)
+        })
+        .collect()
+}
+
+/// Signed area, positive for counter-clockwise.
+pub fn area(r: &[[f64; 2]]) -> f64 {
+    let n = r.len();
+    (0..n)
+        .map(|i| {
+            let (p, q) = (r[i], r[(i + 1) % n]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+/// True when no turn of the ring goes clockwise (collinear points allowed).
+pub fn is_convex(r: &[[f64; 2]]) -> bool {
+    let n = r.len();
+    if n < 3 {
+        return false;
+    }
+    (0..n).all(|i| {
+        let (p, q, s) = (r[i], r[(i + 1) % n], r[(i + 2) % n]);
+        let cross = (q[0] - p[0]) * (s[1] - q[1]) - (q[1] - p[1]) * (s[0] - q[0]);
+        cross >= -1e-9
+    })
+}
+
+/// Drops consecutive points closer than 0.1 mm.
+pub fn dedup(r: LocalRing) -> LocalRing {
+    let mut out: LocalRing = Vec::with_capacity(r.len());
+    for p in r {
+        if out
+            .last()
+            .is_none_or(|l| (l[0] - p[0]).abs() > 1e-4 || (l[1] - p[1]).abs() > 1e-4)
+        {
+            out.push(p);
+        }
+    }
+    while out.len() > 1 {
+        let (f, l) = (out[0], out[out.len() - 1]);
+        if (f[0] - l[0]).abs() <= 1e-4 && (f[1] - l[1]).abs() <= 1e-4 {
+            out.pop();
+        } else {
+            break;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn convex_band_clip_is_exact() {
+        let sq = vec![[0., 0.], [4., 0.], [4., 20.], [0., 20.]];
+        let parts = clip_band(&sq, 2.0, 14.0);
+        assert_eq!(parts.len(), 1);
+        assert!((area(&parts[0]) - 48.0).abs() < 1e-9);
+        assert!(parts[0].iter().all(|p| p[1] >= 2.0 && p[1] <= 14.0));
+    }
+
+    #[test]
+    fn concave_band_clip_keeps_both_arms() {
+        // A U shape open at the top: the band above y = 5 cuts it into two arms.
+        let u = vec![
+            [0., 0.],
+            [6., 0.],
+            [6., 10.],
+            [4., 10.],
+            [4., 5.],
+            [2., 5.],
+            [2., 10.],
+            [0., 10.],
+        ];
+        assert!(!is_convex(&u));
+        let parts = clip_band(&u, 6.0, f64::INFINITY);
+        assert_eq!(parts.len(), 2);
+        let total: f64 = parts.iter().map(|p| area(p)).sum();
+        assert!((total - 16.0).abs() < 1e-6, "{total}");
+    }
+}

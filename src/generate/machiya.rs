@@ -1,0 +1,332 @@
+//! Machiya (町家) townhouses, section 4.1 of the paper.
+//!
+//! A machiya is built to the full width of its frontage, side walls against its neighbours,
+//! facing the street with no gap (the paper: "建物は間口いっぱいに建てられて"). The house is the
+//! part of the lot between `setback` and `setback + depth` behind the frontage, so it can never
+//! leave its lot whatever the lot's shape; a gable roof with its ridge parallel to the street
+//! (hirairi 平入) sits on it, and a pent roof (hisashi 庇) reaches over the street.
+
+use geo_types::Coord;
+
+use super::clip::{LocalRing, area, clip_band, is_convex};
+use super::materials;
+use super::mesh::{Frame, Mesh};
+use crate::model::PlannedMachiya;
+use crate::params::MachiyaParams;
+use crate::templates::MachiyaType;
+
+/// Pitch of the street-side pent roof (rise per metre).
+const HISASHI_PITCH: f64 = 0.3;
+/// Thickness of the pent roof slab.
+const HISASHI_THICKNESS: f64 = 0.12;
+/// The pent roof reaches this far into the house so that its back face is hidden inside.
+const HISASHI_TUCK: f64 = 0.05;
+/// Thickness of the wall of a heitsuki and of a kanban-gatera board.
+const WALL_THICKNESS: f64 = 0.25;
+/// Texture base of plaster, wood and floor: one repeat per this many metres.
+const WORLD_TEXTURE_BASE: f64 = 2.0;
+/// Texture base of roof tiles: one repeat per metre along the street and up the slope.
+const ROOF_TEXTURE_BASE: f64 = 1.0;
+
+/// The frontage frame: u along the street, v into the lot, in map metres.
+#[derive(Debug, Clone, Copy)]
+struct Local {
+    a: Coord<f64>,
+    u: Coord<f64>,
+    v: Coord<f64>,
+}
+
+impl Local {
+    fn to_map(self, p: [f64; 2]) -> Coord<f64> {
+        Coord {
+            x: self.a.x + p[0] * self.u.x + p[1] * self.v.x,
+            y: self.a.y + p[0] * self.u.y + p[1] * self.v.y,
+        }
+    }
+    fn from_map(self, c: Coord<f64>) -> [f64; 2] {
+        let (dx, dy) = (c.x - self.a.x, c.y - self.a.y);
+        [dx * self.u.x + dy * self.u.y, dx * self.v.x + dy * self.v.y]
+    }
+}
+
+/// How the walls of an extruded part are dressed.
+struct Dress {
+    top: u16,
+    bottom: u16,
+    wall: u16,
+    /// Walls on the line `v = front_v` get this material with facade UVs.
+    facade: Option<Facade>,
+}
+
+struct Facade {
+    material: u16,
+    front_v: f64,
+    /// Texture repeats per metre along u (a whole number of repeats across the frontage).
+    u_scale: f64,
+    /// Height the texture spans once, bottom to top.
+    height: f64,
+}
+
+/// Builds the mesh of one machiya, or says why it cannot be built.
+pub fn build(
+    m: &PlannedMachiya,
+    t: &MachiyaType,
+    params: &MachiyaParams,
+    frame: Frame,
+) -> Result<Mesh, String> {
+    let f = &m.frontage;
+    let local = Local {
+        a: f.a,
+        u: f.u_axis(),
+        v: f.v_axis(),
+    };
+    let ext = &m.outline.exterior().0;
+    let ring: LocalRing = super::clip::dedup(
+        ext[..ext.len() - 1]
+            .iter()
+            .map(|c| local.from_map(*c))
+            .collect(),
+    );
+    if ring.len() < 3 || area(&ring) <= 0.0 {
+        return Err("the outline is degenerate in the frontage frame".into());
+    }
+    let lot_depth = ring.iter().map(|p| p[1]).fold(0.0, f64::max);
+    let setback = t.setback;
+    let wanted = if t.depth > 0.0 { t.depth } else { params.depth };
+    let depth = wanted.min(lot_depth - setback);
+    if depth < params.min_depth {
+        return Err(format!(
+            "type {} needs {:.2} m behind the frontage (setback {setback} m + machiya.min_depth \
+             {} m) but the lot is {lot_depth:.2} m deep",
+            t.name,
+            setback + params.min_depth,
+            params.min_depth
+        ));
+    }
+    let body = clip_band(&ring, setback, setback + depth);
+    if body.is_empty() {
+        return Err("no part of the lot lies in the house's band behind the frontage".into());
+    }
+
+    let mut mesh = Mesh::new(format!("machiya_{}", m.id));
+    let width = f.width();
+    let eave = t.eave_height;
+    let ridge_v = setback + depth / 2.0;
+    let pitch = t.roof_pitch;
+    let gable = move |v: f64| eave + pitch * (depth / 2.0 - (v - ridge_v).abs());
+    let facade_material = materials::find(&t.facade_material).unwrap_or(0);
+    let repeats = (width / t.facade_base).ceil().max(1.0);
+    let dress = Dress {
+        top: materials::find(&t.roof_material).unwrap_or(0),
+        bottom: materials::id("floor"),
+        wall: materials::find(&t.wall_material).unwrap_or(0),
+        facade: Some(Facade {
+            material: facade_material,
+            front_v: setback,
+            u_scale: repeats / width,
+            height: eave + t.parapet_height,
+        }),
+    };
+    // The two roof halves meet at the ridge: split the body there so every face is planar.
+    let mut halves = Vec::new();
+    for part in &body {
+        halves.extend(clip_band(part, f64::NEG_INFINITY, ridge_v));
+        halves.extend(clip_band(part, ridge_v, f64::INFINITY));
+    }
+    extrude(&mut mesh, frame, local, &halves, &|_| 0.0, &gable, Some(ridge_v), &dress);
+
+    if t.hisashi_height > 0.0 {
+        hisashi(&mut mesh, frame, local, &body, t, setback);
+    }
+    if t.front_wall_height > 0.0 && setback > WALL_THICKNESS {
+        let wall = clip_band(&ring, 0.0, WALL_THICKNESS);
+        let h = t.front_wall_height;
+        let dress = Dress {
+            top: materials::id("wood"),
+            bottom: materials::id("floor"),
+            wall: materials::id("tsuchikabe_wall"),
+            facade: None,
+        };
+        extrude(&mut mesh, frame, local, &wall, &|_| 0.0, &|_| h, None, &dress);
+    }
+    if t.parapet_height > 0.0 {
+        // The board stands on the front wall and hides the roof behind it.
+        let board = clip_band(&ring, setback, setback + WALL_THICKNESS.min(depth / 2.0));
+        let top = eave + t.parapet_height;
+        let dress = Dress {
+            top: materials::id("wood"),
+            bottom: materials::id("wood"),
+            wall: materials::id("wood"),
+            facade: Some(Facade {
+                material: facade_material,
+                front_v: setback,
+                u_scale: repeats / width,
+                height: top,
+            }),
+        };
+        extrude(&mut mesh, frame, local, &board, &|_| eave, &|_| top, None, &dress);
+    }
+    Ok(mesh.finish())
+}
+
+/// The street-side pent roof: a thin sloping slab along the facade, reaching over the street.
+fn hisashi(
+    mesh: &mut Mesh,
+    frame: Frame,
+    local: Local,
+    body: &[LocalRing],
+    t: &MachiyaType,
+    front_v: f64,
+) {
+    let on_front = body
+        .iter()
+        .flatten()
+        .filter(|p| (p[1] - front_v).abs() < 0.01);
+    let (mut u0, mut u1) = (f64::MAX, f64::MIN);
+    for p in on_front {
+        u0 = u0.min(p[0]);
+        u1 = u1.max(p[0]);
+    }
+    if u1 - u0 < 0.1 {
+        return;
+    }
+    let (v0, v1) = (front_v - t.hisashi_depth, front_v + HISASHI_TUCK);
+    let slab = vec![[u0, v0], [u1, v0], [u1, v1], [u0, v1]];
+    let hh = t.hisashi_height;
+    let top = move |v: f64| hh + (v - front_v) * HISASHI_PITCH;
+    let bottom = move |v: f64| top(v) - HISASHI_THICKNESS;
+    let dress = Dress {
+        top: materials::id("kawara_roof"),
+        bottom: materials::id("wood"),
+        wall: materials::id("wood"),
+        facade: None,
+    };
+    extrude(mesh, frame, local, &[slab], &bottom, &top, None, &dress);
+}
+
+/// Extrudes planar parts between a bottom and a top height, each a function of v that is
+/// linear on every part. Walls on the line `v = ridge` are left out: there two parts meet
+/// and the shell continues. The result is closed when the parts tile a closed region.
+#[allow(clippy::too_many_arguments)]
+fn extrude(
+    mesh: &mut Mesh,
+    frame: Frame,
+    local: Local,
+    parts: &[LocalRing],
+    bottom: &dyn Fn(f64) -> f64,
+    top: &dyn Fn(f64) -> f64,
+    ridge: Option<f64>,
+    dress: &Dress,
+) {
+    for part in parts {
+        let n = part.len();
+        // Top (counter-clockwise seen from above) and bottom (reversed).
+        let tris = triangles(part);
+        let slope = |p: [f64; 2]| {
+            let dh = top(p[1] + 0.5) - top(p[1] - 0.5);
+            (1.0 + dh * dh).sqrt()
+        };
+        for tri in &tris {
+            let corners = tri
+                .iter()
+                .map(|&i| {
+                    let p = part[i];
+                    let pos = mesh.vertex(frame, local.to_map(p), top(p[1]));
+                    let uv = mesh.uv(p[0] / ROOF_TEXTURE_BASE, p[1] * slope(p) / ROOF_TEXTURE_BASE);
+                    (pos, uv)
+                })
+                .collect();
+            mesh.face(dress.top, corners);
+            let corners = tri
+                .iter()
+                .rev()
+                .map(|&i| {
+                    let p = part[i];
+                    let pos = mesh.vertex(frame, local.to_map(p), bottom(p[1]));
+                    let uv = mesh.uv(p[0] / WORLD_TEXTURE_BASE, p[1] / WORLD_TEXTURE_BASE);
+                    (pos, uv)
+                })
+                .collect();
+            mesh.face(dress.bottom, corners);
+        }
+        // Walls, outward: walking p -> q counter-clockwise, outside is on the right.
+        for i in 0..n {
+            let (p, q) = (part[i], part[(i + 1) % n]);
+            if let Some(r) = ridge {
+                if (p[1] - r).abs() < 1e-6 && (q[1] - r).abs() < 1e-6 {
+                    continue;
+                }
+            }
+            let (hp0, hq0, hp1, hq1) = (bottom(p[1]), bottom(q[1]), top(p[1]), top(q[1]));
+            let pm = local.to_map(p);
+            let qm = local.to_map(q);
+            let ids = [
+                mesh.vertex(frame, pm, hp0),
+                mesh.vertex(frame, qm, hq0),
+                mesh.vertex(frame, qm, hq1),
+                mesh.vertex(frame, pm, hp1),
+            ];
+            let facade = dress.facade.as_ref().filter(|fa| {
+                (p[1] - fa.front_v).abs() < 0.01 && (q[1] - fa.front_v).abs() < 0.01
+            });
+            let (material, uvs) = match facade {
+                Some(fa) => {
+                    let (up, uq) = (p[0] * fa.u_scale, q[0] * fa.u_scale);
+                    let h = fa.height;
+                    (
+                        fa.material,
+                        [
+                            mesh.uv(up, hp0 / h),
+                            mesh.uv(uq, hq0 / h),
+                            mesh.uv(uq, hq1 / h),
+                            mesh.uv(up, hp1 / h),
+                        ],
+                    )
+                }
+                None => {
+                    let len = (q[0] - p[0]).hypot(q[1] - p[1]) / WORLD_TEXTURE_BASE;
+                    let b = WORLD_TEXTURE_BASE;
+                    (
+                        dress.wall,
+                        [
+                            mesh.uv(0.0, hp0 / b),
+                            mesh.uv(len, hq0 / b),
+                            mesh.uv(len, hq1 / b),
+                            mesh.uv(0.0, hp1 / b),
+                        ],
+                    )
+                }
+            };
+            mesh.face(material, ids.into_iter().zip(uvs).collect());
+        }
+    }
+}
+
+/// Triangles (counter-clockwise) covering a ring: the ring itself when convex, else earcut.
+fn triangles(part: &[[f64; 2]]) -> Vec<Vec<usize>> {
+    if is_convex(part) {
+        return vec![(0..part.len()).collect()];
+    }
+    use geo::TriangulateEarcut;
+    use geo_types::{LineString, Polygon};
+    let poly = Polygon::new(
+        LineString(part.iter().map(|p| Coord { x: p[0], y: p[1] }).collect()),
+        vec![],
+    );
+    let raw = poly.earcut_triangles_raw();
+    let index_of = |v: [f64; 2]| part.iter().position(|p| *p == v);
+    raw.triangle_indices
+        .chunks_exact(3)
+        .filter_map(|t| {
+            let mut ids: Vec<usize> = t
+                .iter()
+                .map(|&k| index_of(raw.vertices[k]))
+                .collect::<Option<_>>()?;
+            let tri: Vec<[f64; 2]> = ids.iter().map(|&i| part[i]).collect();
+            if area(&tri) < 0.0 {
+                ids.reverse();
+            }
+            Some(ids)
+        })
+        .collect()
+}

@@ -1,0 +1,121 @@
+//! A mesh object as it will be written: positions in millimetres, shared within the object.
+//!
+//! Positions are rounded to whole millimetres when they are added, and equal positions share
+//! one index. That makes shells closed by construction (two faces meeting at an edge use the
+//! same two indices), keeps files small, and lets the OBJ writer print integers.
+
+use std::collections::HashMap;
+
+use geo_types::Coord;
+
+/// One face: a material and its corners as (position index, uv index), counter-clockwise
+/// seen from outside.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Face {
+    pub material: u16,
+    pub corners: Vec<(u32, u32)>,
+}
+
+/// One OBJ object (`o <name>`).
+#[derive(Debug, Clone, Default)]
+pub struct Mesh {
+    pub name: String,
+    /// Output frame, millimetres: x east, y up, z south, relative to the dataset origin.
+    pub positions: Vec<[i64; 3]>,
+    /// Texture coordinates in units of 1/10000.
+    pub uvs: Vec<[i32; 2]>,
+    pub faces: Vec<Face>,
+    pos_index: HashMap<[i64; 3], u32>,
+    uv_index: HashMap<[i32; 2], u32>,
+}
+
+/// Converts map coordinates (east, north, height; metres) to the output frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Frame {
+    pub origin: [f64; 2],
+}
+
+impl Mesh {
+    pub fn new(name: String) -> Mesh {
+        Mesh {
+            name,
+            ..Mesh::default()
+        }
+    }
+
+    /// Adds (or finds) the vertex at map point `p`, height `h`.
+    pub fn vertex(&mut self, frame: Frame, p: Coord<f64>, h: f64) -> u32 {
+        let key = [
+            mm(p.x - frame.origin[0]),
+            mm(h),
+            mm(-(p.y - frame.origin[1])),
+        ];
+        let next = self.positions.len() as u32;
+        *self.pos_index.entry(key).or_insert_with(|| {
+            self.positions.push(key);
+            next
+        })
+    }
+
+    /// Adds (or finds) a texture coordinate.
+    pub fn uv(&mut self, u: f64, v: f64) -> u32 {
+        let key = [(u * 10_000.0).round() as i32, (v * 10_000.0).round() as i32];
+        let next = self.uvs.len() as u32;
+        *self.uv_index.entry(key).or_insert_with(|| {
+            self.uvs.push(key);
+            next
+        })
+    }
+
+    /// Adds a face, dropping corners that collapsed onto their neighbour when rounded to
+    /// millimetres; a face left with fewer than three corners is not added.
+    pub fn face(&mut self, material: u16, corners: Vec<(u32, u32)>) {
+        let mut c: Vec<(u32, u32)> = Vec::with_capacity(corners.len());
+        for k in corners {
+            if c.last().map(|l| l.0) != Some(k.0) {
+                c.push(k);
+            }
+        }
+        while c.len() > 1 && c.first().map(|f| f.0) == c.last().map(|l| l.0) {
+            c.pop();
+        }
+        if c.len() >= 3 {
+            self.faces.push(Face {
+                material,
+                corners: c,
+            });
+        }
+    }
+
+    /// Releases the lookup tables once the mesh is complete.
+    pub fn finish(mut self) -> Mesh {
+        self.pos_index = HashMap::new();
+        self.uv_index = HashMap::new();
+        self
+    }
+}
+
+/// Rounds metres to whole millimetres.
+pub fn mm(v: f64) -> i64 {
+    (v * 1000.0).round() as i64
+}
+
+/// Directed edges that are not matched by exactly one opposite edge: empty for a closed,
+/// consistently oriented (watertight) mesh.
+pub fn open_edges(mesh: &Mesh) -> Vec<(u32, u32)> {
+    let mut count: HashMap<(u32, u32), i32> = HashMap::new();
+    for f in &mesh.faces {
+        let n = f.corners.len();
+        for i in 0..n {
+            let (a, b) = (f.corners[i].0, f.corners[(i + 1) % n].0);
+            *count.entry((a, b)).or_default() += 1;
+        }
+    }
+    let mut bad: Vec<(u32, u32)> = count
+        .iter()
+        .filter(|((a, b), n)| **n != 1 || count.get(&(*b, *a)) != Some(&1))
+        .map(|(e, _)| *e)
+        .collect();
+    bad.sort();
+    bad
+}

@@ -1,0 +1,216 @@
+//! Reads one shapefile layer: geometry from `.shp`/`.shx`, attributes from `.dbf`, text
+//! decoded by the `.cpg` code page.
+//!
+//! The dangerous case in Japanese data is a Shift_JIS DBF with no `.cpg` and no code page in
+//! its header: it decodes as UTF-8 into replacement characters without any error. We decode,
+//! then look for U+FFFD and warn, naming the file and the option that fixes it.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+use shapefile::Shape;
+
+use super::InputError;
+
+/// One feature: its shape and its attributes as text.
+pub struct Feature {
+    /// Record number in the file, 0-based.
+    pub record: usize,
+    pub shape: Shape,
+    pub attrs: BTreeMap<String, String>,
+}
+
+/// A layer as read, before any interpretation.
+pub struct Layer {
+    pub path: PathBuf,
+    pub features: Vec<Feature>,
+    /// The encoding used for the DBF text, for the report.
+    pub encoding: String,
+    /// The `.prj` text, if present.
+    pub prj: Option<String>,
+    pub warnings: Vec<String>,
+}
+
+/// Maps a code page name (from a `.cpg` or the parameter file) to an encoding.
+///
+/// Accepts the names Japanese GIS software writes, including `MS932` and `Windows-31J`, which
+/// the dbase crate's own table does not know.
+pub fn encoding_for(name: &str) -> Option<&'static encoding_rs::Encoding> {
+    let n = name
+        .trim()
+        .trim_start_matches('\u{feff}')
+        .to_ascii_lowercase()
+        .replace(['-', '_', ' '], "");
+    match n.as_str() {
+        "utf8" | "65001" | "unicode" => Some(encoding_rs::UTF_8),
+        "shiftjis" | "sjis" | "cp932" | "932" | "ms932" | "windows31j" | "mskanji"
+        | "windows932" => Some(encoding_rs::SHIFT_JIS),
+        "eucjp" | "20932" | "51932" => Some(encoding_rs::EUC_JP),
+        "latin1" | "iso88591" | "cp1252" | "1252" | "windows1252" => Some(encoding_rs::WINDOWS_1252),
+        "gbk" | "cp936" | "936" => Some(encoding_rs::GBK),
+        "big5" | "950" | "cp950" => Some(encoding_rs::BIG5),
+        "euckr" | "949" | "cp949" => Some(encoding_rs::EUC_KR),
+        _ => encoding_rs::Encoding::for_label(name.trim().as_bytes()),
+    }
+}
+
+/// Reads a whole layer. `forced` is the encoding from the parameter file, empty for none.
+pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
+    let file = path.display().to_string();
+    let io = |what: &str, e: std::io::Error| InputError::Layer {
+        file: file.clone(),
+        message: format!("{what}: {e}"),
+    };
+    let mut warnings = Vec::new();
+    let shapes = shapefile::ShapeReader::from_path(path)
+        .and_then(|r| r.read())
+        .map_err(|e| InputError::Layer {
+            file: file.clone(),
+            message: format!("cannot read the shapes: {e}"),
+        })?;
+
+    let dbf_path = path.with_extension("dbf");
+    let dbf = File::open(&dbf_path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => InputError::Layer {
+            file: file.clone(),
+            message: format!(
+                "the attribute file {} is missing; a shapefile needs its .shp, .shx and .dbf",
+                dbf_path.display()
+            ),
+        },
+        _ => io("cannot open the .dbf", e),
+    })?;
+
+    let cpg = std::fs::read_to_string(path.with_extension("cpg")).ok();
+    let (encoding, encoding_name) = if !forced.trim().is_empty() {
+        let enc = encoding_for(forced).ok_or_else(|| InputError::Layer {
+            file: file.clone(),
+            message: format!("unknown encoding `{forced}` in the parameter file"),
+        })?;
+        (Some(enc), format!("{} (parameter file)", enc.name()))
+    } else if let Some(label) = cpg.as_deref().filter(|s| !s.trim().is_empty()) {
+        match encoding_for(label) {
+            Some(enc) => (Some(enc), format!("{} (.cpg)", enc.name())),
+            None => {
+                warnings.push(format!(
+                    "{file}: the .cpg names an unknown code page `{}`; reading the DBF by its header",
+                    label.trim()
+                ));
+                (None, "DBF header".to_string())
+            }
+        }
+    } else {
+        (None, "DBF header or UTF-8 (no .cpg)".to_string())
+    };
+    let builder = dbase::ReaderBuilder::new();
+    let builder = match encoding {
+        Some(enc) => builder.with_encoding(dbase::encoding::EncodingRs::from(enc)),
+        None => builder,
+    };
+    let mut dbf = builder
+        .build(BufReader::new(dbf))
+        .map_err(|e| InputError::Layer {
+            file: dbf_path.display().to_string(),
+            message: format!("cannot read the DBF: {e}"),
+        })?;
+    let records = dbf.read().map_err(|e| InputError::Layer {
+        file: dbf_path.display().to_string(),
+        message: format!("cannot read the DBF records: {e}"),
+    })?;
+    if records.len() != shapes.len() {
+        return Err(InputError::Layer {
+            file: file.clone(),
+            message: format!(
+                "the .shp has {} shapes but the .dbf has {} records; the files do not belong together",
+                shapes.len(),
+                records.len()
+            ),
+        });
+    }
+
+    let mut garbled = 0usize;
+    let mut features = Vec::with_capacity(shapes.len());
+    for (record, (shape, rec)) in shapes.into_iter().zip(records).enumerate() {
+        let mut attrs = BTreeMap::new();
+        for (name, value) in rec.into_iter() {
+            let text = field_text(&value);
+            if text.contains('\u{fffd}') {
+                garbled += 1;
+            }
+            attrs.insert(name, text);
+        }
+        features.push(Feature {
+            record,
+            shape,
+            attrs,
+        });
+    }
+    if garbled > 0 {
+        warnings.push(format!(
+            "{file}: {garbled} text value(s) did not decode as {encoding_name} and contain \u{fffd}; \
+             if the data is Japanese, add a .cpg file containing SHIFT_JIS or set \
+             `encoding = \"shift_jis\"` for this layer in the parameter file"
+        ));
+    }
+    let prj = std::fs::read_to_string(path.with_extension("prj")).ok();
+    Ok(Layer {
+        path: path.to_path_buf(),
+        features,
+        encoding: encoding_name,
+        prj,
+        warnings,
+    })
+}
+
+/// Renders a DBF value as the text a user would see in a GIS attribute table.
+fn field_text(value: &dbase::FieldValue) -> String {
+    use dbase::FieldValue as V;
+    match value {
+        V::Character(s) => s.as_deref().unwrap_or("").trim().to_string(),
+        V::Memo(s) => s.trim().to_string(),
+        V::Numeric(n) => n.map(fmt_number).unwrap_or_default(),
+        V::Float(n) => n.map(|v| fmt_number(f64::from(v))).unwrap_or_default(),
+        V::Double(n) => fmt_number(*n),
+        V::Integer(n) => n.to_string(),
+        V::Currency(n) => fmt_number(*n),
+        V::Logical(b) => b.map(|b| b.to_string()).unwrap_or_default(),
+        V::Date(d) => d
+            .map(|d| format!("{:04}-{:02}-{:02}", d.year(), d.month(), d.day()))
+            .unwrap_or_default(),
+        V::DateTime(dt) => {
+            let d = dt.date();
+            format!("{:04}-{:02}-{:02}", d.year(), d.month(), d.day())
+        }
+    }
+}
+
+/// Whole numbers print without a fraction so that numeric ids read as `12`, not `12.0`.
+fn fmt_number(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{}", v as i64)
+    } else {
+        format!("{v}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn japanese_code_page_names_are_known() {
+        for name in ["SHIFT_JIS", "Shift_JIS\n", "CP932", "932", "MS932", "Windows-31J", "sjis"] {
+            assert_eq!(encoding_for(name), Some(encoding_rs::SHIFT_JIS), "{name}");
+        }
+        assert_eq!(encoding_for("UTF-8"), Some(encoding_rs::UTF_8));
+        assert_eq!(encoding_for("no-such-code-page"), None);
+    }
+
+    #[test]
+    fn numeric_ids_print_as_integers() {
+        assert_eq!(fmt_number(12.0), "12");
+        assert_eq!(fmt_number(2.5), "2.5");
+    }
+}

@@ -1,0 +1,17 @@
+//! edo-city: GIS lots and streets in, a tiled 3D city of Edo-era Kyoto out.
+//!
+//! The method is Kosaka et al. 2008, "Automatic generation of 3D city models from GIS data".
+//! The pipeline reads in one direction, one module per stage:
+//! [`input`] -> [`analyse`] -> [`generate`] -> [`output`], driven by [`build`].
+//! See ARCHITECTURE.md for the codemap and the rules each stage keeps.
+
+pub mod analyse;
+pub mod build;
+pub mod generate;
+pub mod input;
+pub mod model;
+pub mod output;
+pub mod params;
+pub mod rng;
+pub mod synth;
+pub mod templates;

@@ -1,0 +1,225 @@
+//! The `edo-city` command line: parses flags into validated options and calls the library.
+//! Everything the user sees (progress bars, the summary, error context) lives here.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use edo_city::build::{BuildOptions, BuildOutcome, Progress, build};
+use edo_city::params::Params;
+
+#[derive(Parser)]
+#[command(name = "edo-city", version, about = "GIS lots and streets in, a tiled 3D city of Edo-era Kyoto townhouses out (Kosaka et al. 2008)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Build a tiled OBJ/MTL city from a shapefile directory.
+    Build {
+        /// Input directory (lots.shp, blocks.shp and/or streets.shp, lots.csv/.xlsx).
+        input: PathBuf,
+        /// Output directory; tiles go to <out>/tiles, textures to <out>/textures.
+        #[arg(short, long, default_value = "out")]
+        out: PathBuf,
+        /// Parameter file (TOML); keys it leaves out keep the defaults of params/default.toml.
+        #[arg(short, long)]
+        params: Option<PathBuf>,
+        /// Directory of machiya type files (*.toml), replacing the shipped types.
+        #[arg(long)]
+        templates: Option<PathBuf>,
+        /// Worker threads (0 = one per core). The output does not depend on it.
+        #[arg(short = 'j', long, default_value_t = 0)]
+        threads: usize,
+        /// No progress bars and no summary.
+        #[arg(short, long)]
+        quiet: bool,
+        /// Print the time of each stage.
+        #[arg(long)]
+        timings: bool,
+    },
+    /// Write a Kyoto-like shapefile directory of synthetic lots, blocks and streets.
+    Synth {
+        /// Output directory.
+        dir: PathBuf,
+        /// Number of lots.
+        #[arg(long, default_value_t = 500)]
+        lots: usize,
+        /// Seed of the town's layout.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+    /// Print the default parameter file (documented key by key).
+    Params,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Build {
+            input,
+            out,
+            params,
+            templates,
+            threads,
+            quiet,
+            timings,
+        } => {
+            let params = match &params {
+                Some(p) => Params::from_path(p)?,
+                None => Params::default(),
+            };
+            let opts = BuildOptions {
+                input,
+                out,
+                params,
+                templates,
+                threads,
+            };
+            let bars = Bars::new(quiet || !std::io::stderr().is_terminal());
+            let outcome = build(&opts, &bars).context("the build did not finish")?;
+            if !quiet {
+                print_summary(&opts, &outcome);
+            }
+            if timings {
+                let t = &outcome.timings;
+                eprintln!(
+                    "timings: read {:.3} s, analyse {:.3} s, generate+write {:.3} s, total {:.3} s",
+                    t.read.as_secs_f64(),
+                    t.analyse.as_secs_f64(),
+                    t.generate_and_write.as_secs_f64(),
+                    t.total.as_secs_f64()
+                );
+            }
+            Ok(())
+        }
+        Command::Synth { dir, lots, seed } => {
+            if lots == 0 {
+                anyhow::bail!("--lots must be at least 1");
+            }
+            let s = edo_city::synth::write_town(&dir, lots, seed).map_err(anyhow::Error::msg)?;
+            println!(
+                "wrote {}: {} lots ({} machiya), {} blocks, {} streets",
+                dir.display(),
+                s.lots,
+                s.machiya,
+                s.blocks,
+                s.streets
+            );
+            Ok(())
+        }
+        Command::Params => {
+            print!("{}", edo_city::params::DEFAULT_TOML);
+            Ok(())
+        }
+    }
+}
+
+fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
+    let r = &o.report;
+    let c = &r.counts;
+    println!("edo-city: built {} into {}", opts.input.display(), opts.out.display());
+    println!(
+        "  lots       {:>7}  ({})",
+        c.lots,
+        c.lots_by_use
+            .iter()
+            .map(|(k, v)| format!("{k} {v}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    println!(
+        "  machiya    {:>7}  (type from data {}, drawn from type_mix {})",
+        c.machiya, c.type_given, c.type_drawn
+    );
+    for (t, n) in &c.by_type {
+        let share = 100.0 * *n as f64 / c.machiya.max(1) as f64;
+        println!("    {t:<18} {n:>7}  {share:5.1} %");
+    }
+    println!(
+        "  frontage fallback {:>3}  (no vertex pair passed the Fig.4 test)",
+        c.frontage_fallback
+    );
+    println!(
+        "  tiles      {:>7}  ({:.1} MB written)",
+        c.tiles,
+        o.bytes_written as f64 / 1e6
+    );
+    for t in &r.tables {
+        println!(
+            "  table {}: {} rows, {} matched, {} rows without a lot, {} lots without a row",
+            t.file, t.rows, t.matched, t.rows_without_feature, t.features_without_row
+        );
+    }
+    if c.skipped > 0 {
+        println!("  skipped    {:>7}  (details in report.json):", c.skipped);
+        for (reason, n) in &r.skipped_by_reason {
+            println!("    {n:>5}  {reason}");
+        }
+    }
+    for w in r.warnings.iter().take(10) {
+        println!("  warning: {w}");
+    }
+    if r.warnings.len() > 10 {
+        println!("  ... {} more warnings in report.json", r.warnings.len() - 10);
+    }
+    println!("  in {:.2} s", o.timings.total.as_secs_f64());
+}
+
+/// indicatif bars, one per stage, drawn on stderr only when it is a terminal.
+struct Bars {
+    bar: ProgressBar,
+}
+
+impl Bars {
+    fn new(hidden: bool) -> Bars {
+        let bar = ProgressBar::new(0);
+        if hidden {
+            bar.set_draw_target(ProgressDrawTarget::hidden());
+        }
+        Bars { bar }
+    }
+}
+
+impl Progress for Bars {
+    fn start(&self, stage: &str, total: u64) {
+        self.bar.reset();
+        self.bar.set_length(total);
+        let style = if total == 0 {
+            ProgressStyle::with_template("{spinner} {msg} {elapsed}")
+        } else {
+            ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} {elapsed} eta {eta}")
+        };
+        if let Ok(s) = style {
+            self.bar.set_style(s.progress_chars("=> "));
+        }
+        self.bar.set_message(stage.to_string());
+        if total == 0 {
+            self.bar.enable_steady_tick(Duration::from_millis(100));
+        }
+    }
+    fn inc(&self, n: u64) {
+        self.bar.inc(n);
+    }
+    fn finish(&self) {
+        self.bar.disable_steady_tick();
+        self.bar.finish_and_clear();
+    }
+}

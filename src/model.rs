@@ -1,0 +1,174 @@
+//! Plain data passed between the pipeline stages.
+//!
+//! Every stage takes these types and returns new ones; none of them does I/O. Keeping them
+//! here (and not inside a stage) lets `input/` and `analyse/` stay independent of each other.
+
+use std::collections::BTreeMap;
+
+use geo_types::{Coord, LineString, Polygon};
+use serde::Serialize;
+
+/// What a lot (shikichi 敷地) is used for; decides which generator it gets.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LotUse {
+    /// Town lot (machi-chi 町地): gets a townhouse, machiya 町家.
+    Machiya,
+    /// Samurai residence (buke-chi 武家地): fence and gate (a later stage).
+    Buke,
+    /// Court noble residence (kuge-chi 公家地): fence and gate (a later stage).
+    Kuge,
+    /// Temple or shrine (jisha-chi 寺社地): earthen wall and gate (a later stage).
+    Jisha,
+    /// Anything else, kept verbatim so the report can name it.
+    Other(String),
+}
+
+impl LotUse {
+    /// Parses the `use` attribute; an empty value means a town lot, as the paper's data did.
+    pub fn parse(raw: &str) -> LotUse {
+        let t = raw.trim();
+        match t.to_lowercase().as_str() {
+            "" | "machiya" | "machi" | "machichi" | "町地" | "町家" | "町屋" => LotUse::Machiya,
+            "buke" | "bukechi" | "武家地" | "武家" => LotUse::Buke,
+            "kuge" | "kugechi" | "公家地" | "公家" => LotUse::Kuge,
+            "jisha" | "jishachi" | "寺社地" | "寺社" | "寺" | "社" => LotUse::Jisha,
+            _ => LotUse::Other(t.to_string()),
+        }
+    }
+
+    /// The name used in reports.
+    pub fn name(&self) -> &str {
+        match self {
+            LotUse::Machiya => "machiya",
+            LotUse::Buke => "buke",
+            LotUse::Kuge => "kuge",
+            LotUse::Jisha => "jisha",
+            LotUse::Other(s) => s,
+        }
+    }
+}
+
+/// One lot polygon with the attributes the pipeline needs, after the table join.
+#[derive(Debug, Clone)]
+pub struct Lot {
+    /// The `id` attribute, unique within the layer.
+    pub id: String,
+    /// Position in the shapefile (0-based), used to keep every output in input order.
+    pub record: usize,
+    /// Outline in projected metres, exterior ring counter-clockwise, closed.
+    pub outline: Polygon<f64>,
+    pub lot_use: LotUse,
+    /// Raw machiya type (`mtype`), resolved against the templates during analysis.
+    pub mtype: Option<String>,
+    pub district: Option<String>,
+    /// A tile id given in the data; wins over the computed one.
+    pub tile: Option<String>,
+    /// Every attribute of the feature (DBF fields, then table values on top).
+    pub attrs: BTreeMap<String, String>,
+}
+
+/// A street centreline with its full width in metres.
+#[derive(Debug, Clone)]
+pub struct Street {
+    pub id: String,
+    pub line: LineString<f64>,
+    pub width: f64,
+}
+
+/// A feature left out of the build, with the reason, for `report.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Skipped {
+    pub layer: String,
+    pub file: String,
+    pub id: String,
+    pub reason: String,
+}
+
+/// Everything read from the input directory, in input order.
+#[derive(Debug, Clone, Default)]
+pub struct Dataset {
+    pub lots: Vec<Lot>,
+    /// City blocks (machi 町 / gaiku 街区): their boundaries are street edges.
+    pub blocks: Vec<Polygon<f64>>,
+    pub streets: Vec<Street>,
+    /// Contents of the lots layer's `.prj`, if any, carried to the manifest.
+    pub crs_wkt: Option<String>,
+    pub skipped: Vec<Skipped>,
+    pub warnings: Vec<String>,
+    pub joins: Vec<TableJoin>,
+}
+
+/// How an attribute table matched its layer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TableJoin {
+    pub layer: String,
+    pub file: String,
+    pub rows: usize,
+    pub matched: usize,
+    /// Row ids with no feature of that id (first few kept for the report).
+    pub rows_without_feature: usize,
+    pub rows_without_feature_ids: Vec<String>,
+    pub features_without_row: usize,
+}
+
+/// The frontage (maguchi 間口): the lot edge facing the street, from Fig.4 of the paper.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frontage {
+    /// Start and end vertex; walking a -> b the lot lies on the left.
+    pub a: Coord<f64>,
+    pub b: Coord<f64>,
+    /// True when no pair passed the paper's test and the nearest edge was taken.
+    pub fallback: bool,
+}
+
+impl Frontage {
+    pub fn width(&self) -> f64 {
+        ((self.b.x - self.a.x).powi(2) + (self.b.y - self.a.y).powi(2)).sqrt()
+    }
+
+    /// Unit vector along the street (u axis of the local frame).
+    pub fn u_axis(&self) -> Coord<f64> {
+        let w = self.width();
+        Coord {
+            x: (self.b.x - self.a.x) / w,
+            y: (self.b.y - self.a.y) / w,
+        }
+    }
+
+    /// Unit vector from the street into the lot (v axis of the local frame).
+    pub fn v_axis(&self) -> Coord<f64> {
+        let u = self.u_axis();
+        Coord { x: -u.y, y: u.x }
+    }
+}
+
+/// A tile id `<col>_<row>` on the fixed grid.
+pub type TileId = String;
+
+/// A machiya lot after analysis: everything generation needs, nothing more.
+#[derive(Debug, Clone)]
+pub struct PlannedMachiya {
+    pub id: String,
+    pub record: usize,
+    pub outline: Polygon<f64>,
+    pub frontage: Frontage,
+    /// Template name of the resolved type.
+    pub mtype: String,
+    /// True when the type came from the data, false when drawn from the type mix.
+    pub type_given: bool,
+    pub district: Option<String>,
+    pub tile: TileId,
+}
+
+/// The output of analysis: what to build, tile by tile.
+#[derive(Debug, Clone, Default)]
+pub struct Plan {
+    /// Dataset origin in projected metres: output coordinates are relative to it.
+    pub origin: [f64; 2],
+    /// Machiya per tile, each tile's list in input order.
+    pub tiles: BTreeMap<TileId, Vec<PlannedMachiya>>,
+    pub frontage_fallback: usize,
+    pub skipped: Vec<Skipped>,
+    pub warnings: Vec<String>,
+}

@@ -1,0 +1,38 @@
+//! The MTL file of a tile, and the texture library copied beside the tiles.
+//!
+//! Textured materials get a white `Kd`: three.js multiplies the texture by `Kd`, Blender and
+//! MeshLab ignore it when a texture is present, so white shows the texture right everywhere.
+
+use std::fmt::Write;
+
+use crate::generate::materials::MATERIALS;
+
+/// MTL text listing every material; textures are referenced as `../textures/<file>`.
+pub fn mtl_text() -> String {
+    let mut s = format!(
+        "# edo-city {} materials; textures in ../textures/\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    for m in MATERIALS {
+        let _ = writeln!(s, "\nnewmtl {}", m.name);
+        match m.texture {
+            Some(t) => {
+                let _ = writeln!(
+                    s,
+                    "# untextured colour: {:.3} {:.3} {:.3}",
+                    m.kd[0], m.kd[1], m.kd[2]
+                );
+                s.push_str("Ka 1.000 1.000 1.000\nKd 1.000 1.000 1.000\n");
+                let _ = writeln!(s, "Ks 0.000 0.000 0.000\nd 1.0\nillum 1\nmap_Kd ../textures/{t}");
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "Ka {0:.3} {1:.3} {2:.3}\nKd {0:.3} {1:.3} {2:.3}\nKs 0.000 0.000 0.000\nd 1.0\nillum 1",
+                    m.kd[0], m.kd[1], m.kd[2]
+                );
+            }
+        }
+    }
+    s
+}

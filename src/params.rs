@@ -1,0 +1,373 @@
+//! The parameter file: every constant of the method a user may change, in one TOML file.
+//!
+//! `params/default.toml` is the documented reference; it is compiled into the binary so that
+//! `edo-city build` works from any directory. Unknown keys and wrong types are errors that
+//! name the key, line and column (serde's `deny_unknown_fields` plus toml's spans).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// The default parameter file, shipped inside the binary.
+pub const DEFAULT_TOML: &str = include_str!("../params/default.toml");
+
+#[derive(Debug, Error)]
+pub enum ParamsError {
+    #[error("cannot read parameter file {path}: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("parameter file {path}: {message}")]
+    Parse { path: String, message: String },
+    #[error("parameter file {path}: {message}")]
+    Invalid { path: String, message: String },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Params {
+    /// Seed of every random choice; same seed, same city.
+    pub seed: u64,
+    /// Edge of a square tile, metres.
+    pub tile_size: f64,
+    /// A point of the tile grid, metres. Tile `c_r` spans
+    /// `[origin + c*size, origin + (c+1)*size)` in x and the same in y with `r`.
+    pub tile_origin: [f64; 2],
+    /// Output coordinates are relative to this point. Empty: the south-west corner of the data
+    /// rounded down to a whole kilometre (stated in the manifest and every OBJ header).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<[f64; 2]>,
+    pub layers: Layers,
+    pub frontage: FrontageParams,
+    pub machiya: MachiyaParams,
+    /// Relative weights of the machiya types drawn for lots of unknown type.
+    pub type_mix: BTreeMap<String, f64>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layers {
+    pub lots: LotsLayer,
+    pub blocks: BlocksLayer,
+    pub streets: StreetsLayer,
+}
+
+/// Settings shared by every layer: where it is and how its text is encoded.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LotsLayer {
+    /// Shapefile path, relative to the input directory.
+    pub file: String,
+    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
+    #[serde(default)]
+    pub encoding: String,
+    /// Attribute table joined on `id`: `<table>.csv` or `<table>.xlsx` in the input directory.
+    pub table: String,
+    /// XLSX sheet to read; empty = the first sheet.
+    #[serde(default)]
+    pub sheet: String,
+    pub fields: LotFields,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LotFields {
+    pub id: String,
+    #[serde(rename = "use")]
+    pub lot_use: String,
+    pub mtype: String,
+    pub district: String,
+    pub tile: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlocksLayer {
+    pub file: String,
+    #[serde(default)]
+    pub encoding: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StreetsLayer {
+    pub file: String,
+    #[serde(default)]
+    pub encoding: String,
+    /// Field holding the full street width in metres.
+    pub width_field: String,
+    /// Width used where the field is missing, empty or not a positive number.
+    pub default_width: f64,
+}
+
+/// The constants of Fig.4.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrontageParams {
+    /// Largest angle at the lot centroid between the two frontage vertices, degrees.
+    pub max_angle_deg: f64,
+    /// Shortest frontage, metres.
+    pub min_length: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MachiyaParams {
+    /// Depth of the main building (omoya 主屋) from the frontage into the lot, metres;
+    /// a shallower lot is filled to its back.
+    pub depth: f64,
+    /// Lots whose house would be shallower than this are skipped and reported, metres.
+    pub min_depth: f64,
+    /// Directory of machiya type files; empty = the ones shipped inside the binary.
+    #[serde(default)]
+    pub templates: String,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        // The shipped file is the single source of the defaults; a unit test parses it.
+        Params::from_toml_str(DEFAULT_TOML, "params/default.toml")
+            .expect("shipped params/default.toml is valid")
+    }
+}
+
+impl Params {
+    /// Reads a parameter file. Keys it leaves out keep their default values.
+    pub fn from_path(path: &Path) -> Result<Params, ParamsError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ParamsError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Params::from_toml_str(&text, &path.display().to_string())
+    }
+
+    /// Parses parameter text over the defaults: a user file may give only the keys it changes.
+    pub fn from_toml_str(text: &str, path: &str) -> Result<Params, ParamsError> {
+        let parse = |t: &str| -> Result<toml::Table, ParamsError> {
+            t.parse::<toml::Table>().map_err(|e| ParamsError::Parse {
+                path: path.to_string(),
+                message: e.to_string(),
+            })
+        };
+        let mut merged = parse(DEFAULT_TOML)?;
+        let user = parse(text)?;
+        // `type_mix` is replaced whole: a user who lists types means exactly those.
+        merge(&mut merged, user);
+        // Re-serialise and parse with spans so that errors point into the user's text when the
+        // key is theirs. Type errors are found by parsing the user's text alone first.
+        check_user_keys(text, path)?;
+        let merged_text = toml::to_string(&merged).map_err(|e| ParamsError::Parse {
+            path: path.to_string(),
+            message: e.to_string(),
+        })?;
+        let params: Params = toml::from_str(&merged_text).map_err(|e| ParamsError::Parse {
+            path: path.to_string(),
+            message: e.to_string(),
+        })?;
+        params.validate(path)?;
+        Ok(params)
+    }
+
+    fn validate(&self, path: &str) -> Result<(), ParamsError> {
+        let bad = |message: String| ParamsError::Invalid {
+            path: path.to_string(),
+            message,
+        };
+        let positive = [
+            ("tile_size", self.tile_size),
+            ("frontage.min_length", self.frontage.min_length),
+            ("machiya.depth", self.machiya.depth),
+            ("layers.streets.default_width", self.layers.streets.default_width),
+        ];
+        for (key, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(bad(format!("`{key}` must be a positive number, got {value}")));
+            }
+        }
+        if !(self.machiya.min_depth.is_finite() && self.machiya.min_depth >= 0.0) {
+            return Err(bad("`machiya.min_depth` must be 0 or more".into()));
+        }
+        let angle = self.frontage.max_angle_deg;
+        if !(angle > 0.0 && angle <= 180.0) {
+            return Err(bad(format!(
+                "`frontage.max_angle_deg` must be in (0, 180], got {angle}"
+            )));
+        }
+        if self.type_mix.is_empty() {
+            return Err(bad("`type_mix` lists no machiya type".into()));
+        }
+        for (name, w) in &self.type_mix {
+            if !(w.is_finite() && *w >= 0.0) {
+                return Err(bad(format!("`type_mix.{name}` must be 0 or more, got {w}")));
+            }
+        }
+        if self.type_mix.values().sum::<f64>() <= 0.0 {
+            return Err(bad("`type_mix` weights add up to 0".into()));
+        }
+        Ok(())
+    }
+}
+
+/// Overlays `user` on `base`, table by table; `type_mix` is replaced whole.
+fn merge(base: &mut toml::Table, user: toml::Table) {
+    for (key, value) in user {
+        match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(u)) if key != "type_mix" => {
+                merge(b, u)
+            }
+            (_, v) => {
+                base.insert(key, v);
+            }
+        }
+    }
+}
+
+/// Parses the user's own text against the schema, every field optional, so that an unknown
+/// key or a wrong type is reported with the line and column of the user's file.
+fn check_user_keys(text: &str, path: &str) -> Result<(), ParamsError> {
+    toml::from_str::<partial::Params>(text)
+        .map(|_| ())
+        .map_err(|e| ParamsError::Parse {
+            path: path.to_string(),
+            message: e.to_string(),
+        })
+}
+
+/// The same schema with every field optional, for checking a partial user file.
+mod partial {
+    use serde::Deserialize;
+    use std::collections::BTreeMap;
+
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    pub struct Params {
+        seed: Option<u64>,
+        tile_size: Option<f64>,
+        tile_origin: Option<[f64; 2]>,
+        origin: Option<[f64; 2]>,
+        layers: Option<Layers>,
+        frontage: Option<Frontage>,
+        machiya: Option<Machiya>,
+        type_mix: Option<BTreeMap<String, f64>>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Layers {
+        lots: Option<Lots>,
+        blocks: Option<Blocks>,
+        streets: Option<Streets>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Lots {
+        file: Option<String>,
+        encoding: Option<String>,
+        table: Option<String>,
+        sheet: Option<String>,
+        fields: Option<LotFields>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct LotFields {
+        id: Option<String>,
+        #[serde(rename = "use")]
+        lot_use: Option<String>,
+        mtype: Option<String>,
+        district: Option<String>,
+        tile: Option<String>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Blocks {
+        file: Option<String>,
+        encoding: Option<String>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Streets {
+        file: Option<String>,
+        encoding: Option<String>,
+        width_field: Option<String>,
+        default_width: Option<f64>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Frontage {
+        max_angle_deg: Option<f64>,
+        min_length: Option<f64>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Machiya {
+        depth: Option<f64>,
+        min_depth: Option<f64>,
+        templates: Option<String>,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shipped_defaults_parse_and_follow_the_paper() {
+        let p = Params::default();
+        assert_eq!(p.tile_size, 250.0);
+        assert_eq!(p.frontage.max_angle_deg, 120.0);
+        assert_eq!(p.frontage.min_length, 1.2);
+        assert_eq!(p.type_mix.get("hiraya"), Some(&86.0));
+        assert_eq!(p.type_mix.get("naka-nikai-small"), Some(&66.0));
+        assert_eq!(p.type_mix.get("naka-nikai-large"), Some(&84.0));
+    }
+
+    #[test]
+    fn a_partial_file_overrides_only_its_keys() {
+        let p = Params::from_toml_str("seed = 9\n[machiya]\ndepth = 8.0\n", "t.toml").unwrap();
+        assert_eq!(p.seed, 9);
+        assert_eq!(p.machiya.depth, 8.0);
+        assert_eq!(p.tile_size, 250.0);
+    }
+
+    #[test]
+    fn unknown_key_names_key_and_line() {
+        let err = Params::from_toml_str("seed = 1\n\n[frontage]\nmax_angel_deg = 100\n", "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("max_angel_deg"), "{err}");
+        assert!(err.contains("line 4"), "{err}");
+    }
+
+    #[test]
+    fn wrong_type_names_key_and_line() {
+        let err = Params::from_toml_str("seed = 1\ntile_size = \"big\"\n", "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("line 2"), "{err}");
+        assert!(err.contains("tile_size") || err.contains("f64"), "{err}");
+    }
+
+    #[test]
+    fn negative_tile_size_is_rejected() {
+        let err = Params::from_toml_str("tile_size = -5.0\n", "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("tile_size"), "{err}");
+    }
+
+    #[test]
+    fn type_mix_is_replaced_whole() {
+        let p = Params::from_toml_str("[type_mix]\nsangai = 1.0\n", "t.toml").unwrap();
+        assert_eq!(p.type_mix.len(), 1);
+    }
+}
