@@ -62,7 +62,9 @@ impl Canvas {
     }
     fn save(&self, name: &str) {
         let path = format!("textures/{name}");
-        self.img.save(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+        self.img
+            .save(&path)
+            .unwrap_or_else(|e| panic!("{path}: {e}"));
         println!("wrote {path}");
     }
 }
@@ -80,7 +82,10 @@ fn lattice(period: u32, slat: u32) -> impl Fn(u32, u32) -> Rgba<u8> {
 }
 
 fn plaster(x: u32, y: u32) -> Rgba<u8> {
-    shade(PLASTER, noise(x, y, 2) * 0.03 + noise(x / 8, y / 8, 3) * 0.02)
+    shade(
+        PLASTER,
+        noise(x, y, 2) * 0.03 + noise(x / 8, y / 8, 3) * 0.02,
+    )
 }
 
 fn beam(x: u32, y: u32) -> Rgba<u8> {
@@ -173,7 +178,9 @@ fn main() {
                 shade([150, 170, 180], noise(x, y, 9) * 0.05)
             }
         });
-        c.band(0.80, 0.92, |x, y| shade([40, 40, 44], noise(x, y, 10) * 0.05));
+        c.band(0.80, 0.92, |x, y| {
+            shade([40, 40, 44], noise(x, y, 10) * 0.05)
+        });
         c.save("facade_kanban.png");
     }
     // Plain materials, tiled by world size (2 m walls, 1 m roof).
@@ -185,7 +192,11 @@ fn main() {
     c.band(0.0, 1.0, |x, y| {
         // Pantiles: channels down the slope every 32 px, courses every 32 px.
         let across = ((x % 32) as f32 / 32.0 * std::f32::consts::TAU).sin() * 0.18;
-        let course = if y % 32 < 3 { -0.3 } else { (y % 32) as f32 / 32.0 * 0.1 };
+        let course = if y % 32 < 3 {
+            -0.3
+        } else {
+            (y % 32) as f32 / 32.0 * 0.1
+        };
         shade([88, 90, 96], across + course + noise(x, y, 11) * 0.04)
     });
     c.save("kawara.png");
@@ -200,7 +211,10 @@ fn main() {
     let mut c = Canvas::new(128, 128);
     c.band(0.0, 1.0, |x, y| {
         let course = if y % 32 < 2 { -0.15 } else { 0.0 };
-        shade([196, 164, 112], noise(x, y, 14) * 0.06 + noise(x / 6, y / 6, 15) * 0.05 + course)
+        shade(
+            [196, 164, 112],
+            noise(x, y, 14) * 0.06 + noise(x / 6, y / 6, 15) * 0.05 + course,
+        )
     });
     c.save("tsuchikabe.png");
 }

@@ -121,7 +121,11 @@ fn run(
     timings.read = t0.elapsed();
 
     let t = Instant::now();
-    let lots_file = opts.input.join(&params.layers.lots.file).display().to_string();
+    let lots_file = opts
+        .input
+        .join(&params.layers.lots.file)
+        .display()
+        .to_string();
     let machiya_lots = data
         .lots
         .iter()
@@ -164,7 +168,10 @@ fn run(
     };
     rep.counts.lots = data.lots.len();
     for lot in &data.lots {
-        *rep.counts.lots_by_use.entry(lot.lot_use.name().to_string()).or_default() += 1;
+        *rep.counts
+            .lots_by_use
+            .entry(lot.lot_use.name().to_string())
+            .or_default() += 1;
     }
     rep.skipped = data.skipped.clone();
     rep.skipped.extend(plan.skipped.iter().cloned());
@@ -206,7 +213,9 @@ fn run(
     rep.counts.tiles = manifest_tiles.len();
     rep.counts.skipped = rep.skipped.len();
     for s in &rep.skipped {
-        *rep.skipped_by_reason.entry(report::reason_class(&s.reason)).or_default() += 1;
+        *rep.skipped_by_reason
+            .entry(report::reason_class(&s.reason))
+            .or_default() += 1;
     }
 
     let report_path = opts.out.join("report.json");

@@ -10,11 +10,15 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use edo_city::build::{BuildOptions, BuildOutcome, Progress, build};
+use edo_city::build::{build, BuildOptions, BuildOutcome, Progress};
 use edo_city::params::Params;
 
 #[derive(Parser)]
-#[command(name = "edo-city", version, about = "GIS lots and streets in, a tiled 3D city of Edo-era Kyoto townhouses out (Kosaka et al. 2008)")]
+#[command(
+    name = "edo-city",
+    version,
+    about = "GIS lots and streets in, a tiled 3D city of Edo-era Kyoto townhouses out (Kosaka et al. 2008)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -135,7 +139,11 @@ fn run(cli: Cli) -> Result<()> {
 fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
     let r = &o.report;
     let c = &r.counts;
-    println!("edo-city: built {} into {}", opts.input.display(), opts.out.display());
+    println!(
+        "edo-city: built {} into {}",
+        opts.input.display(),
+        opts.out.display()
+    );
     println!(
         "  lots       {:>7}  ({})",
         c.lots,
@@ -178,7 +186,10 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
         println!("  warning: {w}");
     }
     if r.warnings.len() > 10 {
-        println!("  ... {} more warnings in report.json", r.warnings.len() - 10);
+        println!(
+            "  ... {} more warnings in report.json",
+            r.warnings.len() - 10
+        );
     }
     println!("  in {:.2} s", o.timings.total.as_secs_f64());
 }

@@ -29,7 +29,9 @@ impl LotUse {
     pub fn parse(raw: &str) -> LotUse {
         let t = raw.trim();
         match t.to_lowercase().as_str() {
-            "" | "machiya" | "machi" | "machichi" | "町地" | "町家" | "町屋" => LotUse::Machiya,
+            "" | "machiya" | "machi" | "machichi" | "町地" | "町家" | "町屋" => {
+                LotUse::Machiya
+            }
             "buke" | "bukechi" | "武家地" | "武家" => LotUse::Buke,
             "kuge" | "kugechi" | "公家地" | "公家" => LotUse::Kuge,
             "jisha" | "jishachi" | "寺社地" | "寺社" | "寺" | "社" => LotUse::Jisha,

@@ -180,11 +180,16 @@ impl Params {
             ("tile_size", self.tile_size),
             ("frontage.min_length", self.frontage.min_length),
             ("machiya.depth", self.machiya.depth),
-            ("layers.streets.default_width", self.layers.streets.default_width),
+            (
+                "layers.streets.default_width",
+                self.layers.streets.default_width,
+            ),
         ];
         for (key, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(bad(format!("`{key}` must be a positive number, got {value}")));
+                return Err(bad(format!(
+                    "`{key}` must be a positive number, got {value}"
+                )));
             }
         }
         if !(self.machiya.min_depth.is_finite() && self.machiya.min_depth >= 0.0) {

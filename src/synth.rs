@@ -46,6 +46,16 @@ pub struct SynthLot {
     pub district: &'static str,
 }
 
+/// A synthetic town in memory.
+#[derive(Debug, Clone)]
+pub struct Town {
+    pub lots: Vec<SynthLot>,
+    /// Block outlines, counter-clockwise.
+    pub blocks: Vec<Vec<[f64; 2]>>,
+    /// Street centrelines with their full width.
+    pub streets: Vec<(Vec<[f64; 2]>, f64)>,
+}
+
 /// Machiya types written into the data (kanji, as in the machiya database), with weights.
 const GIVEN_TYPES: &[(&str, f64)] = &[
     ("平屋", 30.0),
@@ -71,10 +81,7 @@ fn pick<'a>(rng: &mut Pcg64, items: &'a [(&'a str, f64)]) -> &'a str {
 }
 
 /// Makes the town in memory: lots, block outlines and street centrelines (with widths).
-pub fn make_town(
-    lots_wanted: usize,
-    seed: u64,
-) -> (Vec<SynthLot>, Vec<Vec<[f64; 2]>>, Vec<(Vec<[f64; 2]>, f64)>) {
+pub fn make_town(lots_wanted: usize, seed: u64) -> Town {
     // About 64 lots fit a block; lay the blocks out in a near-square grid.
     let blocks_needed = lots_wanted.div_ceil(60).max(1);
     let nx = (blocks_needed as f64).sqrt().ceil() as usize;
@@ -95,11 +102,11 @@ pub fn make_town(
     let mut lots = Vec::with_capacity(lots_wanted);
     let mut blocks = Vec::new();
     'grid: for by in 0..ny {
-        for bx in 0..nx {
+        for (bx, x) in xs[..nx].iter().enumerate() {
             if lots.len() >= lots_wanted {
                 break 'grid;
             }
-            let x0 = BASE[0] + xs[bx] + width(bx) / 2.0;
+            let x0 = BASE[0] + x + width(bx) / 2.0;
             let y0 = BASE[1] + ys[by] + width(by) / 2.0;
             blocks.push(rect(x0, y0, BLOCK, BLOCK));
             let district = DISTRICTS[(2 - (by * 3 / ny).min(2)).min(2)];
@@ -133,7 +140,11 @@ pub fn make_town(
             width(j),
         ));
     }
-    (lots, blocks, streets)
+    Town {
+        lots,
+        blocks,
+        streets,
+    }
 }
 
 fn rect(x0: f64, y0: f64, w: f64, h: f64) -> Vec<[f64; 2]> {
@@ -194,9 +205,19 @@ fn block_lots(
         for w in frontages(rng, BLOCK) {
             let ring = if east {
                 let x = x0 + BLOCK;
-                vec![[x - side_depth, y], [x, y], [x, y + w], [x - side_depth, y + w]]
+                vec![
+                    [x - side_depth, y],
+                    [x, y],
+                    [x, y + w],
+                    [x - side_depth, y + w],
+                ]
             } else {
-                vec![[x0, y], [x0 + side_depth, y], [x0 + side_depth, y + w], [x0, y + w]]
+                vec![
+                    [x0, y],
+                    [x0 + side_depth, y],
+                    [x0 + side_depth, y + w],
+                    [x0, y + w],
+                ]
             };
             push(lots, rng, ring);
             y += w;
@@ -246,7 +267,11 @@ fn block_lots(
 /// Writes `lots.shp`, `blocks.shp`, `streets.shp` (with `.cpg` and `.prj`) into `dir`.
 pub fn write_town(dir: &Path, lots_wanted: usize, seed: u64) -> Result<SynthSummary, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let (lots, blocks, streets) = make_town(lots_wanted, seed);
+    let Town {
+        lots,
+        blocks,
+        streets,
+    } = make_town(lots_wanted, seed);
     write_lots(&dir.join("lots.shp"), &lots)?;
     write_blocks(&dir.join("blocks.shp"), &blocks)?;
     write_streets(&dir.join("streets.shp"), &streets)?;
@@ -295,8 +320,14 @@ pub fn write_lots(path: &Path, lots: &[SynthLot]) -> Result<(), String> {
     for lot in lots {
         let mut rec = dbase::Record::default();
         rec.insert("id".into(), dbase::FieldValue::Numeric(Some(lot.id as f64)));
-        rec.insert("use".into(), dbase::FieldValue::Character(Some(lot.lot_use.into())));
-        rec.insert("mtype".into(), dbase::FieldValue::Character(Some(lot.mtype.into())));
+        rec.insert(
+            "use".into(),
+            dbase::FieldValue::Character(Some(lot.lot_use.into())),
+        );
+        rec.insert(
+            "mtype".into(),
+            dbase::FieldValue::Character(Some(lot.mtype.into())),
+        );
         rec.insert(
             "district".into(),
             dbase::FieldValue::Character(Some(lot.district.into())),
@@ -313,7 +344,10 @@ fn write_blocks(path: &Path, blocks: &[Vec<[f64; 2]>]) -> Result<(), String> {
     let mut w = shapefile::Writer::from_path(path, table).map_err(shp_err(path))?;
     for (i, b) in blocks.iter().enumerate() {
         let mut rec = dbase::Record::default();
-        rec.insert("id".into(), dbase::FieldValue::Numeric(Some(i as f64 + 1.0)));
+        rec.insert(
+            "id".into(),
+            dbase::FieldValue::Numeric(Some(i as f64 + 1.0)),
+        );
         w.write_shape_and_record(&shp_polygon(b), &rec)
             .map_err(shp_err(path))?;
     }
@@ -329,7 +363,10 @@ fn write_streets(path: &Path, streets: &[(Vec<[f64; 2]>, f64)]) -> Result<(), St
     for (i, (line, width)) in streets.iter().enumerate() {
         let pts: Vec<Point> = line.iter().map(|p| Point::new(p[0], p[1])).collect();
         let mut rec = dbase::Record::default();
-        rec.insert("id".into(), dbase::FieldValue::Numeric(Some(i as f64 + 1.0)));
+        rec.insert(
+            "id".into(),
+            dbase::FieldValue::Numeric(Some(i as f64 + 1.0)),
+        );
         rec.insert("width".into(), dbase::FieldValue::Numeric(Some(*width)));
         w.write_shape_and_record(&Polyline::new(pts), &rec)
             .map_err(shp_err(path))?;
@@ -344,11 +381,14 @@ mod tests {
 
     #[test]
     fn exactly_the_lots_asked_for_and_deterministic() {
-        let (a, _, _) = make_town(1000, 3);
-        let (b, _, _) = make_town(1000, 3);
+        let a = make_town(1000, 3).lots;
+        let b = make_town(1000, 3).lots;
         assert_eq!(a.len(), 1000);
         assert_eq!(a.len(), b.len());
-        assert!(a.iter().zip(&b).all(|(x, y)| x.ring == y.ring && x.mtype == y.mtype));
+        assert!(a
+            .iter()
+            .zip(&b)
+            .all(|(x, y)| x.ring == y.ring && x.mtype == y.mtype));
     }
 
     #[test]
@@ -357,7 +397,11 @@ mod tests {
         for _ in 0..200 {
             let ws = frontages(&mut rng, 80.0);
             assert!((ws.iter().sum::<f64>() - 80.0).abs() < 1e-9);
-            assert!(ws.iter().all(|w| *w >= 1.5 * KEN - 1e-9 && *w <= 5.0 * KEN + 1e-9), "{ws:?}");
+            assert!(
+                ws.iter()
+                    .all(|w| *w >= 1.5 * KEN - 1e-9 && *w <= 5.0 * KEN + 1e-9),
+                "{ws:?}"
+            );
         }
     }
 }

@@ -15,7 +15,10 @@ use crate::generate::materials;
 
 /// The types shipped with the tool, compiled in so the binary works anywhere.
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("hiraya.toml", include_str!("../templates/machiya/hiraya.toml")),
+    (
+        "hiraya.toml",
+        include_str!("../templates/machiya/hiraya.toml"),
+    ),
     (
         "naka-nikai-small.toml",
         include_str!("../templates/machiya/naka-nikai-small.toml"),
@@ -24,13 +27,22 @@ pub const BUILTIN: &[(&str, &str)] = &[
         "naka-nikai-large.toml",
         include_str!("../templates/machiya/naka-nikai-large.toml"),
     ),
-    ("sou-nikai.toml", include_str!("../templates/machiya/sou-nikai.toml")),
-    ("sangai.toml", include_str!("../templates/machiya/sangai.toml")),
+    (
+        "sou-nikai.toml",
+        include_str!("../templates/machiya/sou-nikai.toml"),
+    ),
+    (
+        "sangai.toml",
+        include_str!("../templates/machiya/sangai.toml"),
+    ),
     (
         "shimoutaya.toml",
         include_str!("../templates/machiya/shimoutaya.toml"),
     ),
-    ("heitsuki.toml", include_str!("../templates/machiya/heitsuki.toml")),
+    (
+        "heitsuki.toml",
+        include_str!("../templates/machiya/heitsuki.toml"),
+    ),
     (
         "kanban-gatera.toml",
         include_str!("../templates/machiya/kanban-gatera.toml"),
@@ -42,10 +54,7 @@ pub enum TemplateError {
     #[error("machiya type file {file}: {message}")]
     Invalid { file: String, message: String },
     #[error("cannot read machiya type directory {dir}: {source}")]
-    Io {
-        dir: String,
-        source: std::io::Error,
-    },
+    Io { dir: String, source: std::io::Error },
 }
 
 /// One machiya type: the heights and materials of its parts. Lengths in metres.
@@ -164,7 +173,9 @@ impl Catalog {
                     if other != t.name {
                         return Err(TemplateError::Invalid {
                             file,
-                            message: format!("the spelling `{spelling}` is already used by type `{other}`"),
+                            message: format!(
+                                "the spelling `{spelling}` is already used by type `{other}`"
+                            ),
                         });
                     }
                 }
@@ -249,7 +260,15 @@ mod tests {
     #[test]
     fn shipped_types_cover_the_paper() {
         let cat = Catalog::load(None).unwrap();
-        for kanji in ["総二階", "中二階", "平屋", "三階", "仕舞屋", "塀付", "看板建"] {
+        for kanji in [
+            "総二階",
+            "中二階",
+            "平屋",
+            "三階",
+            "仕舞屋",
+            "塀付",
+            "看板建",
+        ] {
             assert!(cat.resolve(kanji).is_some(), "{kanji}");
         }
         for name in ["hiraya", "naka-nikai-small", "naka-nikai-large"] {
@@ -266,6 +285,9 @@ mod tests {
         )
         .unwrap();
         let err = Catalog::load(Some(dir.path())).unwrap_err().to_string();
-        assert!(err.contains("tall.toml") && err.contains("no_such"), "{err}");
+        assert!(
+            err.contains("tall.toml") && err.contains("no_such"),
+            "{err}"
+        );
     }
 }

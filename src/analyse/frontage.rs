@@ -117,7 +117,10 @@ mod tests {
         let dist = [20., 20., 0., 0.];
         let f = find_frontage(&ring, &dist, c(2., 10.), RULE);
         assert_eq!((f.a, f.b), (c(4., 20.), c(0., 20.)));
-        assert!(f.v_axis().y < 0.0, "v points into the lot, away from the street");
+        assert!(
+            f.v_axis().y < 0.0,
+            "v points into the lot, away from the street"
+        );
         assert!((lot_depth(&ring, &f) - 20.0).abs() < 1e-9);
     }
 

@@ -14,7 +14,7 @@ use crate::model::{Dataset, Lot, LotUse, Plan, PlannedMachiya, Skipped};
 use crate::params::Params;
 use crate::rng::feature_rng;
 use crate::templates::Catalog;
-use frontage::{FrontageRule, find_frontage, lot_depth};
+use frontage::{find_frontage, lot_depth, FrontageRule};
 use street::StreetEdges;
 
 /// Why a lot did not make it into the plan, or what it became.
@@ -117,9 +117,10 @@ fn plan_lot(
         Some(t) => (t.to_string(), true),
         None => (draw_type(params, &lot.id), false),
     };
-    let tile = lot.tile.clone().unwrap_or_else(|| {
-        tiling::tile_id(centroid, params.tile_size, params.tile_origin)
-    });
+    let tile = lot
+        .tile
+        .clone()
+        .unwrap_or_else(|| tiling::tile_id(centroid, params.tile_size, params.tile_origin));
     Outcome::Planned(
         Box::new(PlannedMachiya {
             id: lot.id.clone(),

@@ -5,7 +5,7 @@
 //! centreline distance stops as soon as no wider street can still be nearer.
 
 use geo_types::{Coord, Polygon};
-use rstar::{AABB, PointDistance, RTree, RTreeObject};
+use rstar::{PointDistance, RTree, RTreeObject, AABB};
 
 use crate::model::Street;
 
@@ -102,7 +102,7 @@ impl StreetEdges {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use geo_types::{LineString, polygon};
+    use geo_types::{polygon, LineString};
 
     #[test]
     fn block_boundary_is_the_edge() {

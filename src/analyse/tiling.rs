@@ -30,7 +30,14 @@ mod tests {
 
     #[test]
     fn ids_round_trip_and_stay_fixed() {
-        let id = tile_id(Coord { x: -20_001.0, y: -108_999.0 }, 250.0, [0.0, 0.0]);
+        let id = tile_id(
+            Coord {
+                x: -20_001.0,
+                y: -108_999.0,
+            },
+            250.0,
+            [0.0, 0.0],
+        );
         assert_eq!(id, "-81_-436");
         assert_eq!(parse_tile_id(&id), Some((-81, -436)));
         assert_eq!(parse_tile_id("x_1"), None);

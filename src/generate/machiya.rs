@@ -8,7 +8,7 @@
 
 use geo_types::Coord;
 
-use super::clip::{LocalRing, area, clip_band, is_convex};
+use super::clip::{area, clip_band, is_convex, LocalRing};
 use super::materials;
 use super::mesh::{Frame, Mesh};
 use crate::model::PlannedMachiya;
@@ -23,6 +23,10 @@ const HISASHI_THICKNESS: f64 = 0.12;
 const HISASHI_TUCK: f64 = 0.05;
 /// Thickness of the wall of a heitsuki and of a kanban-gatera board.
 const WALL_THICKNESS: f64 = 0.25;
+/// The kanban board stands this far in front of the facade ...
+const BOARD_OFFSET: f64 = 0.02;
+/// ... and reaches this far below the eave, behind the wall's top.
+const BOARD_OVERLAP: f64 = 0.3;
 /// Texture base of plaster, wood and floor: one repeat per this many metres.
 const WORLD_TEXTURE_BASE: f64 = 2.0;
 /// Texture base of roof tiles: one repeat per metre along the street and up the slope.
@@ -43,7 +47,7 @@ impl Local {
             y: self.a.y + p[0] * self.u.y + p[1] * self.v.y,
         }
     }
-    fn from_map(self, c: Coord<f64>) -> [f64; 2] {
+    fn to_local(self, c: Coord<f64>) -> [f64; 2] {
         let (dx, dy) = (c.x - self.a.x, c.y - self.a.y);
         [dx * self.u.x + dy * self.u.y, dx * self.v.x + dy * self.v.y]
     }
@@ -84,7 +88,7 @@ pub fn build(
     let ring: LocalRing = super::clip::dedup(
         ext[..ext.len() - 1]
             .iter()
-            .map(|c| local.from_map(*c))
+            .map(|c| local.to_local(*c))
             .collect(),
     );
     if ring.len() < 3 || area(&ring) <= 0.0 {
@@ -133,7 +137,16 @@ pub fn build(
         halves.extend(clip_band(part, f64::NEG_INFINITY, ridge_v));
         halves.extend(clip_band(part, ridge_v, f64::INFINITY));
     }
-    extrude(&mut mesh, frame, local, &halves, &|_| 0.0, &gable, Some(ridge_v), &dress);
+    extrude(
+        &mut mesh,
+        frame,
+        local,
+        &halves,
+        &|_| 0.0,
+        &gable,
+        Some(ridge_v),
+        &dress,
+    );
 
     if t.hisashi_height > 0.0 {
         hisashi(&mut mesh, frame, local, &body, t, setback);
@@ -147,24 +160,52 @@ pub fn build(
             wall: materials::id("tsuchikabe_wall"),
             facade: None,
         };
-        extrude(&mut mesh, frame, local, &wall, &|_| 0.0, &|_| h, None, &dress);
+        extrude(
+            &mut mesh,
+            frame,
+            local,
+            &wall,
+            &|_| 0.0,
+            &|_| h,
+            None,
+            &dress,
+        );
     }
     if t.parapet_height > 0.0 {
-        // The board stands on the front wall and hides the roof behind it.
-        let board = clip_band(&ring, setback, setback + WALL_THICKNESS.min(depth / 2.0));
-        let top = eave + t.parapet_height;
-        let dress = Dress {
-            top: materials::id("wood"),
-            bottom: materials::id("wood"),
-            wall: materials::id("wood"),
-            facade: Some(Facade {
-                material: facade_material,
-                front_v: setback,
-                u_scale: repeats / width,
-                height: top,
-            }),
-        };
-        extrude(&mut mesh, frame, local, &board, &|_| eave, &|_| top, None, &dress);
+        // The board stands 2 cm proud of the facade and reaches down behind its top, so it
+        // is a closed shell of its own and never coplanar with the wall (no z-fighting).
+        if let Some((u0, u1)) = front_extent(&body, setback) {
+            let v0 = setback - BOARD_OFFSET;
+            let board = vec![
+                [u0, v0],
+                [u1, v0],
+                [u1, setback + WALL_THICKNESS],
+                [u0, setback + WALL_THICKNESS],
+            ];
+            let top = eave + t.parapet_height;
+            let bottom = eave - BOARD_OVERLAP;
+            let dress = Dress {
+                top: materials::id("wood"),
+                bottom: materials::id("wood"),
+                wall: materials::id("wood"),
+                facade: Some(Facade {
+                    material: facade_material,
+                    front_v: v0,
+                    u_scale: repeats / width,
+                    height: top,
+                }),
+            };
+            extrude(
+                &mut mesh,
+                frame,
+                local,
+                &[board],
+                &|_| bottom,
+                &|_| top,
+                None,
+                &dress,
+            );
+        }
     }
     Ok(mesh.finish())
 }
@@ -178,18 +219,9 @@ fn hisashi(
     t: &MachiyaType,
     front_v: f64,
 ) {
-    let on_front = body
-        .iter()
-        .flatten()
-        .filter(|p| (p[1] - front_v).abs() < 0.01);
-    let (mut u0, mut u1) = (f64::MAX, f64::MIN);
-    for p in on_front {
-        u0 = u0.min(p[0]);
-        u1 = u1.max(p[0]);
-    }
-    if u1 - u0 < 0.1 {
+    let Some((u0, u1)) = front_extent(body, front_v) else {
         return;
-    }
+    };
     let (v0, v1) = (front_v - t.hisashi_depth, front_v + HISASHI_TUCK);
     let slab = vec![[u0, v0], [u1, v0], [u1, v1], [u0, v1]];
     let hh = t.hisashi_height;
@@ -202,6 +234,20 @@ fn hisashi(
         facade: None,
     };
     extrude(mesh, frame, local, &[slab], &bottom, &top, None, &dress);
+}
+
+/// The span along the street of the house's front wall (points of the body on `v = front_v`).
+fn front_extent(body: &[LocalRing], front_v: f64) -> Option<(f64, f64)> {
+    let (mut u0, mut u1) = (f64::MAX, f64::MIN);
+    for p in body
+        .iter()
+        .flatten()
+        .filter(|p| (p[1] - front_v).abs() < 0.01)
+    {
+        u0 = u0.min(p[0]);
+        u1 = u1.max(p[0]);
+    }
+    (u1 - u0 >= 0.1).then_some((u0, u1))
 }
 
 /// Extrudes planar parts between a bottom and a top height, each a function of v that is
@@ -232,7 +278,10 @@ fn extrude(
                 .map(|&i| {
                     let p = part[i];
                     let pos = mesh.vertex(frame, local.to_map(p), top(p[1]));
-                    let uv = mesh.uv(p[0] / ROOF_TEXTURE_BASE, p[1] * slope(p) / ROOF_TEXTURE_BASE);
+                    let uv = mesh.uv(
+                        p[0] / ROOF_TEXTURE_BASE,
+                        p[1] * slope(p) / ROOF_TEXTURE_BASE,
+                    );
                     (pos, uv)
                 })
                 .collect();
@@ -266,9 +315,10 @@ fn extrude(
                 mesh.vertex(frame, qm, hq1),
                 mesh.vertex(frame, pm, hp1),
             ];
-            let facade = dress.facade.as_ref().filter(|fa| {
-                (p[1] - fa.front_v).abs() < 0.01 && (q[1] - fa.front_v).abs() < 0.01
-            });
+            let facade = dress
+                .facade
+                .as_ref()
+                .filter(|fa| (p[1] - fa.front_v).abs() < 0.01 && (q[1] - fa.front_v).abs() < 0.01);
             let (material, uvs) = match facade {
                 Some(fa) => {
                     let (up, uq) = (p[0] * fa.u_scale, q[0] * fa.u_scale);
@@ -329,4 +379,131 @@ fn triangles(part: &[[f64; 2]]) -> Vec<Vec<usize>> {
             Some(ids)
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::mesh::open_edges;
+    use crate::model::Frontage;
+    use crate::params::Params;
+    use crate::templates::Catalog;
+    use geo_types::{LineString, Polygon};
+    use proptest::prelude::*;
+
+    fn planned(ring: &[[f64; 2]]) -> PlannedMachiya {
+        let mut pts: Vec<Coord<f64>> = ring.iter().map(|p| Coord { x: p[0], y: p[1] }).collect();
+        pts.push(pts[0]);
+        PlannedMachiya {
+            id: "1".into(),
+            record: 0,
+            outline: Polygon::new(LineString(pts), vec![]),
+            frontage: Frontage {
+                a: Coord {
+                    x: ring[0][0],
+                    y: ring[0][1],
+                },
+                b: Coord {
+                    x: ring[1][0],
+                    y: ring[1][1],
+                },
+                fallback: false,
+            },
+            mtype: String::new(),
+            type_given: false,
+            district: None,
+            tile: "0_0".into(),
+        }
+    }
+
+    /// Ground vertices of a mesh, back in map metres.
+    fn ground(mesh: &Mesh) -> Vec<[f64; 2]> {
+        mesh.positions
+            .iter()
+            .filter(|p| p[1] == 0)
+            .map(|p| [p[0] as f64 / 1000.0, -(p[2] as f64) / 1000.0])
+            .collect()
+    }
+
+    fn inside_or_on(ring: &[[f64; 2]], p: [f64; 2], tol: f64) -> bool {
+        use geo::{Contains, Distance, Euclidean};
+        let poly = planned(ring).outline;
+        let pt = geo_types::Point::new(p[0], p[1]);
+        poly.contains(&pt) || Euclidean.distance(&pt, poly.exterior()) <= tol
+    }
+
+    #[test]
+    fn every_shipped_type_is_a_closed_shell_on_a_town_lot() {
+        let cat = Catalog::load(None).unwrap();
+        let params = Params::default().machiya;
+        let lot = [[0.0, 0.0], [5.4, 0.0], [5.5, 30.0], [0.1, 30.0]];
+        for t in cat.types.values() {
+            let mesh = build(&planned(&lot), t, &params, Frame { origin: [0.0, 0.0] })
+                .unwrap_or_else(|e| panic!("{}: {e}", t.name));
+            assert!(open_edges(&mesh).is_empty(), "{}: open edges", t.name);
+            let top = mesh.positions.iter().map(|p| p[1]).max().unwrap();
+            assert!(
+                top as f64 / 1000.0 > t.eave_height,
+                "{}: roof above the eaves",
+                t.name
+            );
+            for p in ground(&mesh) {
+                assert!(inside_or_on(&lot, p, 0.001), "{}: {p:?} outside", t.name);
+            }
+        }
+    }
+
+    #[test]
+    fn a_lot_too_shallow_is_refused_with_a_reason() {
+        let cat = Catalog::load(None).unwrap();
+        let params = Params::default().machiya;
+        let lot = [[0.0, 0.0], [5.0, 0.0], [5.0, 1.0], [0.0, 1.0]];
+        let err = build(
+            &planned(&lot),
+            cat.get("hiraya").unwrap(),
+            &params,
+            Frame { origin: [0.0, 0.0] },
+        )
+        .unwrap_err();
+        assert!(err.contains("1.00 m deep"), "{err}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        /// Any strip lot, any type: the house is closed, stands inside its lot, and only
+        /// the pent roof reaches over the street.
+        #[test]
+        fn houses_are_closed_and_stay_in_their_lots(
+            width in 2.7f64..12.0,
+            d1 in 3.0f64..60.0,
+            d2 in 3.0f64..60.0,
+            s1 in -0.3f64..0.3,
+            s2 in -0.3f64..0.3,
+            type_index in 0usize..8,
+            ox in -50_000.0f64..50_000.0,
+        ) {
+            let cat = Catalog::load(None).unwrap();
+            let t = cat.types.values().nth(type_index % cat.types.len()).unwrap();
+            let params = Params::default().machiya;
+            let lot = [[ox, 0.0], [ox + width, 0.0], [ox + width + s1 * d1, d1], [ox + s2 * d2, d2]];
+            let local: Vec<[f64; 2]> = lot.iter().map(|p| [p[0] - ox, p[1]]).collect();
+            prop_assume!(is_convex(&local));
+            match build(&planned(&lot), t, &params, Frame { origin: [0.0, 0.0] }) {
+                Ok(mesh) => {
+                    prop_assert!(open_edges(&mesh).is_empty(), "open edges on {:?}", lot);
+                    for p in ground(&mesh) {
+                        prop_assert!(inside_or_on(&lot, p, 0.002), "{:?} outside {:?}", p, lot);
+                    }
+                    for p in &mesh.positions {
+                        let q = [p[0] as f64 / 1000.0, -(p[2] as f64) / 1000.0];
+                        let over_street = !inside_or_on(&lot, q, 0.002);
+                        prop_assert!(!over_street || (q[1] >= -t.hisashi_depth - 0.002 && p[1] > 2000),
+                            "{:?} leaves the lot other than as eaves", q);
+                    }
+                }
+                Err(reason) => prop_assert!(reason.contains("deep"), "{}", reason),
+            }
+        }
+    }
 }

@@ -11,7 +11,7 @@ pub mod table;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 
-use geo::{Area, Orient, orient::Direction};
+use geo::{orient::Direction, Area, Orient};
 use geo_types::{Coord, LineString, MultiPolygon, Polygon};
 use shapefile::Shape;
 use thiserror::Error;
@@ -98,7 +98,10 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             if !seen.insert(id.clone()) {
                 data.skipped.push(skip(
                     id,
-                    format!("duplicate id: record {} repeats an earlier lot's id", f.record),
+                    format!(
+                        "duplicate id: record {} repeats an earlier lot's id",
+                        f.record
+                    ),
                 ));
                 continue;
             }
@@ -180,8 +183,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
                 .cloned()
                 .unwrap_or_else(|| f.record.to_string());
             for line in lines {
-                if line.0.len() >= 2 && line.0.iter().all(|c| c.x.is_finite() && c.y.is_finite())
-                {
+                if line.0.len() >= 2 && line.0.iter().all(|c| c.x.is_finite() && c.y.is_finite()) {
                     data.streets.push(Street {
                         id: id.clone(),
                         line,

@@ -48,7 +48,9 @@ pub fn encoding_for(name: &str) -> Option<&'static encoding_rs::Encoding> {
         "shiftjis" | "sjis" | "cp932" | "932" | "ms932" | "windows31j" | "mskanji"
         | "windows932" => Some(encoding_rs::SHIFT_JIS),
         "eucjp" | "20932" | "51932" => Some(encoding_rs::EUC_JP),
-        "latin1" | "iso88591" | "cp1252" | "1252" | "windows1252" => Some(encoding_rs::WINDOWS_1252),
+        "latin1" | "iso88591" | "cp1252" | "1252" | "windows1252" => {
+            Some(encoding_rs::WINDOWS_1252)
+        }
         "gbk" | "cp936" | "936" => Some(encoding_rs::GBK),
         "big5" | "950" | "cp950" => Some(encoding_rs::BIG5),
         "euckr" | "949" | "cp949" => Some(encoding_rs::EUC_KR),
@@ -201,7 +203,15 @@ mod tests {
 
     #[test]
     fn japanese_code_page_names_are_known() {
-        for name in ["SHIFT_JIS", "Shift_JIS\n", "CP932", "932", "MS932", "Windows-31J", "sjis"] {
+        for name in [
+            "SHIFT_JIS",
+            "Shift_JIS\n",
+            "CP932",
+            "932",
+            "MS932",
+            "Windows-31J",
+            "sjis",
+        ] {
             assert_eq!(encoding_for(name), Some(encoding_rs::SHIFT_JIS), "{name}");
         }
         assert_eq!(encoding_for("UTF-8"), Some(encoding_rs::UTF_8));

@@ -184,7 +184,10 @@ mod tests {
         let p = dir.path().join("lots.csv");
         std::fs::write(&p, "lot,mtype\n1,hiraya\n").unwrap();
         let err = read_csv(&p, "id").unwrap_err().to_string();
-        assert!(err.contains("lots.csv") && err.contains("lot, mtype"), "{err}");
+        assert!(
+            err.contains("lots.csv") && err.contains("lot, mtype"),
+            "{err}"
+        );
     }
 
     #[test]

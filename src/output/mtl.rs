@@ -23,7 +23,10 @@ pub fn mtl_text() -> String {
                     m.kd[0], m.kd[1], m.kd[2]
                 );
                 s.push_str("Ka 1.000 1.000 1.000\nKd 1.000 1.000 1.000\n");
-                let _ = writeln!(s, "Ks 0.000 0.000 0.000\nd 1.0\nillum 1\nmap_Kd ../textures/{t}");
+                let _ = writeln!(
+                    s,
+                    "Ks 0.000 0.000 0.000\nd 1.0\nillum 1\nmap_Kd ../textures/{t}"
+                );
             }
             None => {
                 let _ = writeln!(

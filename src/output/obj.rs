@@ -103,8 +103,23 @@ mod tests {
 
     #[test]
     fn fixed_point_matches_float_formatting() {
-        for v in [0i64, 1, -1, 999, -1000, 1001, 123_456_789, -5, 10, -10_000_001] {
-            assert_eq!(fixed(v, 1000, 3), format!("{:.3}", v as f64 / 1000.0), "{v}");
+        for v in [
+            0i64,
+            1,
+            -1,
+            999,
+            -1000,
+            1001,
+            123_456_789,
+            -5,
+            10,
+            -10_000_001,
+        ] {
+            assert_eq!(
+                fixed(v, 1000, 3),
+                format!("{:.3}", v as f64 / 1000.0),
+                "{v}"
+            );
         }
         assert_eq!(fixed(-12_345, 10_000, 4), "-1.2345");
         assert_eq!(fixed(7, 10_000, 4), "0.0007");

@@ -1,0 +1,34 @@
+# edo-city: the two commands a fresh machine needs are `make run` and `make test`.
+
+CARGO ?= cargo
+
+.PHONY: run test lint bench textures fixtures clean
+
+## Build the tool and the city of the bundled example data into out/.
+run:
+	$(CARGO) run --release -- build fixtures/kyoto-small --out out
+
+## Unit, property, end-to-end and doc tests.
+test:
+	$(CARGO) test --all-targets
+	$(CARGO) test --doc
+
+## Formatting and lints, as CI runs them.
+lint:
+	$(CARGO) fmt --all -- --check
+	$(CARGO) clippy --all-targets -- -D warnings
+
+## Whole-Kyoto scale: 30,052 synthetic lots, three builds, per-stage timings.
+bench:
+	bash scripts/bench.sh
+
+## Redraw the texture library (the PNGs are committed).
+textures:
+	$(CARGO) run --release --example make_textures
+
+## Regenerate the example data (lots.csv is written by hand on top of it).
+fixtures:
+	$(CARGO) run --release -- synth fixtures/kyoto-small --lots 400 --seed 9
+
+clean:
+	rm -rf out target

@@ -1,0 +1,193 @@
+//! Helpers shared by the end-to-end tests: run the real binary, re-read what it wrote.
+#![allow(dead_code)]
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use geo::{Contains, Distance, Euclidean};
+use geo_types::{Coord, LineString, Point, Polygon};
+
+pub fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(name)
+}
+
+pub fn edo_city() -> Command {
+    Command::cargo_bin("edo-city").expect("binary built")
+}
+
+/// Runs `edo-city build <input> --out <out> <extra...>` and asserts it succeeded.
+pub fn build_ok(input: &Path, out: &Path, extra: &[&str]) -> serde_json::Value {
+    let output = edo_city()
+        .arg("build")
+        .arg(input)
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .output()
+        .expect("runs");
+    assert!(
+        output.status.success(),
+        "build failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    read_json(&out.join("report.json"))
+}
+
+pub fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).expect("json exists")).expect("valid json")
+}
+
+/// Copies a fixture directory so a test can change it.
+pub fn copy_fixture(name: &str, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(fixture(name)).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+}
+
+/// Every file under `dir`, relative path -> bytes.
+pub fn all_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).unwrap().display().to_string();
+                out.insert(rel, std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+/// Lots of a shapefile: id -> (use, mtype, polygon).
+pub fn read_lots(shp: &Path) -> HashMap<String, (String, String, Polygon<f64>)> {
+    let mut reader = shapefile::Reader::from_path(shp).expect("lots readable");
+    let mut out = HashMap::new();
+    for item in reader.iter_shapes_and_records() {
+        let (shape, record) = item.unwrap();
+        let text = |k: &str| match record.get(k) {
+            Some(dbase::FieldValue::Character(Some(s))) => s.trim().to_string(),
+            Some(dbase::FieldValue::Numeric(Some(n))) => format!("{}", *n as i64),
+            _ => String::new(),
+        };
+        let shapefile::Shape::Polygon(p) = shape else {
+            panic!("lots are polygons")
+        };
+        let ring: Vec<Coord<f64>> = p.rings()[0]
+            .points()
+            .iter()
+            .map(|q| Coord { x: q.x, y: q.y })
+            .collect();
+        out.insert(
+            text("id"),
+            (
+                text("use"),
+                text("mtype"),
+                Polygon::new(LineString(ring), vec![]),
+            ),
+        );
+    }
+    out
+}
+
+/// One machiya object as re-read by tobj: its name, map-frame vertices, materials used.
+pub struct ObjObject {
+    pub name: String,
+    /// (east, north, up) in map metres.
+    pub vertices: Vec<[f64; 3]>,
+    pub materials: Vec<String>,
+}
+
+/// Loads a tile with tobj, checks indices, UVs, materials and textures; returns its objects.
+pub fn load_tile(obj: &Path, origin: [f64; 2]) -> Vec<ObjObject> {
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ..Default::default()
+    };
+    let (models, materials) = tobj::load_obj(obj, &opts).expect("tobj reads the OBJ");
+    let materials = materials.expect("tobj reads the MTL");
+    assert!(!materials.is_empty());
+    let tiles_dir = obj.parent().unwrap();
+    for m in &materials {
+        if let Some(tex) = &m.diffuse_texture {
+            assert!(
+                tiles_dir.join(tex).exists(),
+                "texture {tex} of material {} missing",
+                m.name
+            );
+        }
+    }
+    let mut by_name: BTreeMap<String, ObjObject> = BTreeMap::new();
+    for model in &models {
+        let mesh = &model.mesh;
+        let nv = mesh.positions.len() / 3;
+        let nt = mesh.texcoords.len() / 2;
+        assert!(
+            mesh.indices.iter().all(|&i| (i as usize) < nv),
+            "{}",
+            model.name
+        );
+        assert!(
+            mesh.texcoord_indices.iter().all(|&i| (i as usize) < nt),
+            "{}",
+            model.name
+        );
+        assert_eq!(
+            mesh.texcoord_indices.len(),
+            mesh.indices.len(),
+            "{}: every face has UVs",
+            model.name
+        );
+        assert!(
+            mesh.texcoords.iter().all(|t| t.is_finite()),
+            "{}",
+            model.name
+        );
+        assert!(
+            mesh.positions.iter().all(|p| p.is_finite()),
+            "{}",
+            model.name
+        );
+        let mat = mesh
+            .material_id
+            .map(|i| materials[i].name.clone())
+            .expect("every face has a material");
+        let entry = by_name
+            .entry(model.name.clone())
+            .or_insert_with(|| ObjObject {
+                name: model.name.clone(),
+                vertices: Vec::new(),
+                materials: Vec::new(),
+            });
+        entry.materials.push(mat);
+        for &i in &mesh.indices {
+            let k = i as usize * 3;
+            let (x, y, z) = (
+                mesh.positions[k],
+                mesh.positions[k + 1],
+                mesh.positions[k + 2],
+            );
+            entry.vertices.push([x + origin[0], -z + origin[1], y]);
+        }
+    }
+    by_name.into_values().collect()
+}
+
+/// Distance from a map point to a lot (0 inside).
+pub fn distance_to_lot(lot: &Polygon<f64>, east: f64, north: f64) -> f64 {
+    let p = Point::new(east, north);
+    if lot.contains(&p) {
+        0.0
+    } else {
+        Euclidean.distance(&p, lot.exterior())
+    }
+}
