@@ -235,6 +235,7 @@ fn run(
         textures,
     };
     let manifest_path = opts.out.join("manifest.json");
+    remove_stale_tiles(&manifest_path, &opts.out, &manifest.tiles);
     let manifest_json = serde_json::to_vec_pretty(&manifest).expect("manifest serialises");
     output::atomic::write_atomic(&manifest_path, &manifest_json)
         .map_err(|e| write_err(&manifest_path, e))?;
@@ -245,4 +246,30 @@ fn run(
         timings,
         bytes_written,
     })
+}
+
+/// Deletes the tiles a previous build into the same directory listed in its manifest that
+/// this build did not write, so the directory holds one consistent city. Files the tool did
+/// not write itself are never touched.
+fn remove_stale_tiles(manifest_path: &Path, out: &Path, tiles: &[report::ManifestTile]) {
+    let Ok(bytes) = std::fs::read(manifest_path) else {
+        return;
+    };
+    let Ok(old) = serde_json::from_slice::<serde_json::Value>(&bytes) else {
+        return;
+    };
+    let current: std::collections::HashSet<&str> = tiles
+        .iter()
+        .flat_map(|t| [t.obj.path.as_str(), t.mtl.path.as_str()])
+        .collect();
+    for tile in old["tiles"].as_array().into_iter().flatten() {
+        for kind in ["obj", "mtl"] {
+            if let Some(path) = tile[kind]["path"].as_str() {
+                let safe = path.starts_with("tiles/") && !path.contains("..");
+                if safe && !current.contains(path) {
+                    let _ = std::fs::remove_file(out.join(path));
+                }
+            }
+        }
+    }
 }

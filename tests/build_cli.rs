@@ -189,3 +189,32 @@ fn a_seed_changes_drawn_types_but_not_given_ones() {
     assert_ne!(ra["counts"]["by_type"], rb["counts"]["by_type"]);
     assert_eq!(ra["counts"]["type_given"], rb["counts"]["type_given"]);
 }
+
+#[test]
+fn a_tile_attribute_wins_and_a_rebuild_leaves_no_stale_tiles() {
+    let dir = tempfile::tempdir().unwrap();
+    copy_fixture("kyoto-small", dir.path());
+    let out = dir.path().join("out");
+    let first = build_ok(dir.path(), &out, &["--quiet"]);
+    let first_tiles = first["counts"]["tiles"].as_u64().unwrap();
+
+    std::fs::write(
+        dir.path().join("lots.csv"),
+        "id,tile\n1,sanjo\n2,../escape\n",
+    )
+    .unwrap();
+    let report = build_ok(dir.path(), &out, &["--quiet"]);
+    let obj =
+        std::fs::read_to_string(out.join("tiles/sanjo.obj")).expect("tile from the attribute");
+    assert!(obj.contains("o machiya_1\n"));
+    assert!(!out.join("escape.obj").exists() && !dir.path().join("escape.obj").exists());
+    assert!(report["warnings"].to_string().contains("../escape"));
+    assert_eq!(report["counts"]["tiles"].as_u64().unwrap(), first_tiles + 1);
+
+    // Back to the computed tiles: the `sanjo` tile of the previous build is gone.
+    std::fs::remove_file(dir.path().join("lots.csv")).unwrap();
+    build_ok(dir.path(), &out, &["--quiet"]);
+    assert!(!out.join("tiles/sanjo.obj").exists());
+    let files = std::fs::read_dir(out.join("tiles")).unwrap().count() as u64;
+    assert_eq!(files, 2 * first_tiles);
+}

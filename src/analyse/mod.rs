@@ -19,7 +19,7 @@ use street::StreetEdges;
 
 /// Why a lot did not make it into the plan, or what it became.
 enum Outcome {
-    Planned(Box<PlannedMachiya>, Option<String>),
+    Planned(Box<PlannedMachiya>, Vec<String>),
     Skipped(Skipped),
 }
 
@@ -53,13 +53,11 @@ pub fn analyse(
     };
     for o in outcomes {
         match o {
-            Outcome::Planned(m, warning) => {
+            Outcome::Planned(m, warnings) => {
                 if m.frontage.fallback {
                     plan.frontage_fallback += 1;
                 }
-                if let Some(w) = warning {
-                    plan.warnings.push(w);
-                }
+                plan.warnings.extend(warnings);
                 plan.tiles.entry(m.tile.clone()).or_default().push(*m);
             }
             Outcome::Skipped(s) => plan.skipped.push(s),
@@ -102,11 +100,11 @@ fn plan_lot(
         ));
     }
 
-    let mut warning = None;
+    let mut warnings = Vec::new();
     let given = lot.mtype.as_deref().and_then(|m| {
         let r = catalog.resolve(m);
         if r.is_none() {
-            warning = Some(format!(
+            warnings.push(format!(
                 "{lots_file}: lot {}: unknown machiya type `{m}`; a type was drawn from type_mix",
                 lot.id
             ));
@@ -117,10 +115,19 @@ fn plan_lot(
         Some(t) => (t.to_string(), true),
         None => (draw_type(params, &lot.id), false),
     };
-    let tile = lot
-        .tile
-        .clone()
-        .unwrap_or_else(|| tiling::tile_id(centroid, params.tile_size, params.tile_origin));
+    let computed = || tiling::tile_id(centroid, params.tile_size, params.tile_origin);
+    let tile = match lot.tile.as_deref() {
+        Some(t) if tiling::is_valid_tile_name(t) => t.to_string(),
+        Some(t) => {
+            warnings.push(format!(
+                "{lots_file}: lot {}: tile `{t}` is not usable as a file name (letters, digits, \
+                 `_`, `-` and `.` only); the computed tile was used",
+                lot.id
+            ));
+            computed()
+        }
+        None => computed(),
+    };
     Outcome::Planned(
         Box::new(PlannedMachiya {
             id: lot.id.clone(),
@@ -132,7 +139,7 @@ fn plan_lot(
             district: lot.district.clone(),
             tile,
         }),
-        warning,
+        warnings,
     )
 }
 

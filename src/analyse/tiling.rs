@@ -18,6 +18,25 @@ pub fn tile_id(p: Coord<f64>, size: f64, origin: [f64; 2]) -> String {
     format!("{col}_{row}")
 }
 
+/// A tile id given in the data becomes a file name: it must not escape the tiles directory
+/// or be mistaken for a flag.
+///
+/// ```
+/// use edo_city::analyse::tiling::is_valid_tile_name;
+/// assert!(is_valid_tile_name("12_7"));
+/// assert!(is_valid_tile_name("sanjo.east"));
+/// assert!(!is_valid_tile_name("../12_7"));
+/// assert!(!is_valid_tile_name("-3_4"));
+/// ```
+pub fn is_valid_tile_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.len() <= 64
+        && !name.starts_with(['-', '.'])
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+}
+
 /// Parses a tile id back to its column and row.
 pub fn parse_tile_id(id: &str) -> Option<(i64, i64)> {
     let (c, r) = id.split_once('_')?;
