@@ -11,25 +11,21 @@ fn unknown_parameter_key_names_key_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let params = dir.path().join("p.toml");
     std::fs::write(&params, "seed = 3\n[machiya]\ndepht = 10.0\n").unwrap();
-    edo_city()
-        .args(["build", fixture("kyoto-small").to_str().unwrap(), "--out"])
-        .arg(dir.path().join("out"))
-        .arg("--params")
-        .arg(&params)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("depht").and(predicate::str::contains("line 3")));
+    build_cmd(
+        &fixture("kyoto-small"),
+        &dir.path().join("out"),
+        &["--params", params.to_str().unwrap()],
+    )
+    .assert()
+    .code(2)
+    .stderr(predicate::str::contains("depht").and(predicate::str::contains("line 3")));
     assert!(!dir.path().join("out").exists(), "nothing written");
 }
 
 #[test]
 fn missing_lots_layer_says_which_file_and_key() {
     let dir = tempfile::tempdir().unwrap();
-    edo_city()
-        .arg("build")
-        .arg(dir.path())
-        .arg("--out")
-        .arg(dir.path().join("out"))
+    build_cmd(dir.path(), &dir.path().join("out"), &[])
         .assert()
         .code(2)
         .stderr(
@@ -42,11 +38,7 @@ fn missing_dbf_is_named() {
     let dir = tempfile::tempdir().unwrap();
     copy_fixture("kyoto-small", dir.path());
     std::fs::remove_file(dir.path().join("lots.dbf")).unwrap();
-    edo_city()
-        .arg("build")
-        .arg(dir.path())
-        .arg("--out")
-        .arg(dir.path().join("out"))
+    build_cmd(dir.path(), &dir.path().join("out"), &[])
         .assert()
         .code(2)
         .stderr(predicate::str::contains("lots.dbf").and(predicate::str::contains("missing")));
@@ -57,16 +49,14 @@ fn type_mix_naming_an_unknown_type_is_an_error() {
     let dir = tempfile::tempdir().unwrap();
     let params = dir.path().join("p.toml");
     std::fs::write(&params, "[type_mix]\nhiraya = 1.0\npagoda = 2.0\n").unwrap();
-    edo_city()
-        .arg("build")
-        .arg(fixture("kyoto-small"))
-        .arg("--out")
-        .arg(dir.path().join("out"))
-        .arg("--params")
-        .arg(&params)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("pagoda"));
+    build_cmd(
+        &fixture("kyoto-small"),
+        &dir.path().join("out"),
+        &["--params", params.to_str().unwrap()],
+    )
+    .assert()
+    .code(2)
+    .stderr(predicate::str::contains("pagoda"));
 }
 
 #[test]
@@ -144,16 +134,14 @@ fn xlsx_table_joins_from_the_named_sheet() {
 
     // A sheet that is not there is an error that lists the sheets.
     std::fs::write(&params, "[layers.lots]\nsheet = \"lots\"\n").unwrap();
-    edo_city()
-        .arg("build")
-        .arg(dir.path())
-        .arg("--out")
-        .arg(dir.path().join("out2"))
-        .arg("--params")
-        .arg(&params)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("notes, types"));
+    build_cmd(
+        dir.path(),
+        &dir.path().join("out2"),
+        &["--params", params.to_str().unwrap()],
+    )
+    .assert()
+    .code(2)
+    .stderr(predicate::str::contains("notes, types"));
 }
 
 #[test]
@@ -168,11 +156,7 @@ fn points_as_lots_are_refused_with_the_record() {
     w.write_shape_and_record(&shapefile::Point::new(0.0, 0.0), &rec)
         .unwrap();
     drop(w);
-    edo_city()
-        .arg("build")
-        .arg(dir.path())
-        .arg("--out")
-        .arg(dir.path().join("out"))
+    build_cmd(dir.path(), &dir.path().join("out"), &[])
         .assert()
         .code(2)
         .stderr(predicate::str::contains("lots.shp").and(predicate::str::contains("point")));

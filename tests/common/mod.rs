@@ -191,3 +191,14 @@ pub fn distance_to_lot(lot: &Polygon<f64>, east: f64, north: f64) -> f64 {
         Euclidean.distance(&p, lot.exterior())
     }
 }
+
+/// `edo-city build <input> --out <out> <extra...>`, to run and assert on.
+pub fn build_cmd(input: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut cmd = edo_city();
+    cmd.arg("build")
+        .arg(input)
+        .arg("--out")
+        .arg(out)
+        .args(extra);
+    cmd
+}
