@@ -164,8 +164,11 @@ fn run(
         tool: "edo-city".into(),
         version: env!("CARGO_PKG_VERSION").into(),
         input: opts.input.display().to_string(),
+        crs: data.crs.clone(),
+        layers: data.layers.clone(),
         ..Default::default()
     };
+    rep.counts.footprints_read = data.footprints.len();
     rep.counts.lots = data.lots.len();
     for lot in &data.lots {
         *rep.counts
@@ -183,6 +186,7 @@ fn run(
         .tiles
         .values()
         .flatten()
+        .filter(|m| m.height.is_none())
         .map(|m| (m.id.as_str(), m.type_given))
         .collect();
 
@@ -192,24 +196,30 @@ fn run(
         let (mt, skipped, types) = result?;
         rep.tiles.push(report::TileReport {
             id: (*id).clone(),
-            machiya: types.len(),
+            machiya: types.iter().filter(|t| !t.1).count(),
             obj_bytes: mt.obj.bytes,
         });
         bytes_written += mt.obj.bytes + mt.mtl.bytes;
-        for t in types {
-            *rep.counts.by_type.entry(t).or_default() += 1;
+        for (t, footprint) in types {
+            let map = if footprint {
+                &mut rep.counts.footprints_by_type
+            } else {
+                &mut rep.counts.by_type
+            };
+            *map.entry(t).or_default() += 1;
         }
         rep.skipped.extend(skipped);
         manifest_tiles.push(mt);
     }
     rep.counts.machiya = rep.counts.by_type.values().sum();
+    rep.counts.footprints = rep.counts.footprints_by_type.values().sum();
     let skipped_ids: std::collections::HashSet<&str> =
         rep.skipped.iter().map(|s| s.id.as_str()).collect();
     rep.counts.type_given = given
         .iter()
         .filter(|(id, g)| **g && !skipped_ids.contains(**id))
         .count();
-    rep.counts.type_drawn = rep.counts.machiya - rep.counts.type_given;
+    rep.counts.type_drawn = rep.counts.machiya.saturating_sub(rep.counts.type_given);
     rep.counts.tiles = manifest_tiles.len();
     rep.counts.skipped = rep.skipped.len();
     for s in &rep.skipped {
@@ -228,6 +238,7 @@ fn run(
         version: env!("CARGO_PKG_VERSION").into(),
         origin: plan.origin,
         frame: "x = east - origin[0], y = up, z = -(north - origin[1]); metres".into(),
+        crs: data.crs.clone(),
         crs_wkt: data.crs_wkt.clone(),
         tile_size: params.tile_size,
         params: params.clone(),

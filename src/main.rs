@@ -161,6 +161,18 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
         let share = 100.0 * *n as f64 / c.machiya.max(1) as f64;
         println!("    {t:<18} {n:>7}  {share:5.1} %");
     }
+    if c.footprints_read > 0 {
+        println!(
+            "  footprints {:>7}  of {} read ({})",
+            c.footprints,
+            c.footprints_read,
+            c.footprints_by_type
+                .iter()
+                .map(|(k, v)| format!("{k} {v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     println!(
         "  frontage fallback {:>3}  (no vertex pair passed the Fig.4 test)",
         c.frontage_fallback

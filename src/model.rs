@@ -68,6 +68,32 @@ pub struct Lot {
     pub tile: Option<String>,
     /// Every attribute of the feature (DBF fields, then table values on top).
     pub attrs: BTreeMap<String, String>,
+    /// Ground elevation, metres: the `ground` field, else the lowest Z of a PolygonZ, else 0.
+    pub ground: f64,
+}
+
+/// A building footprint from the data, built as a house of its own height.
+#[derive(Debug, Clone)]
+pub struct Footprint {
+    pub id: String,
+    pub record: usize,
+    pub outline: Polygon<f64>,
+    pub mtype: Option<String>,
+    /// Total height, ground to ridge, metres.
+    pub height: f64,
+    pub ground: f64,
+}
+
+/// What was read from one layer, for the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LayerInfo {
+    pub role: String,
+    pub file: String,
+    pub features: usize,
+    pub encoding: String,
+    /// The layer's CRS as a proj string, or how it was assumed.
+    pub crs: String,
+    pub reprojected: bool,
 }
 
 /// A street centreline with its full width in metres.
@@ -94,8 +120,12 @@ pub struct Dataset {
     /// City blocks (machi 町 / gaiku 街区): their boundaries are street edges.
     pub blocks: Vec<Polygon<f64>>,
     pub streets: Vec<Street>,
+    pub footprints: Vec<Footprint>,
     /// Contents of the lots layer's `.prj`, if any, carried to the manifest.
     pub crs_wkt: Option<String>,
+    /// The CRS all coordinates are in (proj string); empty when unknown (no `.prj` anywhere).
+    pub crs: String,
+    pub layers: Vec<LayerInfo>,
     pub skipped: Vec<Skipped>,
     pub warnings: Vec<String>,
     pub joins: Vec<TableJoin>,
@@ -161,6 +191,20 @@ pub struct PlannedMachiya {
     pub type_given: bool,
     pub district: Option<String>,
     pub tile: TileId,
+    /// Ground elevation under the house, metres.
+    pub ground: f64,
+    /// Total height for a footprint house; `None` for a lot-filling machiya.
+    pub height: Option<f64>,
+}
+
+impl PlannedMachiya {
+    /// Object name in the OBJ: `machiya_<id>` for lots, `footprint_<id>` for footprints.
+    pub fn object_name(&self) -> String {
+        match self.height {
+            None => format!("machiya_{}", self.id),
+            Some(_) => format!("footprint_{}", self.id),
+        }
+    }
 }
 
 /// The output of analysis: what to build, tile by tile.
@@ -171,6 +215,8 @@ pub struct Plan {
     /// Machiya per tile, each tile's list in input order.
     pub tiles: BTreeMap<TileId, Vec<PlannedMachiya>>,
     pub frontage_fallback: usize,
+    /// Footprints planned (they share the tiles with the machiya).
+    pub footprints: usize,
     pub skipped: Vec<Skipped>,
     pub warnings: Vec<String>,
 }

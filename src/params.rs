@@ -40,6 +40,10 @@ pub struct Params {
     /// rounded down to a whole kilometre (stated in the manifest and every OBJ header).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub origin: Option<[f64; 2]>,
+    /// Output CRS (`EPSG:6674`, a proj string or WKT); also assumed for layers without a
+    /// `.prj`. Empty: the lots layer's own CRS when projected, else the UTM zone of its centre.
+    #[serde(default)]
+    pub crs: String,
     pub layers: Layers,
     pub frontage: FrontageParams,
     pub machiya: MachiyaParams,
@@ -53,6 +57,8 @@ pub struct Layers {
     pub lots: LotsLayer,
     pub blocks: BlocksLayer,
     pub streets: StreetsLayer,
+    pub street_widths: StreetWidthsLayer,
+    pub footprints: FootprintsLayer,
 }
 
 /// Settings shared by every layer: where it is and how its text is encoded.
@@ -70,6 +76,12 @@ pub struct LotsLayer {
     #[serde(default)]
     pub sheet: String,
     pub fields: LotFields,
+    /// Value maps per attribute (`use`, `mtype`, `district`): raw value -> value.
+    #[serde(default)]
+    pub values: BTreeMap<String, BTreeMap<String, String>>,
+    /// Value per attribute where the field is missing or empty.
+    #[serde(default)]
+    pub constants: BTreeMap<String, String>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -81,6 +93,9 @@ pub struct LotFields {
     pub mtype: String,
     pub district: String,
     pub tile: String,
+    /// Ground elevation field, metres; "" = none (Z of PolygonZ vertices, else 0).
+    #[serde(default)]
+    pub ground: String,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -101,6 +116,51 @@ pub struct StreetsLayer {
     pub width_field: String,
     /// Width used where the field is missing, empty or not a positive number.
     pub default_width: f64,
+}
+
+/// A line layer whose lines carry street widths (Chino's split lines), joined to the street
+/// centrelines by distance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StreetWidthsLayer {
+    /// "" = no such layer.
+    pub file: String,
+    #[serde(default)]
+    pub encoding: String,
+    pub width_field: String,
+    /// A centreline piece takes the width of the nearest width line within this distance.
+    pub max_distance: f64,
+}
+
+/// Building footprints built as houses of their own height (PLATEAU, OSM buildings).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FootprintsLayer {
+    /// "" = no such layer.
+    pub file: String,
+    #[serde(default)]
+    pub encoding: String,
+    pub fields: FootprintFields,
+    /// Value maps per attribute (`mtype`), as for lots.
+    #[serde(default)]
+    pub values: BTreeMap<String, BTreeMap<String, String>>,
+    /// Type of footprints whose `mtype` is empty or unknown.
+    pub default_type: String,
+    /// Height of one storey, for footprints with `storeys` but no height.
+    pub storey_height: f64,
+    /// Height of footprints with neither.
+    pub default_height: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FootprintFields {
+    pub id: String,
+    pub mtype: String,
+    /// Total height (ground to ridge), metres.
+    pub height: String,
+    pub storeys: String,
+    pub ground: String,
 }
 
 /// The constants of Fig.4.
@@ -201,6 +261,34 @@ impl Params {
                 "`frontage.max_angle_deg` must be in (0, 180], got {angle}"
             )));
         }
+        let fp = &self.layers.footprints;
+        for (key, value) in [
+            ("layers.footprints.storey_height", fp.storey_height),
+            ("layers.footprints.default_height", fp.default_height),
+            (
+                "layers.street_widths.max_distance",
+                self.layers.street_widths.max_distance,
+            ),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(bad(format!(
+                    "`{key}` must be a positive number, got {value}"
+                )));
+            }
+        }
+        for key in self
+            .layers
+            .lots
+            .values
+            .keys()
+            .chain(self.layers.lots.constants.keys())
+        {
+            if !["use", "mtype", "district"].contains(&key.as_str()) {
+                return Err(bad(format!(
+                    "`layers.lots.values.{key}` / `constants.{key}`: only use, mtype and district can be mapped"
+                )));
+            }
+        }
         if self.type_mix.is_empty() {
             return Err(bad("`type_mix` lists no machiya type".into()));
         }
@@ -220,7 +308,9 @@ impl Params {
 fn merge(base: &mut toml::Table, user: toml::Table) {
     for (key, value) in user {
         match (base.get_mut(&key), value) {
-            (Some(toml::Value::Table(b)), toml::Value::Table(u)) if key != "type_mix" => {
+            (Some(toml::Value::Table(b)), toml::Value::Table(u))
+                if !matches!(key.as_str(), "type_mix" | "values" | "constants") =>
+            {
                 merge(b, u)
             }
             (_, v) => {
@@ -254,6 +344,7 @@ mod partial {
         tile_size: Option<f64>,
         tile_origin: Option<[f64; 2]>,
         origin: Option<[f64; 2]>,
+        crs: Option<String>,
         layers: Option<Layers>,
         frontage: Option<Frontage>,
         machiya: Option<Machiya>,
@@ -266,6 +357,39 @@ mod partial {
         lots: Option<Lots>,
         blocks: Option<Blocks>,
         streets: Option<Streets>,
+        street_widths: Option<Widths>,
+        footprints: Option<Footprints>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Widths {
+        file: Option<String>,
+        encoding: Option<String>,
+        width_field: Option<String>,
+        max_distance: Option<f64>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Footprints {
+        file: Option<String>,
+        encoding: Option<String>,
+        fields: Option<FootprintFields>,
+        values: Option<BTreeMap<String, BTreeMap<String, String>>>,
+        default_type: Option<String>,
+        storey_height: Option<f64>,
+        default_height: Option<f64>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct FootprintFields {
+        id: Option<String>,
+        mtype: Option<String>,
+        height: Option<String>,
+        storeys: Option<String>,
+        ground: Option<String>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]
@@ -276,6 +400,8 @@ mod partial {
         table: Option<String>,
         sheet: Option<String>,
         fields: Option<LotFields>,
+        values: Option<BTreeMap<String, BTreeMap<String, String>>>,
+        constants: Option<BTreeMap<String, String>>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]
@@ -287,6 +413,7 @@ mod partial {
         mtype: Option<String>,
         district: Option<String>,
         tile: Option<String>,
+        ground: Option<String>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]

@@ -10,7 +10,7 @@ use geo_types::Coord;
 use rand::RngExt;
 use rayon::prelude::*;
 
-use crate::model::{Dataset, Lot, LotUse, Plan, PlannedMachiya, Skipped};
+use crate::model::{Dataset, Footprint, Lot, LotUse, Plan, PlannedMachiya, Skipped};
 use crate::params::Params;
 use crate::rng::feature_rng;
 use crate::templates::Catalog;
@@ -32,7 +32,14 @@ pub fn analyse(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Plan {
     let edges = StreetEdges::new(&data.blocks, &data.streets);
-    let origin = params.origin.unwrap_or_else(|| default_origin(&data.lots));
+    let origin = params.origin.unwrap_or_else(|| {
+        default_origin(
+            data.lots
+                .iter()
+                .map(|l| &l.outline)
+                .chain(data.footprints.iter().map(|f| &f.outline)),
+        )
+    });
     let rule = FrontageRule {
         max_angle_deg: params.frontage.max_angle_deg,
         min_length: params.frontage.min_length,
@@ -47,11 +54,20 @@ pub fn analyse(
             o
         })
         .collect();
+    let fp_outcomes: Vec<Outcome> = data
+        .footprints
+        .par_iter()
+        .map(|f| plan_footprint(f, &edges, rule, params, catalog))
+        .collect();
     let mut plan = Plan {
         origin,
         ..Plan::default()
     };
-    for o in outcomes {
+    plan.footprints = fp_outcomes
+        .iter()
+        .filter(|o| matches!(o, Outcome::Planned(..)))
+        .count();
+    for o in outcomes.into_iter().chain(fp_outcomes) {
         match o {
             Outcome::Planned(m, warnings) => {
                 if m.frontage.fallback {
@@ -138,6 +154,57 @@ fn plan_lot(
             type_given,
             district: lot.district.clone(),
             tile,
+            ground: lot.ground,
+            height: None,
+        }),
+        warnings,
+    )
+}
+
+/// A footprint: frontage towards the nearest street edge like a lot; its type from its
+/// `mtype` or `layers.footprints.default_type` (never drawn: a footprint is a known building).
+fn plan_footprint(
+    f: &Footprint,
+    edges: &StreetEdges,
+    rule: FrontageRule,
+    params: &Params,
+    catalog: &Catalog,
+) -> Outcome {
+    let fp = &params.layers.footprints;
+    let ring: Vec<Coord<f64>> = {
+        let r = &f.outline.exterior().0;
+        r[..r.len().saturating_sub(1)].to_vec()
+    };
+    let Some(centroid) = f.outline.centroid() else {
+        return Outcome::Skipped(Skipped {
+            layer: "footprints".into(),
+            file: params.layers.footprints.file.clone(),
+            id: f.id.clone(),
+            reason: "the outline has no centroid".into(),
+        });
+    };
+    let dist: Vec<f64> = ring.iter().map(|p| edges.distance(*p)).collect();
+    let frontage = find_frontage(&ring, &dist, centroid.0, rule);
+    let mut warnings = Vec::new();
+    let given = f.mtype.as_deref().and_then(|m| catalog.resolve(m));
+    if let (Some(m), None) = (&f.mtype, given) {
+        warnings.push(format!(
+            "{}: footprint {}: unknown type `{m}`; built as {}",
+            fp.file, f.id, fp.default_type
+        ));
+    }
+    Outcome::Planned(
+        Box::new(PlannedMachiya {
+            id: f.id.clone(),
+            record: f.record,
+            outline: f.outline.clone(),
+            frontage,
+            mtype: given.unwrap_or(&fp.default_type).to_string(),
+            type_given: given.is_some(),
+            district: None,
+            tile: tiling::tile_id(centroid.0, params.tile_size, params.tile_origin),
+            ground: f.ground,
+            height: Some(f.height),
         }),
         warnings,
     )
@@ -166,10 +233,10 @@ pub fn draw_type(params: &Params, id: &str) -> String {
 
 /// The south-west corner of the lots, rounded down to a whole kilometre, so that small edits
 /// to the data rarely move it.
-fn default_origin(lots: &[Lot]) -> [f64; 2] {
+fn default_origin<'a>(outlines: impl Iterator<Item = &'a geo_types::Polygon<f64>>) -> [f64; 2] {
     let (mut x, mut y) = (f64::INFINITY, f64::INFINITY);
-    for lot in lots {
-        for c in &lot.outline.exterior().0 {
+    for outline in outlines {
+        for c in &outline.exterior().0 {
             x = x.min(c.x);
             y = y.min(c.y);
         }

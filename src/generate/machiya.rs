@@ -95,8 +95,16 @@ pub fn build(
         return Err("the outline is degenerate in the frontage frame".into());
     }
     let lot_depth = ring.iter().map(|p| p[1]).fold(0.0, f64::max);
-    let setback = t.setback;
-    let wanted = if t.depth > 0.0 { t.depth } else { params.depth };
+    let footprint = m.height.is_some();
+    // A footprint is the building itself: no setback, its whole depth.
+    let setback = if footprint { 0.0 } else { t.setback };
+    let wanted = if footprint {
+        lot_depth
+    } else if t.depth > 0.0 {
+        t.depth
+    } else {
+        params.depth
+    };
     let depth = wanted.min(lot_depth - setback);
     if depth < params.min_depth {
         return Err(format!(
@@ -112,11 +120,19 @@ pub fn build(
         return Err("no part of the lot lies in the house's band behind the frontage".into());
     }
 
-    let mut mesh = Mesh::new(format!("machiya_{}", m.id));
+    let mut mesh = Mesh::new(m.object_name());
     let width = f.width();
-    let eave = t.eave_height;
+    let (eave, pitch) = match m.height {
+        None => (t.eave_height, t.roof_pitch),
+        // Fit the type's roof under the building's own height: the rise never takes more
+        // than a third of it, so tall buildings keep walls and low ones keep a roof.
+        Some(h) => {
+            let rise = (t.roof_pitch * depth / 2.0).min(h / 3.0);
+            (h - rise, rise / (depth / 2.0))
+        }
+    };
     let ridge_v = setback + depth / 2.0;
-    let pitch = t.roof_pitch;
+    let base = m.ground;
     let gable = move |v: f64| eave + pitch * (depth / 2.0 - (v - ridge_v).abs());
     let facade_material = materials::find(&t.facade_material).unwrap_or(0);
     let repeats = (width / t.facade_base).ceil().max(1.0);
@@ -128,7 +144,7 @@ pub fn build(
             material: facade_material,
             front_v: setback,
             u_scale: repeats / width,
-            height: eave + t.parapet_height,
+            height: t.eave_height + t.parapet_height,
         }),
     };
     // The two roof halves meet at the ridge: split the body there so every face is planar.
@@ -137,21 +153,23 @@ pub fn build(
         halves.extend(clip_band(part, f64::NEG_INFINITY, ridge_v));
         halves.extend(clip_band(part, ridge_v, f64::INFINITY));
     }
+    let roof = move |v: f64| base + gable(v);
     extrude(
         &mut mesh,
         frame,
         local,
         &halves,
-        &|_| 0.0,
-        &gable,
+        &|_| base,
+        &roof,
         Some(ridge_v),
         &dress,
+        base,
     );
 
-    if t.hisashi_height > 0.0 {
-        hisashi(&mut mesh, frame, local, &body, t, setback);
+    if t.hisashi_height > 0.0 && t.hisashi_height < eave - 0.3 {
+        hisashi(&mut mesh, frame, local, &body, t, setback, base);
     }
-    if t.front_wall_height > 0.0 && setback > WALL_THICKNESS {
+    if !footprint && t.front_wall_height > 0.0 && setback > WALL_THICKNESS {
         let wall = clip_band(&ring, 0.0, WALL_THICKNESS);
         let h = t.front_wall_height;
         let dress = Dress {
@@ -165,10 +183,11 @@ pub fn build(
             frame,
             local,
             &wall,
-            &|_| 0.0,
-            &|_| h,
+            &|_| base,
+            &|_| base + h,
             None,
             &dress,
+            base,
         );
     }
     if t.parapet_height > 0.0 {
@@ -192,7 +211,7 @@ pub fn build(
                     material: facade_material,
                     front_v: v0,
                     u_scale: repeats / width,
-                    height: top,
+                    height: t.eave_height + t.parapet_height,
                 }),
             };
             extrude(
@@ -200,10 +219,11 @@ pub fn build(
                 frame,
                 local,
                 &[board],
-                &|_| bottom,
-                &|_| top,
+                &|_| base + bottom,
+                &|_| base + top,
                 None,
                 &dress,
+                base,
             );
         }
     }
@@ -218,6 +238,7 @@ fn hisashi(
     body: &[LocalRing],
     t: &MachiyaType,
     front_v: f64,
+    base: f64,
 ) {
     let Some((u0, u1)) = front_extent(body, front_v) else {
         return;
@@ -225,7 +246,7 @@ fn hisashi(
     let (v0, v1) = (front_v - t.hisashi_depth, front_v + HISASHI_TUCK);
     let slab = vec![[u0, v0], [u1, v0], [u1, v1], [u0, v1]];
     let hh = t.hisashi_height;
-    let top = move |v: f64| hh + (v - front_v) * HISASHI_PITCH;
+    let top = move |v: f64| base + hh + (v - front_v) * HISASHI_PITCH;
     let bottom = move |v: f64| top(v) - HISASHI_THICKNESS;
     let dress = Dress {
         top: materials::id("kawara_roof"),
@@ -233,7 +254,17 @@ fn hisashi(
         wall: materials::id("wood"),
         facade: None,
     };
-    extrude(mesh, frame, local, &[slab], &bottom, &top, None, &dress);
+    extrude(
+        mesh,
+        frame,
+        local,
+        &[slab],
+        &bottom,
+        &top,
+        None,
+        &dress,
+        base,
+    );
 }
 
 /// The span along the street of the house's front wall (points of the body on `v = front_v`).
@@ -263,6 +294,7 @@ fn extrude(
     top: &dyn Fn(f64) -> f64,
     ridge: Option<f64>,
     dress: &Dress,
+    base: f64,
 ) {
     for part in parts {
         let n = part.len();
@@ -322,14 +354,16 @@ fn extrude(
             let (material, uvs) = match facade {
                 Some(fa) => {
                     let (up, uq) = (p[0] * fa.u_scale, q[0] * fa.u_scale);
+                    // Facade UVs count from the ground, so the texture's storeys line up with
+                    // the house's whatever the ground elevation.
                     let h = fa.height;
                     (
                         fa.material,
                         [
-                            mesh.uv(up, hp0 / h),
-                            mesh.uv(uq, hq0 / h),
-                            mesh.uv(uq, hq1 / h),
-                            mesh.uv(up, hp1 / h),
+                            mesh.uv(up, (hp0 - base) / h),
+                            mesh.uv(uq, (hq0 - base) / h),
+                            mesh.uv(uq, (hq1 - base) / h),
+                            mesh.uv(up, (hp1 - base) / h),
                         ],
                     )
                 }
@@ -339,10 +373,10 @@ fn extrude(
                     (
                         dress.wall,
                         [
-                            mesh.uv(0.0, hp0 / b),
-                            mesh.uv(len, hq0 / b),
-                            mesh.uv(len, hq1 / b),
-                            mesh.uv(0.0, hp1 / b),
+                            mesh.uv(0.0, (hp0 - base) / b),
+                            mesh.uv(len, (hq0 - base) / b),
+                            mesh.uv(len, (hq1 - base) / b),
+                            mesh.uv(0.0, (hp1 - base) / b),
                         ],
                     )
                 }
@@ -413,6 +447,8 @@ mod tests {
             type_given: false,
             district: None,
             tile: "0_0".into(),
+            ground: 0.0,
+            height: None,
         }
     }
 

@@ -18,8 +18,8 @@ use mesh::{Frame, Mesh};
 pub struct TileMeshes {
     pub meshes: Vec<Mesh>,
     pub skipped: Vec<Skipped>,
-    /// Type name of each mesh, parallel to `meshes`, for the report.
-    pub types: Vec<String>,
+    /// Type name of each mesh and whether it is a footprint, parallel to `meshes`.
+    pub types: Vec<(String, bool)>,
 }
 
 pub fn generate_tile(
@@ -39,7 +39,7 @@ pub fn generate_tile(
         match result {
             Ok(mesh) => {
                 out.meshes.push(mesh);
-                out.types.push(m.mtype.clone());
+                out.types.push((m.mtype.clone(), m.height.is_some()));
             }
             Err(reason) => out.skipped.push(Skipped {
                 layer: "lots".into(),

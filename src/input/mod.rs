@@ -1,23 +1,29 @@
 //! Stage 1: read the input directory into a [`Dataset`].
 //!
-//! Layer problems that make the build meaningless (no lots layer, a lots layer of points, a
-//! `.dbf` that does not match its `.shp`) are errors. Problems with single features (no id, a
-//! duplicate id, a ring of fewer than three points) skip that feature and are reported, so
-//! the rest of the city is still built.
+//! Every role (lots, blocks, streets, street widths, footprints) is a shapefile the parameter
+//! file points at, with its fields mapped by name. All coordinates are brought into one
+//! projected CRS (see [`crs`]). Layer problems that make the build meaningless (a lots layer
+//! of points, a `.dbf` that does not match its `.shp`, an unreadable `.prj`) are errors;
+//! problems with single features skip that feature with a reason, and the rest is built.
 
+pub mod crs;
+pub mod fields;
+pub mod geometry;
 pub mod shp;
 pub mod table;
+pub mod widths;
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
-use geo::{orient::Direction, Area, Orient};
-use geo_types::{Coord, LineString, MultiPolygon, Polygon};
-use shapefile::Shape;
+use geo_types::{Coord, LineString};
 use thiserror::Error;
 
-use crate::model::{Dataset, Lot, LotUse, Skipped, Street, TableJoin};
+use crate::model::{Dataset, Footprint, LayerInfo, Lot, LotUse, Skipped, Street, TableJoin};
 use crate::params::Params;
+use crs::Crs;
+use fields::{resolve_field, AttributeRule};
+use geometry::{check_polygon, lines_of, map_polygon, polygons_of};
 
 #[derive(Debug, Error)]
 pub enum InputError {
@@ -29,7 +35,148 @@ pub enum InputError {
     Missing(String),
 }
 
-/// Reads lots, blocks and streets from `dir` as the parameter file maps them.
+/// A layer as opened, with the CRS its coordinates are in.
+struct Opened {
+    role: &'static str,
+    layer: shp::Layer,
+    src: Option<Crs>,
+    file: String,
+}
+
+/// Opens a role's layer. `None` when the role is switched off (`file = ""`) or when an
+/// optional role's default file is not there.
+fn open(
+    dir: &Path,
+    role: &'static str,
+    file: &str,
+    encoding: &str,
+    default_file: &str,
+) -> Result<Option<Opened>, InputError> {
+    if file.trim().is_empty() {
+        return Ok(None);
+    }
+    let path = dir.join(file);
+    if !path.exists() {
+        if file == default_file && role != "lots" {
+            return Ok(None);
+        }
+        return Err(InputError::Missing(format!(
+            "no {role} layer: {} does not exist (set `layers.{role}.file` in the parameter file \
+             to the right path, or to \"\" if there is no such layer)",
+            path.display()
+        )));
+    }
+    let layer = shp::read_layer(&path, encoding)?;
+    Ok(Some(Opened {
+        role,
+        file: path.display().to_string(),
+        layer,
+        src: None,
+    }))
+}
+
+/// Every coordinate of a layer, for choosing a CRS and spotting degrees.
+fn layer_coords(o: &Opened) -> Vec<Coord<f64>> {
+    let mut out = Vec::new();
+    for f in &o.layer.features {
+        if let Ok((polys, _)) = polygons_of(&f.shape) {
+            for p in polys {
+                out.extend(p.exterior().0.iter().copied());
+            }
+        } else if let Ok(lines) = lines_of(&f.shape) {
+            for l in lines {
+                out.extend(l.0);
+            }
+        }
+    }
+    out
+}
+
+/// Chooses the output CRS and the CRS of every layer, with warnings for what was assumed.
+fn resolve_crs(
+    params: &Params,
+    layers: &mut [&mut Opened],
+    warnings: &mut Vec<String>,
+) -> Result<Option<Crs>, InputError> {
+    let mut target = None;
+    if !params.crs.trim().is_empty() {
+        let c = Crs::from_user(&params.crs)
+            .map_err(|m| InputError::Missing(format!("parameter `crs`: {m}")))?;
+        if c.is_geographic() {
+            return Err(InputError::Missing(format!(
+                "parameter `crs` = `{}` is geographic (degrees); the output needs a projected CRS in metres",
+                params.crs
+            )));
+        }
+        target = Some(c);
+    }
+    for o in layers.iter_mut() {
+        o.src = match &o.layer.prj {
+            Some(wkt) => Some(Crs::from_wkt(wkt).map_err(|m| InputError::Layer {
+                file: o.file.replace(".shp", ".prj"),
+                message: format!("{m}; fix the .prj or remove it and set `crs`"),
+            })?),
+            None if !params.crs.trim().is_empty() => {
+                warnings.push(format!(
+                    "{}: no .prj; its coordinates are taken to be in `crs` = {}",
+                    o.file, params.crs
+                ));
+                Crs::from_user(&params.crs).ok()
+            }
+            None if crs::looks_like_degrees(layer_coords(o)) => {
+                warnings.push(format!(
+                    "{}: no .prj, and every coordinate looks like longitude/latitude in degrees; \
+                     read as WGS84 degrees (add a .prj or set `crs` if that is wrong)",
+                    o.file
+                ));
+                Crs::from_user("EPSG:4326").ok()
+            }
+            None => {
+                warnings.push(format!(
+                    "{}: no .prj; its coordinates are taken as projected metres in the output CRS",
+                    o.file
+                ));
+                None
+            }
+        };
+    }
+    if target.is_none() {
+        // The first layer (lots, else footprints, streets, blocks) decides.
+        if let Some(o) = layers.first() {
+            target = match &o.src {
+                Some(c) if !c.is_geographic() => {
+                    Crs::from_wkt(o.layer.prj.as_deref().unwrap_or(""))
+                        .ok()
+                        .or_else(|| Crs::from_user(&c.definition).ok())
+                }
+                Some(_) => {
+                    let pts = layer_coords(o);
+                    let n = pts.len().max(1) as f64;
+                    let lon = pts.iter().map(|c| c.x).sum::<f64>() / n;
+                    let lat = pts.iter().map(|c| c.y).sum::<f64>() / n;
+                    let utm = Crs::utm_for(lon, lat);
+                    warnings.push(format!(
+                        "{} is in longitude/latitude; the city is built in {} (set `crs` to choose)",
+                        o.file, utm.definition
+                    ));
+                    Some(utm)
+                }
+                None => None,
+            };
+        }
+    }
+    Ok(target)
+}
+
+/// Reprojects a layer's feature geometry as it is converted.
+fn to_target(o: &Opened, target: &Option<Crs>, coords: &mut [Coord<f64>]) -> Result<(), String> {
+    match (&o.src, target) {
+        (Some(src), Some(dst)) => crs::reproject(coords, src, dst),
+        _ => Ok(()),
+    }
+}
+
+/// Reads every layer the parameter file maps, as one dataset in one CRS.
 pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> {
     if !dir.is_dir() {
         return Err(InputError::Missing(format!(
@@ -37,53 +184,233 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             dir.display()
         )));
     }
+    let defaults = Params::default();
+    let l = &params.layers;
+    let dl = &defaults.layers;
+    let mut lots = open(dir, "lots", &l.lots.file, &l.lots.encoding, &dl.lots.file)?;
+    let mut footprints = open(
+        dir,
+        "footprints",
+        &l.footprints.file,
+        &l.footprints.encoding,
+        "",
+    )?;
+    let mut streets = open(
+        dir,
+        "streets",
+        &l.streets.file,
+        &l.streets.encoding,
+        &dl.streets.file,
+    )?;
+    let mut blocks = open(
+        dir,
+        "blocks",
+        &l.blocks.file,
+        &l.blocks.encoding,
+        &dl.blocks.file,
+    )?;
+    let mut widths = open(
+        dir,
+        "street_widths",
+        &l.street_widths.file,
+        &l.street_widths.encoding,
+        "",
+    )?;
+
     let mut data = Dataset::default();
-    let lp = &params.layers.lots;
-    let lots_path = dir.join(&lp.file);
-    if !lots_path.exists() {
+    let target = {
+        let mut all: Vec<&mut Opened> = [
+            &mut lots,
+            &mut footprints,
+            &mut streets,
+            &mut blocks,
+            &mut widths,
+        ]
+        .into_iter()
+        .filter_map(|o| o.as_mut())
+        .collect();
+        resolve_crs(params, &mut all, &mut data.warnings)?
+    };
+    data.crs = target
+        .as_ref()
+        .map(|c| c.definition.clone())
+        .unwrap_or_default();
+    for o in [&lots, &footprints, &streets, &blocks, &widths]
+        .into_iter()
+        .flatten()
+    {
+        data.warnings.extend(o.layer.warnings.iter().cloned());
+        data.layers.push(LayerInfo {
+            role: o.role.into(),
+            file: o.file.clone(),
+            features: o.layer.features.len(),
+            encoding: o.layer.encoding.clone(),
+            crs: o
+                .src
+                .as_ref()
+                .map(|c| c.definition.clone())
+                .unwrap_or_else(|| "unknown (no .prj)".into()),
+            reprojected: matches!((&o.src, &target), (Some(s), Some(t)) if !s.same_as(t)),
+        });
+    }
+
+    if let Some(o) = &lots {
+        data.crs_wkt = o.layer.prj.clone();
+        read_lots(dir, params, o, &target, &mut data)?;
+    }
+    if let Some(o) = &footprints {
+        if data.crs_wkt.is_none() {
+            data.crs_wkt = o.layer.prj.clone();
+        }
+        read_footprints(params, o, &target, &mut data)?;
+    }
+    if let Some(o) = &blocks {
+        for f in &o.layer.features {
+            let (polys, _) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
+                file: o.file.clone(),
+                message: format!(
+                    "record {} is a {kind}; the blocks layer must hold polygons",
+                    f.record
+                ),
+            })?;
+            for mut p in polys {
+                map_polygon(&mut p, &mut |c| to_target(o, &target, c)).map_err(|m| {
+                    InputError::Layer {
+                        file: o.file.clone(),
+                        message: m,
+                    }
+                })?;
+                data.blocks.push(p);
+            }
+        }
+    }
+    if let Some(o) = &streets {
+        read_streets(params, o, &target, widths.as_ref(), &mut data)?;
+    }
+    let something = !data.lots.is_empty() || !data.footprints.is_empty();
+    if !something {
+        data.warnings.push(
+            "no lots and no footprints were read: there is nothing to build (set `layers.lots.file` \
+             or `layers.footprints.file`)"
+                .into(),
+        );
+    } else if data.blocks.is_empty() && data.streets.is_empty() {
         return Err(InputError::Missing(format!(
-            "no lots layer: {} does not exist (set `layers.lots.file` in the parameter file \
-             if your lots have another name)",
-            lots_path.display()
+            "no street edges: neither a blocks layer ({}) nor a streets layer ({}) was read; the \
+             frontage of each lot is found from its distance to the street, so one of them is needed",
+            dir.join(&l.blocks.file).display(),
+            dir.join(&l.streets.file).display()
         )));
     }
-    let layer = shp::read_layer(&lots_path, &lp.encoding)?;
-    data.warnings.extend(layer.warnings.iter().cloned());
-    data.crs_wkt = layer.prj.clone();
-    let file = lots_path.display().to_string();
+    Ok(data)
+}
 
+/// The rule for one attribute of a layer: its field (if the layer has it), constant, values.
+#[allow(clippy::too_many_arguments)]
+fn rule(
+    o: &Opened,
+    extra_fields: &[String],
+    attr: &str,
+    field: &str,
+    default_field: &str,
+    values: &std::collections::BTreeMap<String, std::collections::BTreeMap<String, String>>,
+    constants: &std::collections::BTreeMap<String, String>,
+    warnings: &mut Vec<String>,
+) -> AttributeRule {
+    let resolved = resolve_field(field, &o.layer.fields, o.layer.text_encoding)
+        .or_else(|| resolve_field(field, extra_fields, None))
+        .map(String::from);
+    if resolved.is_none() && !field.is_empty() && field != default_field {
+        warnings.push(format!(
+            "{}: no field `{field}` for `{attr}` (fields: {}); the attribute is left empty",
+            o.file,
+            o.layer.fields.join(", ")
+        ));
+    }
+    AttributeRule {
+        field: resolved,
+        constant: constants.get(attr).cloned(),
+        values: values.get(attr).cloned().unwrap_or_default(),
+    }
+}
+
+fn read_lots(
+    dir: &Path,
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let lp = &params.layers.lots;
+    let defaults = Params::default().layers.lots.fields;
+    let id_field = resolve_field(&lp.fields.id, &o.layer.fields, o.layer.text_encoding)
+        .map(String::from)
+        .ok_or_else(|| InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "no id field `{}` (fields: {}); set `layers.lots.fields.id`",
+                lp.fields.id,
+                o.layer.fields.join(", ")
+            ),
+        })?;
     let table = table::find_and_read(dir, &lp.table, &lp.sheet, &lp.fields.id)?;
+    // Table columns count as fields of the layer: a user may keep `mtype` only in lots.csv.
+    let columns: Vec<String> = table
+        .iter()
+        .flat_map(|t| t.rows.iter().flat_map(|r| r.1.keys().cloned()))
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let w = &mut data.warnings;
+    let (v, c, x) = (&lp.values, &lp.constants, &columns);
+    let use_rule = rule(o, x, "use", &lp.fields.lot_use, &defaults.lot_use, v, c, w);
+    let mtype_rule = rule(o, x, "mtype", &lp.fields.mtype, &defaults.mtype, v, c, w);
+    let district_rule = rule(
+        o,
+        x,
+        "district",
+        &lp.fields.district,
+        &defaults.district,
+        v,
+        c,
+        w,
+    );
+    let tile_rule = rule(o, x, "tile", &lp.fields.tile, &defaults.tile, v, c, w);
+    let ground_rule = rule(o, x, "ground", &lp.fields.ground, "", v, c, w);
+
     let mut seen = HashSet::new();
-    let mut lots = Vec::with_capacity(layer.features.len());
-    for f in layer.features {
+    let mut lots = Vec::with_capacity(o.layer.features.len());
+    for f in &o.layer.features {
         let skip = |id: String, reason: String| Skipped {
             layer: "lots".into(),
-            file: file.clone(),
+            file: o.file.clone(),
             id,
             reason,
         };
-        let polys = match polygons_of(&f.shape) {
-            Ok(p) => p,
-            Err(ShapeKind(kind)) => {
-                return Err(InputError::Layer {
-                    file,
-                    message: format!(
-                        "record {} is a {kind}; the lots layer must hold polygons",
-                        f.record
-                    ),
-                })
-            }
-        };
-        let base_id = f.attrs.get(&lp.fields.id).cloned().unwrap_or_default();
+        let (polys, z) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
+            file: o.file.clone(),
+            message: match kind {
+                "multipatch" => format!(
+                    "record {} is a MultiPatch (3D surfaces); edo-city builds from 2D lot \
+                     polygons: export the footprints as Polygon/PolygonZ",
+                    f.record
+                ),
+                _ => format!(
+                    "record {} is a {kind}; the lots layer must hold polygons",
+                    f.record
+                ),
+            },
+        })?;
+        let base_id = f.attrs.get(&id_field).cloned().unwrap_or_default();
         if base_id.is_empty() {
             data.skipped.push(skip(
                 format!("record {}", f.record),
-                format!("no value in the id field `{}`", lp.fields.id),
+                format!("no value in the id field `{id_field}`"),
             ));
             continue;
         }
-        let multi = polys.0.len() > 1;
-        for (part, poly) in polys.0.into_iter().enumerate() {
+        let multi = polys.len() > 1;
+        for (part, mut poly) in polys.into_iter().enumerate() {
             // A multipart lot becomes one lot per part, ids suffixed, so that every id stays
             // unique and the parts can still be traced to their record.
             let id = if multi {
@@ -92,6 +419,10 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
                 base_id.clone()
             };
             if let Err(reason) = check_polygon(&poly) {
+                data.skipped.push(skip(id, reason));
+                continue;
+            }
+            if let Err(reason) = map_polygon(&mut poly, &mut |c| to_target(o, target, c)) {
                 data.skipped.push(skip(id, reason));
                 continue;
             }
@@ -105,6 +436,8 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
                 ));
                 continue;
             }
+            let mut attrs = f.attrs.clone();
+            attrs.insert("\u{0}base_id".into(), base_id.clone());
             lots.push(Lot {
                 id,
                 record: f.record,
@@ -113,115 +446,237 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
                 mtype: None,
                 district: None,
                 tile: None,
-                attrs: f.attrs.clone(),
+                attrs,
+                ground: z.unwrap_or(0.0),
             });
         }
     }
     if let Some(t) = table {
         data.joins.push(join(&mut lots, t, "lots"));
     }
-    let fields = &lp.fields;
-    let text = |lot: &Lot, key: &str| lot.attrs.get(key).filter(|v| !v.is_empty()).cloned();
     for lot in &mut lots {
-        lot.lot_use = LotUse::parse(&text(lot, &fields.lot_use).unwrap_or_default());
-        lot.mtype = text(lot, &fields.mtype);
-        lot.district = text(lot, &fields.district);
-        lot.tile = text(lot, &fields.tile);
+        lot.lot_use = LotUse::parse(&use_rule.value(&lot.attrs).unwrap_or_default());
+        lot.mtype = mtype_rule.value(&lot.attrs);
+        lot.district = district_rule.value(&lot.attrs);
+        lot.tile = tile_rule.value(&lot.attrs);
+        if let Some(g) = ground_rule
+            .value(&lot.attrs)
+            .and_then(|g| g.parse::<f64>().ok())
+        {
+            if g.is_finite() {
+                lot.ground = g;
+            }
+        }
+        lot.attrs.remove("\u{0}base_id");
     }
     data.lots = lots;
-
-    let blocks_path = dir.join(&params.layers.blocks.file);
-    if blocks_path.exists() {
-        let layer = shp::read_layer(&blocks_path, &params.layers.blocks.encoding)?;
-        data.warnings.extend(layer.warnings.iter().cloned());
-        for f in layer.features {
-            match polygons_of(&f.shape) {
-                Ok(mp) => data.blocks.extend(mp.0),
-                Err(ShapeKind(kind)) => {
-                    return Err(InputError::Layer {
-                        file: blocks_path.display().to_string(),
-                        message: format!(
-                            "record {} is a {kind}; the blocks layer must hold polygons",
-                            f.record
-                        ),
-                    })
-                }
-            }
-        }
-    }
-    let sp = &params.layers.streets;
-    let streets_path = dir.join(&sp.file);
-    if streets_path.exists() {
-        let layer = shp::read_layer(&streets_path, &sp.encoding)?;
-        data.warnings.extend(layer.warnings.iter().cloned());
-        let sfile = streets_path.display().to_string();
-        let mut bad_width = 0usize;
-        for f in layer.features {
-            let lines = match lines_of(&f.shape) {
-                Ok(l) => l,
-                Err(ShapeKind(kind)) => {
-                    return Err(InputError::Layer {
-                        file: sfile,
-                        message: format!(
-                            "record {} is a {kind}; the streets layer must hold polylines",
-                            f.record
-                        ),
-                    })
-                }
-            };
-            let width = match f.attrs.get(&sp.width_field).map(|w| w.parse::<f64>()) {
-                Some(Ok(w)) if w.is_finite() && w > 0.0 => w,
-                Some(_) => {
-                    bad_width += 1;
-                    sp.default_width
-                }
-                None => sp.default_width,
-            };
-            let id = f
-                .attrs
-                .get("id")
-                .cloned()
-                .unwrap_or_else(|| f.record.to_string());
-            for line in lines {
-                if line.0.len() >= 2 && line.0.iter().all(|c| c.x.is_finite() && c.y.is_finite()) {
-                    data.streets.push(Street {
-                        id: id.clone(),
-                        line,
-                        width,
-                    });
-                }
-            }
-        }
-        if bad_width > 0 {
-            data.warnings.push(format!(
-                "{sfile}: {bad_width} street(s) have no usable `{}`; they get the default width {} m",
-                sp.width_field, sp.default_width
-            ));
-        }
-    }
-    if data.blocks.is_empty() && data.streets.is_empty() {
-        return Err(InputError::Missing(format!(
-            "no street edges: neither {} nor {} exists (or both are empty); the frontage of each \
-             lot is found from its distance to the street, so one of them is needed",
-            blocks_path.display(),
-            streets_path.display()
-        )));
-    }
-    Ok(data)
+    Ok(())
 }
 
-/// Applies a table to the features: table values win. Returns the match counts.
+fn read_footprints(
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let fp = &params.layers.footprints;
+    let id_field = resolve_field(&fp.fields.id, &o.layer.fields, o.layer.text_encoding)
+        .map(String::from)
+        .ok_or_else(|| InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "no id field `{}` (fields: {}); set `layers.footprints.fields.id`",
+                fp.fields.id,
+                o.layer.fields.join(", ")
+            ),
+        })?;
+    let (nv, nc) = (Default::default(), Default::default());
+    let w = &mut data.warnings;
+    let mtype = rule(
+        o,
+        &[],
+        "mtype",
+        &fp.fields.mtype,
+        "mtype",
+        &fp.values,
+        &nc,
+        w,
+    );
+    let height = rule(o, &[], "height", &fp.fields.height, "height", &nv, &nc, w);
+    let storeys = rule(
+        o,
+        &[],
+        "storeys",
+        &fp.fields.storeys,
+        "storeys",
+        &nv,
+        &nc,
+        w,
+    );
+    let ground = rule(o, &[], "ground", &fp.fields.ground, "", &nv, &nc, w);
+    let mut seen = HashSet::new();
+    let number = |r: &AttributeRule, a| {
+        r.value(a)
+            .and_then(|v| v.parse::<f64>().ok())
+            .filter(|v| v.is_finite() && *v > 0.0)
+    };
+    for f in &o.layer.features {
+        let skip = |id: String, reason: String| Skipped {
+            layer: "footprints".into(),
+            file: o.file.clone(),
+            id,
+            reason,
+        };
+        let (polys, z) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "record {} is a {kind}; the footprints layer must hold polygons",
+                f.record
+            ),
+        })?;
+        let base_id = f.attrs.get(&id_field).cloned().unwrap_or_default();
+        if base_id.is_empty() {
+            data.skipped.push(skip(
+                format!("record {}", f.record),
+                format!("no value in `{id_field}`"),
+            ));
+            continue;
+        }
+        let h = number(&height, &f.attrs)
+            .or_else(|| number(&storeys, &f.attrs).map(|s| s * fp.storey_height + 1.0))
+            .unwrap_or(fp.default_height);
+        let g = ground
+            .value(&f.attrs)
+            .and_then(|v| v.parse::<f64>().ok())
+            .filter(|v| v.is_finite())
+            .or(z)
+            .unwrap_or(0.0);
+        let multi = polys.len() > 1;
+        for (part, mut poly) in polys.into_iter().enumerate() {
+            let id = if multi {
+                format!("{base_id}-{}", part + 1)
+            } else {
+                base_id.clone()
+            };
+            if let Err(reason) = check_polygon(&poly)
+                .and_then(|_| map_polygon(&mut poly, &mut |c| to_target(o, target, c)))
+            {
+                data.skipped.push(skip(id, reason));
+                continue;
+            }
+            if !seen.insert(id.clone()) {
+                data.skipped
+                    .push(skip(id, format!("duplicate id: record {}", f.record)));
+                continue;
+            }
+            data.footprints.push(Footprint {
+                id,
+                record: f.record,
+                outline: poly,
+                mtype: mtype.value(&f.attrs),
+                height: h,
+                ground: g,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn read_streets(
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    widths: Option<&Opened>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let sp = &params.layers.streets;
+    let width_field = resolve_field(&sp.width_field, &o.layer.fields, o.layer.text_encoding);
+    let mut bad_width = 0usize;
+    let mut streets = Vec::new();
+    for f in &o.layer.features {
+        let lines = lines_of(&f.shape).map_err(|kind| InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "record {} is a {kind}; the streets layer must hold polylines",
+                f.record
+            ),
+        })?;
+        let width = match width_field
+            .and_then(|wf| f.attrs.get(wf))
+            .map(|w| w.parse::<f64>())
+        {
+            Some(Ok(w)) if w.is_finite() && w > 0.0 => w,
+            Some(_) => {
+                bad_width += 1;
+                sp.default_width
+            }
+            None => sp.default_width,
+        };
+        for mut line in lines {
+            if line.0.len() >= 2
+                && line.0.iter().all(|c| c.x.is_finite() && c.y.is_finite())
+                && to_target(o, target, &mut line.0).is_ok()
+            {
+                streets.push(Street {
+                    id: f.record.to_string(),
+                    line,
+                    width,
+                });
+            }
+        }
+    }
+    if bad_width > 0 {
+        data.warnings.push(format!(
+            "{}: {bad_width} street(s) have no usable `{}`; they get the default width {} m",
+            o.file, sp.width_field, sp.default_width
+        ));
+    }
+    if let Some(wl) = widths {
+        let wp = &params.layers.street_widths;
+        let field = resolve_field(&wp.width_field, &wl.layer.fields, wl.layer.text_encoding)
+            .ok_or_else(|| InputError::Layer {
+                file: wl.file.clone(),
+                message: format!(
+                    "no width field `{}` (fields: {}); set `layers.street_widths.width_field`",
+                    wp.width_field,
+                    wl.layer.fields.join(", ")
+                ),
+            })?;
+        let mut lines: Vec<(LineString<f64>, f64)> = Vec::new();
+        for f in &wl.layer.features {
+            let Some(w) = f.attrs.get(field).and_then(|v| v.parse::<f64>().ok()) else {
+                continue;
+            };
+            if !(w.is_finite() && w > 0.0) {
+                continue;
+            }
+            for mut line in lines_of(&f.shape).unwrap_or_default() {
+                if to_target(wl, target, &mut line.0).is_ok() {
+                    lines.push((line, w));
+                }
+            }
+        }
+        let (pieces, matched) = widths::apply_widths(streets, &lines, wp.max_distance);
+        data.warnings.push(format!(
+            "{}: {matched} of {} street pieces took their width from {}",
+            o.file,
+            pieces.len(),
+            wl.file
+        ));
+        streets = pieces;
+    }
+    data.streets = streets;
+    Ok(())
+}
+
+/// Applies a table to the lots: table values win. Returns the match counts.
 fn join(lots: &mut [Lot], table: table::Table, layer: &str) -> TableJoin {
     let mut index: HashMap<String, Vec<usize>> = HashMap::new();
     for (i, lot) in lots.iter().enumerate() {
-        // Parts of a multipart lot share the record's id; the row applies to all of them.
-        let key = lot
-            .attrs
-            .get("id")
-            .cloned()
-            .unwrap_or_else(|| lot.id.clone());
-        index.entry(key).or_default().push(i);
-        if !index.contains_key(&lot.id) {
+        // Parts of a multipart lot share their record's id; a row applies to all of them.
+        let base = lot.attrs.get("\u{0}base_id").cloned().unwrap_or_default();
+        index.entry(base.clone()).or_default().push(i);
+        if lot.id != base {
             index.entry(lot.id.clone()).or_default().push(i);
         }
     }
@@ -256,79 +711,4 @@ fn join(lots: &mut [Lot], table: table::Table, layer: &str) -> TableJoin {
     }
     out.features_without_row = matched_lots.iter().filter(|m| !**m).count();
     out
-}
-
-struct ShapeKind(&'static str);
-
-fn shape_kind(shape: &Shape) -> &'static str {
-    match shape {
-        Shape::NullShape => "null shape",
-        Shape::Point(_) | Shape::PointM(_) | Shape::PointZ(_) => "point",
-        Shape::Multipoint(_) | Shape::MultipointM(_) | Shape::MultipointZ(_) => "multipoint",
-        Shape::Polyline(_) | Shape::PolylineM(_) | Shape::PolylineZ(_) => "polyline",
-        Shape::Polygon(_) | Shape::PolygonM(_) | Shape::PolygonZ(_) => "polygon",
-        Shape::Multipatch(_) => "multipatch",
-    }
-}
-
-/// Polygons of a shape (Z and M dropped: elevation comes from a DEM in a later stage).
-/// Exterior rings come out counter-clockwise.
-fn polygons_of(shape: &Shape) -> Result<MultiPolygon<f64>, ShapeKind> {
-    let mp: Result<MultiPolygon<f64>, _> = match shape {
-        Shape::Polygon(p) => MultiPolygon::try_from(p.clone()),
-        Shape::PolygonM(p) => MultiPolygon::try_from(p.clone()),
-        Shape::PolygonZ(p) => MultiPolygon::try_from(p.clone()),
-        Shape::NullShape => return Ok(MultiPolygon(Vec::new())),
-        other => return Err(ShapeKind(shape_kind(other))),
-    };
-    Ok(mp
-        .map(|m| m.orient(Direction::Default))
-        .unwrap_or_else(|_| MultiPolygon(Vec::new())))
-}
-
-fn lines_of(shape: &Shape) -> Result<Vec<LineString<f64>>, ShapeKind> {
-    let parts: Vec<Vec<Coord<f64>>> = match shape {
-        Shape::Polyline(p) => p
-            .parts()
-            .iter()
-            .map(|r| r.iter().map(|q| Coord { x: q.x, y: q.y }).collect())
-            .collect(),
-        Shape::PolylineM(p) => p
-            .parts()
-            .iter()
-            .map(|r| r.iter().map(|q| Coord { x: q.x, y: q.y }).collect())
-            .collect(),
-        Shape::PolylineZ(p) => p
-            .parts()
-            .iter()
-            .map(|r| r.iter().map(|q| Coord { x: q.x, y: q.y }).collect())
-            .collect(),
-        Shape::NullShape => Vec::new(),
-        other => return Err(ShapeKind(shape_kind(other))),
-    };
-    Ok(parts.into_iter().map(LineString).collect())
-}
-
-/// A lot the later stages can work on: finite, at least a triangle, with an area.
-fn check_polygon(poly: &Polygon<f64>) -> Result<(), String> {
-    let ext = poly.exterior();
-    if ext.0.iter().any(|c| !c.x.is_finite() || !c.y.is_finite()) {
-        return Err("a coordinate is not a finite number".into());
-    }
-    let distinct: BTreeMap<(u64, u64), ()> = ext
-        .0
-        .iter()
-        .map(|c| ((c.x.to_bits()), (c.y.to_bits())))
-        .map(|k| (k, ()))
-        .collect();
-    if distinct.len() < 3 {
-        return Err(format!(
-            "the outline has {} distinct vertices; a lot needs at least 3",
-            distinct.len()
-        ));
-    }
-    if poly.unsigned_area() < 1e-6 {
-        return Err("the outline has no area".into());
-    }
-    Ok(())
 }

@@ -28,6 +28,10 @@ pub struct Layer {
     pub features: Vec<Feature>,
     /// The encoding used for the DBF text, for the report.
     pub encoding: String,
+    /// The encoding itself when known (for matching truncated field names).
+    pub text_encoding: Option<&'static encoding_rs::Encoding>,
+    /// Field names in DBF order.
+    pub fields: Vec<String>,
     /// The `.prj` text, if present.
     pub prj: Option<String>,
     pub warnings: Vec<String>,
@@ -117,6 +121,7 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
             file: dbf_path.display().to_string(),
             message: format!("cannot read the DBF: {e}"),
         })?;
+    let fields: Vec<String> = dbf.fields().iter().map(|f| f.name().to_string()).collect();
     let records = dbf.read().map_err(|e| InputError::Layer {
         file: dbf_path.display().to_string(),
         message: format!("cannot read the DBF records: {e}"),
@@ -161,6 +166,8 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
         path: path.to_path_buf(),
         features,
         encoding: encoding_name,
+        text_encoding: encoding,
+        fields,
         prj,
         warnings,
     })

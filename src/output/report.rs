@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::model::{Skipped, TableJoin};
+use crate::model::{LayerInfo, Skipped, TableJoin};
 use crate::params::Params;
 
 #[derive(Debug, Clone, Default, Serialize)]
@@ -16,9 +16,13 @@ pub struct Counts {
     pub lots: usize,
     /// Lots by use (machiya, buke, kuge, jisha, other values).
     pub lots_by_use: BTreeMap<String, usize>,
-    /// Machiya written.
+    /// Machiya written (lot-filling houses).
     pub machiya: usize,
     pub by_type: BTreeMap<String, usize>,
+    /// Footprints read, and built as houses.
+    pub footprints_read: usize,
+    pub footprints: usize,
+    pub footprints_by_type: BTreeMap<String, usize>,
     /// Machiya whose type came from the data / was drawn from `type_mix`.
     pub type_given: usize,
     pub type_drawn: usize,
@@ -33,6 +37,9 @@ pub struct Report {
     pub tool: String,
     pub version: String,
     pub input: String,
+    /// The CRS of the output (proj string); empty when no layer had a `.prj`.
+    pub crs: String,
+    pub layers: Vec<LayerInfo>,
     pub counts: Counts,
     /// Every feature left out, with file, id and reason.
     pub skipped: Vec<Skipped>,
@@ -56,7 +63,9 @@ pub struct Manifest {
     /// Output coordinates are relative to this point, in the input's projected metres.
     pub origin: [f64; 2],
     pub frame: String,
-    /// The input's `.prj`, if it had one.
+    /// The output CRS as a proj string; empty when no layer had a `.prj`.
+    pub crs: String,
+    /// The lots (else footprints) layer's `.prj`, if it had one.
     pub crs_wkt: Option<String>,
     pub tile_size: f64,
     pub params: Params,
