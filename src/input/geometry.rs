@@ -87,11 +87,11 @@ pub fn check_polygon(poly: &Polygon<f64>) -> Result<(), String> {
     Ok(())
 }
 
+/// A change applied to a run of coordinates in place (a reprojection).
+pub type CoordsFn<'a> = dyn FnMut(&mut [Coord<f64>]) -> Result<(), String> + 'a;
+
 /// Applies `f` to every coordinate of a polygon.
-pub fn map_polygon(
-    poly: &mut Polygon<f64>,
-    f: &mut dyn FnMut(&mut [Coord<f64>]) -> Result<(), String>,
-) -> Result<(), String> {
+pub fn map_polygon(poly: &mut Polygon<f64>, f: &mut CoordsFn) -> Result<(), String> {
     let mut result = Ok(());
     poly.exterior_mut(|ls| result = f(&mut ls.0));
     result?;
