@@ -2,7 +2,7 @@
 
 CARGO ?= cargo
 
-.PHONY: run test lint bench textures fixtures clean
+.PHONY: run test lint bench real textures fixtures clean
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
@@ -17,6 +17,17 @@ test:
 lint:
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --all-targets -- -D warnings
+
+REAL ?= ../shared/data/real
+
+## Build every real data set of $(REAL) with its example parameter file into out/real/.
+real:
+	$(CARGO) build --release
+	target/release/edo-city build $(REAL)/chino_plateau_devpermit --params params/examples/chino.toml --out out/real/chino
+	target/release/edo-city build $(REAL)/osaka_plateau --params params/examples/osaka.toml --out out/real/osaka
+	target/release/edo-city build $(REAL)/osaka_plateau --params params/examples/osaka-lonlat.toml --out out/real/osaka-lonlat
+	target/release/edo-city build $(REAL)/kyoto_plateau_related --params params/examples/kyoto.toml --out out/real/kyoto
+	target/release/edo-city build $(REAL)/swellendam_osm --params params/examples/swellendam.toml --out out/real/swellendam
 
 ## Whole-Kyoto scale: 30,052 synthetic lots, three builds, per-stage timings.
 bench:

@@ -145,12 +145,20 @@ fn run(
     std::fs::create_dir_all(&tiles_dir).map_err(|e| write_err(&tiles_dir, e))?;
     let textures = output::write_textures(&opts.out).map_err(|e| write_err(&opts.out, e))?;
 
+    let files = generate::LayerFiles {
+        lots: lots_file.clone(),
+        footprints: opts
+            .input
+            .join(&params.layers.footprints.file)
+            .display()
+            .to_string(),
+    };
     let tiles: Vec<_> = plan.tiles.iter().collect();
     progress.start("writing tiles", tiles.len() as u64);
     let results: Vec<_> = tiles
         .par_iter()
         .map(|(id, lots)| {
-            let meshes = generate::generate_tile(lots, catalog, params, plan.origin, &lots_file);
+            let meshes = generate::generate_tile(lots, catalog, params, plan.origin, &files);
             let written = output::write_tile(&opts.out, id, plan.origin, &meshes.meshes)
                 .map_err(|e| write_err(&tiles_dir.join(format!("{id}.obj")), e));
             progress.inc(1);

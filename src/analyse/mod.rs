@@ -178,7 +178,7 @@ fn plan_footprint(
     let Some(centroid) = f.outline.centroid() else {
         return Outcome::Skipped(Skipped {
             layer: "footprints".into(),
-            file: params.layers.footprints.file.clone(),
+            file: fp.file.clone(),
             id: f.id.clone(),
             reason: "the outline has no centroid".into(),
         });

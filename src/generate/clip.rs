@@ -7,12 +7,36 @@
 use geo::BooleanOps;
 use geo_types::{Coord, LineString, Polygon, Rect};
 
-/// A polygon in the frontage frame: (u, v) pairs, counter-clockwise, not closed.
+/// A ring in the frontage frame: (u, v) pairs, not closed.
 pub type LocalRing = Vec<[f64; 2]>;
 
-/// The parts of `ring` with `lo <= v <= hi` (infinite bounds allowed).
-pub fn clip_band(ring: &[[f64; 2]], lo: f64, hi: f64) -> Vec<LocalRing> {
-    if is_convex(ring) {
+/// A polygon in the frontage frame: exterior counter-clockwise, holes (courtyards) clockwise,
+/// so the polygon's inside is on the left of every edge.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocalPoly {
+    pub exterior: LocalRing,
+    pub holes: Vec<LocalRing>,
+}
+
+impl LocalPoly {
+    /// A polygon without holes.
+    pub fn simple(exterior: LocalRing) -> LocalPoly {
+        LocalPoly {
+            exterior,
+            holes: Vec::new(),
+        }
+    }
+
+    /// Every ring, exterior first.
+    pub fn rings(&self) -> impl Iterator<Item = &LocalRing> {
+        std::iter::once(&self.exterior).chain(&self.holes)
+    }
+}
+
+/// The parts of `poly` with `lo <= v <= hi` (infinite bounds allowed).
+pub fn clip_band(poly: &LocalPoly, lo: f64, hi: f64) -> Vec<LocalPoly> {
+    let ring = &poly.exterior;
+    if poly.holes.is_empty() && is_convex(ring) {
         let mut r = ring.to_vec();
         if lo.is_finite() {
             r = clip_half(&r, lo, true);
@@ -22,12 +46,12 @@ pub fn clip_band(ring: &[[f64; 2]], lo: f64, hi: f64) -> Vec<LocalRing> {
         }
         let r = dedup(r);
         if r.len() >= 3 && area(&r) > 1e-9 {
-            vec![r]
+            vec![LocalPoly::simple(r)]
         } else {
             Vec::new()
         }
     } else {
-        clip_boolean(ring, lo, hi)
+        clip_boolean(poly, lo, hi)
     }
 }
 
@@ -53,9 +77,9 @@ fn clip_half(ring: &[[f64; 2]], c: f64, above: bool) -> LocalRing {
     out
 }
 
-fn clip_boolean(ring: &[[f64; 2]], lo: f64, hi: f64) -> Vec<LocalRing> {
+fn clip_boolean(poly: &LocalPoly, lo: f64, hi: f64) -> Vec<LocalPoly> {
     let (mut umin, mut umax, mut vmin, mut vmax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for p in ring {
+    for p in &poly.exterior {
         umin = umin.min(p[0]);
         umax = umax.max(p[0]);
         vmin = vmin.min(p[1]);
@@ -66,9 +90,10 @@ fn clip_boolean(ring: &[[f64; 2]], lo: f64, hi: f64) -> Vec<LocalRing> {
     if hi <= lo {
         return Vec::new();
     }
-    let poly = Polygon::new(
-        LineString(ring.iter().map(|p| Coord { x: p[0], y: p[1] }).collect()),
-        vec![],
+    let to_ls = |r: &LocalRing| LineString(r.iter().map(|p| Coord { x: p[0], y: p[1] }).collect());
+    let geo_poly = Polygon::new(
+        to_ls(&poly.exterior),
+        poly.holes.iter().map(to_ls).collect(),
     );
     let band = Rect::new(
         Coord {
@@ -81,20 +106,29 @@ fn clip_boolean(ring: &[[f64; 2]], lo: f64, hi: f64) -> Vec<LocalRing> {
         },
     )
     .to_polygon();
-    poly.intersection(&band)
+    let ring_of = |ls: &LineString<f64>, ccw: bool| {
+        let mut r: LocalRing = ls.0[..ls.0.len().saturating_sub(1)]
+            .iter()
+            .map(|c| [c.x, c.y])
+            .collect();
+        if (area(&r) > 0.0) != ccw {
+            r.reverse();
+        }
+        let r = dedup(r);
+        (r.len() >= 3 && area(&r).abs() > 1e-9).then_some(r)
+    };
+    geo_poly
+        .intersection(&band)
         .0
         .into_iter()
         .filter_map(|p| {
-            let ext = &p.exterior().0;
-            let mut r: LocalRing = ext[..ext.len().saturating_sub(1)]
+            let exterior = ring_of(p.exterior(), true)?;
+            let holes = p
+                .interiors()
                 .iter()
-                .map(|c| [c.x, c.y])
+                .filter_map(|h| ring_of(h, false))
                 .collect();
-            if area(&r) < 0.0 {
-                r.reverse();
-            }
-            let r = dedup(r);
-            (r.len() >= 3 && area(&r) > 1e-9).then_some(r)
+            Some(LocalPoly { exterior, holes })
         })
         .collect()
 }
@@ -152,11 +186,14 @@ mod tests {
 
     #[test]
     fn convex_band_clip_is_exact() {
-        let sq = vec![[0., 0.], [4., 0.], [4., 20.], [0., 20.]];
+        let sq = LocalPoly::simple(vec![[0., 0.], [4., 0.], [4., 20.], [0., 20.]]);
         let parts = clip_band(&sq, 2.0, 14.0);
         assert_eq!(parts.len(), 1);
-        assert!((area(&parts[0]) - 48.0).abs() < 1e-9);
-        assert!(parts[0].iter().all(|p| p[1] >= 2.0 && p[1] <= 14.0));
+        assert!((area(&parts[0].exterior) - 48.0).abs() < 1e-9);
+        assert!(parts[0]
+            .exterior
+            .iter()
+            .all(|p| p[1] >= 2.0 && p[1] <= 14.0));
     }
 
     #[test]
@@ -173,9 +210,23 @@ mod tests {
             [0., 10.],
         ];
         assert!(!is_convex(&u));
-        let parts = clip_band(&u, 6.0, f64::INFINITY);
+        let parts = clip_band(&LocalPoly::simple(u), 6.0, f64::INFINITY);
         assert_eq!(parts.len(), 2);
-        let total: f64 = parts.iter().map(|p| area(p)).sum();
+        let total: f64 = parts.iter().map(|p| area(&p.exterior)).sum();
         assert!((total - 16.0).abs() < 1e-6, "{total}");
+    }
+
+    #[test]
+    fn a_courtyard_inside_the_band_stays_a_hole() {
+        let lot = LocalPoly {
+            exterior: vec![[0., 0.], [10., 0.], [10., 30.], [0., 30.]],
+            holes: vec![vec![[3., 4.], [3., 8.], [7., 8.], [7., 4.]]],
+        };
+        let parts = clip_band(&lot, 0.0, 12.0);
+        assert_eq!(parts.len(), 1);
+        assert_eq!(parts[0].holes.len(), 1);
+        assert!(area(&parts[0].holes[0]) < 0.0, "holes run clockwise");
+        let net = area(&parts[0].exterior) + area(&parts[0].holes[0]);
+        assert!((net - 104.0).abs() < 1e-6, "{net}");
     }
 }

@@ -8,7 +8,7 @@
 
 use geo_types::Coord;
 
-use super::clip::{area, clip_band, is_convex, LocalRing};
+use super::clip::{area, clip_band, dedup, is_convex, LocalPoly, LocalRing};
 use super::materials;
 use super::mesh::{Frame, Mesh};
 use crate::model::PlannedMachiya;
@@ -84,14 +84,33 @@ pub fn build(
         u: f.u_axis(),
         v: f.v_axis(),
     };
-    let ext = &m.outline.exterior().0;
-    let ring: LocalRing = super::clip::dedup(
-        ext[..ext.len() - 1]
+    let to_ring = |ls: &geo_types::LineString<f64>| -> LocalRing {
+        dedup(
+            ls.0[..ls.0.len().saturating_sub(1)]
+                .iter()
+                .map(|c| local.to_local(*c))
+                .collect(),
+        )
+    };
+    // Courtyards (holes) stay open: the house is built around them.
+    let lot = LocalPoly {
+        exterior: to_ring(m.outline.exterior()),
+        holes: m
+            .outline
+            .interiors()
             .iter()
-            .map(|c| local.to_local(*c))
+            .map(|h| {
+                let mut r = to_ring(h);
+                if area(&r) > 0.0 {
+                    r.reverse();
+                }
+                r
+            })
+            .filter(|r| r.len() >= 3)
             .collect(),
-    );
-    if ring.len() < 3 || area(&ring) <= 0.0 {
+    };
+    let ring = &lot.exterior;
+    if ring.len() < 3 || area(ring) <= 0.0 {
         return Err("the outline is degenerate in the frontage frame".into());
     }
     let lot_depth = ring.iter().map(|p| p[1]).fold(0.0, f64::max);
@@ -115,7 +134,7 @@ pub fn build(
             params.min_depth
         ));
     }
-    let body = clip_band(&ring, setback, setback + depth);
+    let body = clip_band(&lot, setback, setback + depth);
     if body.is_empty() {
         return Err("no part of the lot lies in the house's band behind the frontage".into());
     }
@@ -170,7 +189,7 @@ pub fn build(
         hisashi(&mut mesh, frame, local, &body, t, setback, base);
     }
     if !footprint && t.front_wall_height > 0.0 && setback > WALL_THICKNESS {
-        let wall = clip_band(&ring, 0.0, WALL_THICKNESS);
+        let wall = clip_band(&lot, 0.0, WALL_THICKNESS);
         let h = t.front_wall_height;
         let dress = Dress {
             top: materials::id("wood"),
@@ -195,12 +214,12 @@ pub fn build(
         // is a closed shell of its own and never coplanar with the wall (no z-fighting).
         if let Some((u0, u1)) = front_extent(&body, setback) {
             let v0 = setback - BOARD_OFFSET;
-            let board = vec![
+            let board = LocalPoly::simple(vec![
                 [u0, v0],
                 [u1, v0],
                 [u1, setback + WALL_THICKNESS],
                 [u0, setback + WALL_THICKNESS],
-            ];
+            ]);
             let top = eave + t.parapet_height;
             let bottom = eave - BOARD_OVERLAP;
             let dress = Dress {
@@ -235,7 +254,7 @@ fn hisashi(
     mesh: &mut Mesh,
     frame: Frame,
     local: Local,
-    body: &[LocalRing],
+    body: &[LocalPoly],
     t: &MachiyaType,
     front_v: f64,
     base: f64,
@@ -244,7 +263,7 @@ fn hisashi(
         return;
     };
     let (v0, v1) = (front_v - t.hisashi_depth, front_v + HISASHI_TUCK);
-    let slab = vec![[u0, v0], [u1, v0], [u1, v1], [u0, v1]];
+    let slab = LocalPoly::simple(vec![[u0, v0], [u1, v0], [u1, v1], [u0, v1]]);
     let hh = t.hisashi_height;
     let top = move |v: f64| base + hh + (v - front_v) * HISASHI_PITCH;
     let bottom = move |v: f64| top(v) - HISASHI_THICKNESS;
@@ -268,11 +287,11 @@ fn hisashi(
 }
 
 /// The span along the street of the house's front wall (points of the body on `v = front_v`).
-fn front_extent(body: &[LocalRing], front_v: f64) -> Option<(f64, f64)> {
+fn front_extent(body: &[LocalPoly], front_v: f64) -> Option<(f64, f64)> {
     let (mut u0, mut u1) = (f64::MAX, f64::MIN);
     for p in body
         .iter()
-        .flatten()
+        .flat_map(|b| &b.exterior)
         .filter(|p| (p[1] - front_v).abs() < 0.01)
     {
         u0 = u0.min(p[0]);
@@ -289,7 +308,7 @@ fn extrude(
     mesh: &mut Mesh,
     frame: Frame,
     local: Local,
-    parts: &[LocalRing],
+    parts: &[LocalPoly],
     bottom: &dyn Fn(f64) -> f64,
     top: &dyn Fn(f64) -> f64,
     ridge: Option<f64>,
@@ -297,7 +316,6 @@ fn extrude(
     base: f64,
 ) {
     for part in parts {
-        let n = part.len();
         // Top (counter-clockwise seen from above) and bottom (reversed).
         let tris = triangles(part);
         let slope = |p: [f64; 2]| {
@@ -307,8 +325,7 @@ fn extrude(
         for tri in &tris {
             let corners = tri
                 .iter()
-                .map(|&i| {
-                    let p = part[i];
+                .map(|&p| {
                     let pos = mesh.vertex(frame, local.to_map(p), top(p[1]));
                     let uv = mesh.uv(
                         p[0] / ROOF_TEXTURE_BASE,
@@ -321,8 +338,7 @@ fn extrude(
             let corners = tri
                 .iter()
                 .rev()
-                .map(|&i| {
-                    let p = part[i];
+                .map(|&p| {
                     let pos = mesh.vertex(frame, local.to_map(p), bottom(p[1]));
                     let uv = mesh.uv(p[0] / WORLD_TEXTURE_BASE, p[1] / WORLD_TEXTURE_BASE);
                     (pos, uv)
@@ -330,9 +346,12 @@ fn extrude(
                 .collect();
             mesh.face(dress.bottom, corners);
         }
-        // Walls, outward: walking p -> q counter-clockwise, outside is on the right.
-        for i in 0..n {
-            let (p, q) = (part[i], part[(i + 1) % n]);
+        // Walls, outward: the polygon's inside is on the left of every edge of every ring
+        // (exterior counter-clockwise, holes clockwise), so outside is on the right.
+        for (p, q) in part
+            .rings()
+            .flat_map(|r| (0..r.len()).map(move |i| (r[i], r[(i + 1) % r.len()])))
+        {
             if let Some(r) = ridge {
                 if (p[1] - r).abs() < 1e-6 && (q[1] - r).abs() < 1e-6 {
                     continue;
@@ -386,32 +405,27 @@ fn extrude(
     }
 }
 
-/// Triangles (counter-clockwise) covering a ring: the ring itself when convex, else earcut.
-fn triangles(part: &[[f64; 2]]) -> Vec<Vec<usize>> {
-    if is_convex(part) {
-        return vec![(0..part.len()).collect()];
+/// Triangles (counter-clockwise) covering a polygon: the polygon itself as one face when it
+/// is convex without holes, else earcut (which keeps the holes open).
+fn triangles(part: &LocalPoly) -> Vec<Vec<[f64; 2]>> {
+    if part.holes.is_empty() && is_convex(&part.exterior) {
+        return vec![part.exterior.clone()];
     }
     use geo::TriangulateEarcut;
     use geo_types::{LineString, Polygon};
-    let poly = Polygon::new(
-        LineString(part.iter().map(|p| Coord { x: p[0], y: p[1] }).collect()),
-        vec![],
-    );
+    let ls = |r: &LocalRing| LineString(r.iter().map(|p| Coord { x: p[0], y: p[1] }).collect());
+    let poly = Polygon::new(ls(&part.exterior), part.holes.iter().map(ls).collect());
     let raw = poly.earcut_triangles_raw();
-    let index_of = |v: [f64; 2]| part.iter().position(|p| *p == v);
     raw.triangle_indices
         .chunks_exact(3)
-        .filter_map(|t| {
-            let mut ids: Vec<usize> = t
-                .iter()
-                .map(|&k| index_of(raw.vertices[k]))
-                .collect::<Option<_>>()?;
-            let tri: Vec<[f64; 2]> = ids.iter().map(|&i| part[i]).collect();
+        .map(|t| {
+            let mut tri: Vec<[f64; 2]> = t.iter().map(|&k| raw.vertices[k]).collect();
             if area(&tri) < 0.0 {
-                ids.reverse();
+                tri.reverse();
             }
-            Some(ids)
+            tri
         })
+        .filter(|tri| area(tri) > 1e-12)
         .collect()
 }
 
@@ -487,6 +501,44 @@ mod tests {
                 assert!(inside_or_on(&lot, p, 0.001), "{}: {p:?} outside", t.name);
             }
         }
+    }
+
+    #[test]
+    fn a_courtyard_stays_open_and_the_house_stays_closed() {
+        let cat = Catalog::load(None).unwrap();
+        let params = Params::default().machiya;
+        let mut m = planned(&[[0.0, 0.0], [10.0, 0.0], [10.0, 30.0], [0.0, 30.0]]);
+        // A courtyard (tsuboniwa 坪庭) 4 m x 4 m inside the house's 12 m band.
+        let hole = LineString::from(vec![
+            (3.0, 4.0),
+            (7.0, 4.0),
+            (7.0, 8.0),
+            (3.0, 8.0),
+            (3.0, 4.0),
+        ]);
+        m.outline = Polygon::new(m.outline.exterior().clone(), vec![hole]);
+        let mesh = build(
+            &m,
+            cat.get("hiraya").unwrap(),
+            &params,
+            Frame { origin: [0.0, 0.0] },
+        )
+        .unwrap();
+        assert!(open_edges(&mesh).is_empty(), "closed around the courtyard");
+        for p in ground(&mesh) {
+            let strictly_inside = p[0] > 3.001 && p[0] < 6.999 && p[1] > 4.001 && p[1] < 7.999;
+            assert!(!strictly_inside, "{p:?} is inside the courtyard");
+        }
+        // Walls stand on the courtyard's four sides, up to the roof.
+        let courtyard_corners = mesh
+            .positions
+            .iter()
+            .filter(|p| [3000, 7000].contains(&p[0]) && [-4000, -8000].contains(&p[2]))
+            .count();
+        assert_eq!(
+            courtyard_corners, 8,
+            "4 corners at the ground and 4 under the roof"
+        );
     }
 
     #[test]

@@ -22,12 +22,19 @@ pub struct TileMeshes {
     pub types: Vec<(String, bool)>,
 }
 
+/// The files features came from, for skip reports.
+#[derive(Debug, Clone, Default)]
+pub struct LayerFiles {
+    pub lots: String,
+    pub footprints: String,
+}
+
 pub fn generate_tile(
     lots: &[PlannedMachiya],
     catalog: &Catalog,
     params: &Params,
     origin: [f64; 2],
-    lots_file: &str,
+    files: &LayerFiles,
 ) -> TileMeshes {
     let frame = Frame { origin };
     let mut out = TileMeshes::default();
@@ -41,12 +48,18 @@ pub fn generate_tile(
                 out.meshes.push(mesh);
                 out.types.push((m.mtype.clone(), m.height.is_some()));
             }
-            Err(reason) => out.skipped.push(Skipped {
-                layer: "lots".into(),
-                file: lots_file.to_string(),
-                id: m.id.clone(),
-                reason,
-            }),
+            Err(reason) => {
+                let (layer, file) = match m.height {
+                    None => ("lots", &files.lots),
+                    Some(_) => ("footprints", &files.footprints),
+                };
+                out.skipped.push(Skipped {
+                    layer: layer.into(),
+                    file: file.clone(),
+                    id: m.id.clone(),
+                    reason,
+                })
+            }
         }
     }
     out

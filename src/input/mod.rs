@@ -418,11 +418,10 @@ fn read_lots(
             } else {
                 base_id.clone()
             };
-            if let Err(reason) = check_polygon(&poly) {
-                data.skipped.push(skip(id, reason));
-                continue;
-            }
-            if let Err(reason) = map_polygon(&mut poly, &mut |c| to_target(o, target, c)) {
+            // Reproject first: the area check is in metres.
+            if let Err(reason) = map_polygon(&mut poly, &mut |c| to_target(o, target, c))
+                .and_then(|_| check_polygon(&poly))
+            {
                 data.skipped.push(skip(id, reason));
                 continue;
             }
@@ -558,8 +557,8 @@ fn read_footprints(
             } else {
                 base_id.clone()
             };
-            if let Err(reason) = check_polygon(&poly)
-                .and_then(|_| map_polygon(&mut poly, &mut |c| to_target(o, target, c)))
+            if let Err(reason) = map_polygon(&mut poly, &mut |c| to_target(o, target, c))
+                .and_then(|_| check_polygon(&poly))
             {
                 data.skipped.push(skip(id, reason));
                 continue;
