@@ -65,6 +65,8 @@ pub struct BuildOptions {
     pub templates: Option<PathBuf>,
     /// Worker threads; 0 = one per core.
     pub threads: usize,
+    /// Also draw `<out>/plan.png`.
+    pub plan_image: bool,
 }
 
 /// Wall time of each stage.
@@ -236,6 +238,12 @@ fn run(
             .or_default() += 1;
     }
 
+    if opts.plan_image {
+        if let Some(png) = output::plan::draw_plan(&data, &plan) {
+            let path = opts.out.join("plan.png");
+            output::atomic::write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
+        }
+    }
     let report_path = opts.out.join("report.json");
     let report_json = serde_json::to_vec_pretty(&rep).expect("report serialises");
     output::atomic::write_atomic(&report_path, &report_json)

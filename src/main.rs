@@ -48,6 +48,9 @@ enum Command {
         /// Print the time of each stage.
         #[arg(long)]
         timings: bool,
+        /// Also draw <out>/plan.png: lots, streets, and the frontage chosen for each house.
+        #[arg(long)]
+        plan: bool,
     },
     /// Write a Kyoto-like shapefile directory of synthetic lots, blocks and streets.
     Synth {
@@ -85,6 +88,7 @@ fn run(cli: Cli) -> Result<()> {
             threads,
             quiet,
             timings,
+            plan,
         } => {
             let params = match &params {
                 Some(p) => Params::from_path(p)?,
@@ -96,6 +100,7 @@ fn run(cli: Cli) -> Result<()> {
                 params,
                 templates,
                 threads,
+                plan_image: plan,
             };
             let bars = Bars::new(quiet || !std::io::stderr().is_terminal());
             let outcome = build(&opts, &bars).context("the build did not finish")?;

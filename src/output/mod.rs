@@ -6,6 +6,7 @@
 pub mod atomic;
 pub mod mtl;
 pub mod obj;
+pub mod plan;
 pub mod report;
 
 use std::path::Path;
