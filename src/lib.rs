@@ -8,6 +8,7 @@
 pub mod analyse;
 pub mod build;
 pub mod generate;
+pub mod init;
 pub mod input;
 pub mod model;
 pub mod output;

@@ -65,6 +65,17 @@ enum Command {
     },
     /// Print the default parameter file (documented key by key).
     Params,
+    /// Inspect a directory of shapefiles and write a starting parameter file with guesses.
+    Init {
+        /// The data directory.
+        dir: PathBuf,
+        /// Where to write the parameter file ("-" = standard output).
+        #[arg(short, long, default_value = "edo-city.toml")]
+        output: PathBuf,
+        /// Replace an existing file.
+        #[arg(long)]
+        force: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -132,6 +143,31 @@ fn run(cli: Cli) -> Result<()> {
                 s.blocks,
                 s.streets
             );
+            Ok(())
+        }
+        Command::Init { dir, output, force } => {
+            if !dir.is_dir() {
+                anyhow::bail!("{} is not a directory", dir.display());
+            }
+            let text = edo_city::init::params_text(&dir);
+            if output.as_os_str() == "-" {
+                print!("{text}");
+            } else {
+                if output.exists() && !force {
+                    anyhow::bail!(
+                        "{} exists; give --force to replace it, or -o another file",
+                        output.display()
+                    );
+                }
+                edo_city::output::atomic::write_atomic(&output, text.as_bytes())
+                    .with_context(|| format!("cannot write {}", output.display()))?;
+                println!(
+                    "wrote {}: check the guesses, then edo-city build {} --params {} --plan",
+                    output.display(),
+                    dir.display(),
+                    output.display()
+                );
+            }
             Ok(())
         }
         Command::Params => {

@@ -206,3 +206,37 @@ fn swellendam_erven_and_buildings_from_two_utm_zones() {
         assert!(reason.contains("no area") || reason.contains("deep"), "{s}");
     }
 }
+
+#[test]
+fn init_guesses_build_every_real_set() {
+    for (set, built_min) in [
+        ("chino_plateau_devpermit", 217),
+        ("osaka_plateau", 1500),
+        ("swellendam_osm", 5000),
+        ("kyoto_plateau_related", 0),
+    ] {
+        let Some(dir) = real(set) else { return };
+        let work = tempfile::tempdir().unwrap();
+        let params = work.path().join("guess.toml");
+        edo_city()
+            .arg("init")
+            .arg(&dir)
+            .arg("-o")
+            .arg(&params)
+            .assert()
+            .success();
+        let text = std::fs::read_to_string(&params).unwrap();
+        assert!(text.contains("# Layers found:"), "{set}: {text}");
+        let r = build_ok(
+            &dir,
+            &work.path().join("out"),
+            &["--quiet", "--params", params.to_str().unwrap()],
+        );
+        let built =
+            r["counts"]["machiya"].as_u64().unwrap() + r["counts"]["footprints"].as_u64().unwrap();
+        assert!(
+            built >= built_min,
+            "{set}: {built} built with the guessed parameters"
+        );
+    }
+}

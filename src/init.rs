@@ -1,0 +1,261 @@
+//! `edo-city init <dir>`: inspects a directory of shapefiles and writes a starting parameter
+//! file with its guesses (which layer is the lots, the streets, ...; which field is the id),
+//! every layer found listed in comments with its type, count, CRS, encoding and fields.
+//! The guesses are a start for the user to correct, never applied silently to a build.
+
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+use crate::input::shp;
+
+/// One shapefile found under the directory.
+#[derive(Debug, Clone)]
+pub struct Found {
+    /// Path relative to the directory, with `/`.
+    pub rel: String,
+    pub kind: &'static str,
+    pub count: usize,
+    pub fields: Vec<String>,
+    pub encoding: String,
+    pub crs: String,
+}
+
+fn find_shapefiles(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x.eq_ignore_ascii_case("shp")) {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Reads what `init` needs of every shapefile under `dir`; unreadable ones are listed with
+/// their error instead.
+pub fn inspect(dir: &Path) -> (Vec<Found>, Vec<String>) {
+    let mut found = Vec::new();
+    let mut problems = Vec::new();
+    for path in find_shapefiles(dir) {
+        let rel = path
+            .strip_prefix(dir)
+            .unwrap_or(&path)
+            .to_string_lossy()
+            .replace('\\', "/");
+        match shp::read_layer(&path, "") {
+            Ok(layer) => {
+                let kind = layer
+                    .features
+                    .iter()
+                    .map(|f| crate::input::geometry::shape_kind(&f.shape))
+                    .find(|k| *k != "null shape")
+                    .unwrap_or("empty");
+                let crs = layer
+                    .prj
+                    .as_deref()
+                    .and_then(|w| w.split('"').nth(1).map(String::from))
+                    .unwrap_or_else(|| "no .prj".into());
+                found.push(Found {
+                    rel,
+                    kind,
+                    count: layer.features.len(),
+                    fields: layer.fields,
+                    encoding: layer.encoding,
+                    crs,
+                });
+            }
+            Err(e) => problems.push(format!("{rel}: {e}")),
+        }
+    }
+    (found, problems)
+}
+
+fn name_score(rel: &str, words: &[&str]) -> usize {
+    let l = rel.to_lowercase();
+    words.iter().filter(|w| l.contains(*w)).count()
+}
+
+fn pick<'a>(found: &'a [Found], kind: &str, words: &[&str], avoid: &[&str]) -> Option<&'a Found> {
+    found
+        .iter()
+        .filter(|f| f.kind == kind && name_score(&f.rel, avoid) == 0)
+        .filter(|f| name_score(&f.rel, words) > 0)
+        .max_by_key(|f| (name_score(&f.rel, words), f.count))
+}
+
+fn field<'a>(f: &'a Found, candidates: &[&str]) -> Option<&'a str> {
+    candidates.iter().find_map(|c| {
+        f.fields
+            .iter()
+            .find(|x| x.eq_ignore_ascii_case(c))
+            .map(String::as_str)
+    })
+}
+
+const ID_FIELDS: &[&str] = &[
+    "id",
+    "fid",
+    "objectid",
+    "gml_id",
+    "osm_id",
+    "chiban_id",
+    "ag_cad_id",
+    "object_id",
+    "任意ID",
+];
+
+/// The parameter file text for `dir`.
+pub fn params_text(dir: &Path) -> String {
+    let (found, problems) = inspect(dir);
+    let lots = pick(
+        &found,
+        "polygon",
+        &[
+            "lot", "parcel", "chiban", "地番", "敷地", "erf", "erven", "urban", "cadast",
+            "shikichi",
+        ],
+        &["build", "bldg", "建物", "district", "road"],
+    );
+    let footprints = pick(
+        &found,
+        "polygon",
+        &["build", "bldg", "建物", "footprint", "house"],
+        &[],
+    );
+    let blocks = pick(
+        &found,
+        "polygon",
+        &["block", "街区", "road_surface", "road"],
+        &["build"],
+    );
+    let streets = pick(
+        &found,
+        "polyline",
+        &["road", "street", "道路", "center", "centre", "route", "way"],
+        &["split", "rail", "border"],
+    );
+    let widths = found.iter().find(|f| {
+        f.kind == "polyline"
+            && Some(f.rel.as_str()) != streets.map(|s| s.rel.as_str())
+            && field(f, &["road_width", "width", "幅員"]).is_some()
+    });
+
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# edo-city parameters for {}, written by `edo-city init`.\n\
+         # These are guesses from layer and field names: check every one, then build with\n\
+         #   edo-city build {} --params <this file> --out out --plan\n\
+         # and look at out/plan.png. Keys left out keep the defaults of `edo-city params`.\n",
+        dir.display(),
+        dir.display()
+    );
+    let quote = |v: &str| format!("{v:?}");
+    let _ = writeln!(s, "[layers.lots]");
+    match lots {
+        Some(l) => {
+            let _ = writeln!(s, "file = {}", quote(&l.rel));
+            let _ = writeln!(s, "[layers.lots.fields]");
+            let id = field(l, ID_FIELDS).unwrap_or("id");
+            let _ = writeln!(s, "id = {}", quote(id));
+            if let Some(d) = field(l, &["district", "districtid", "地区", "town", "suburb"]) {
+                let _ = writeln!(s, "district = {}", quote(d));
+            }
+            let _ = writeln!(
+                s,
+                "# No land-use field is assumed: every lot is a town lot (machiya). Map one with\n\
+                 # use = \"<field>\" and [layers.lots.values.use] \"<code>\" = \"buke\", ..."
+            );
+        }
+        None => {
+            let _ = writeln!(s, "file = \"\"  # no lots layer recognised");
+        }
+    }
+    let _ = writeln!(s, "\n[layers.footprints]");
+    match footprints {
+        Some(f) => {
+            let _ = writeln!(s, "file = {}", quote(&f.rel));
+            let _ = writeln!(s, "[layers.footprints.fields]");
+            let _ = writeln!(s, "id = {}", quote(field(f, ID_FIELDS).unwrap_or("id")));
+            let h = field(f, &["lod1_h", "height", "高さ", "measuredheight"]).unwrap_or("");
+            let st = field(f, &["storeys", "building_l", "levels", "階数", "floors"]).unwrap_or("");
+            let g = field(f, &["ground_z", "ground", "elevation", "標高"]).unwrap_or("");
+            let _ = writeln!(
+                s,
+                "height = {}\nstoreys = {}\nground = {}\nmtype = \"\"",
+                quote(h),
+                quote(st),
+                quote(g)
+            );
+        }
+        None => {
+            let _ = writeln!(s, "file = \"\"");
+        }
+    }
+    let _ = writeln!(s, "\n[layers.blocks]");
+    let _ = writeln!(
+        s,
+        "file = {}",
+        quote(blocks.map(|b| b.rel.as_str()).unwrap_or(""))
+    );
+    let _ = writeln!(s, "\n[layers.streets]");
+    let _ = writeln!(
+        s,
+        "file = {}",
+        quote(streets.map(|b| b.rel.as_str()).unwrap_or(""))
+    );
+    if let Some(w) = streets.and_then(|st| field(st, &["width", "road_width", "幅員"])) {
+        let _ = writeln!(s, "width_field = {}", quote(w));
+    }
+    if let Some(w) = widths {
+        let _ = writeln!(s, "\n[layers.street_widths]");
+        let _ = writeln!(s, "file = {}", quote(&w.rel));
+        let wf = field(w, &["road_width", "width", "幅員"]).unwrap_or("width");
+        let _ = writeln!(s, "width_field = {}", quote(wf));
+    }
+    let _ = writeln!(s, "\n# Layers found:");
+    for f in &found {
+        let _ = writeln!(
+            s,
+            "#   {}  {} x{}  CRS {}  text {}\n#     fields: {}",
+            f.rel,
+            f.kind,
+            f.count,
+            f.crs,
+            f.encoding,
+            f.fields.join(", ")
+        );
+    }
+    for p in &problems {
+        let _ = writeln!(s, "#   could not read {p}");
+    }
+    if found.is_empty() {
+        let _ = writeln!(s, "#   (no shapefiles under {})", dir.display());
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_synthetic_town_is_recognised_and_the_file_parses() {
+        let dir = tempfile::tempdir().unwrap();
+        crate::synth::write_town(dir.path(), 80, 1).unwrap();
+        let text = params_text(dir.path());
+        assert!(text.contains("file = \"lots.shp\""), "{text}");
+        assert!(text.contains("file = \"streets.shp\""), "{text}");
+        assert!(text.contains("file = \"blocks.shp\""), "{text}");
+        crate::params::Params::from_toml_str(&text, "init.toml").unwrap();
+    }
+}
