@@ -164,7 +164,7 @@ fn run(
             let written = output::write_tile(&opts.out, id, plan.origin, &meshes.meshes)
                 .map_err(|e| write_err(&tiles_dir.join(format!("{id}.obj")), e));
             progress.inc(1);
-            written.map(|m| (m, meshes.skipped, meshes.types))
+            written.map(|m| (m, meshes.skipped, meshes.types, meshes.districts))
         })
         .collect();
     progress.finish();
@@ -203,7 +203,10 @@ fn run(
     let mut manifest_tiles = Vec::new();
     let mut bytes_written = 0;
     for (result, (id, _)) in results.into_iter().zip(&tiles) {
-        let (mt, skipped, types) = result?;
+        let (mt, skipped, types, districts) = result?;
+        for d in districts {
+            *rep.counts.by_district.entry(d).or_default() += 1;
+        }
         rep.tiles.push(report::TileReport {
             id: (*id).clone(),
             machiya: types.iter().filter(|t| !t.1).count(),

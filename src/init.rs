@@ -143,6 +143,12 @@ pub fn params_text(dir: &Path) -> String {
         &["road", "street", "道路", "center", "centre", "route", "way"],
         &["split", "rail", "border"],
     );
+    let districts = pick(
+        &found,
+        "polygon",
+        &["district", "地区", "町丁", "chiku", "ward"],
+        &["use_district", "youto"],
+    );
     let widths = found.iter().find(|f| {
         f.kind == "polyline"
             && Some(f.rel.as_str()) != streets.map(|s| s.rel.as_str())
@@ -221,6 +227,12 @@ pub fn params_text(dir: &Path) -> String {
         let _ = writeln!(s, "file = {}", quote(&w.rel));
         let wf = field(w, &["road_width", "width", "幅員"]).unwrap_or("width");
         let _ = writeln!(s, "width_field = {}", quote(wf));
+    }
+    if let Some(d) = districts {
+        let _ = writeln!(s, "\n[layers.districts]");
+        let _ = writeln!(s, "file = {}", quote(&d.rel));
+        let id = field(d, &["name", "disname", "district", "id", "districtid"]).unwrap_or("id");
+        let _ = writeln!(s, "id_field = {}", quote(id));
     }
     let _ = writeln!(s, "\n# Layers found:");
     for f in &found {

@@ -79,6 +79,7 @@ pub struct Footprint {
     pub record: usize,
     pub outline: Polygon<f64>,
     pub mtype: Option<String>,
+    pub district: Option<String>,
     /// Total height, ground to ridge, metres.
     pub height: f64,
     pub ground: f64,

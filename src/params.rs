@@ -59,6 +59,20 @@ pub struct Layers {
     pub streets: StreetsLayer,
     pub street_widths: StreetWidthsLayer,
     pub footprints: FootprintsLayer,
+    pub districts: DistrictsLayer,
+}
+
+/// District polygons (chiku 地区): a lot or footprint without a district attribute gets the
+/// district whose polygon holds its centroid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistrictsLayer {
+    /// "" = no such layer.
+    pub file: String,
+    #[serde(default)]
+    pub encoding: String,
+    /// Field holding the district id (or name).
+    pub id_field: String,
 }
 
 /// Settings shared by every layer: where it is and how its text is encoded.
@@ -359,6 +373,15 @@ mod partial {
         streets: Option<Streets>,
         street_widths: Option<Widths>,
         footprints: Option<Footprints>,
+        districts: Option<Districts>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Districts {
+        file: Option<String>,
+        encoding: Option<String>,
+        id_field: Option<String>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]

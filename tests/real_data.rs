@@ -240,3 +240,17 @@ fn init_guesses_build_every_real_set() {
         );
     }
 }
+
+#[test]
+fn chino_parcels_take_the_town_area_holding_them() {
+    let out = tempfile::tempdir().unwrap();
+    let Some(r) = build_example("chino_plateau_devpermit", "chino", out.path()) else {
+        return;
+    };
+    let by_district = r["counts"]["by_district"].as_object().unwrap();
+    // f_district has 10 town areas (町丁); every parcel lies in one of them.
+    assert_eq!(by_district.len(), 10, "{by_district:?}");
+    assert!(by_district.contains_key("ちの上原"));
+    let total: u64 = by_district.values().map(|v| v.as_u64().unwrap()).sum();
+    assert_eq!(total, 217);
+}

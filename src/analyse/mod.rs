@@ -201,7 +201,7 @@ fn plan_footprint(
             frontage,
             mtype: given.unwrap_or(&fp.default_type).to_string(),
             type_given: given.is_some(),
-            district: None,
+            district: f.district.clone(),
             tile: tiling::tile_id(centroid.0, params.tile_size, params.tile_origin),
             ground: f.ground,
             height: Some(f.height),

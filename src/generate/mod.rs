@@ -20,6 +20,8 @@ pub struct TileMeshes {
     pub skipped: Vec<Skipped>,
     /// Type name of each mesh and whether it is a footprint, parallel to `meshes`.
     pub types: Vec<(String, bool)>,
+    /// District of each mesh ("" = none), parallel to `meshes`.
+    pub districts: Vec<String>,
 }
 
 /// The files features came from, for skip reports.
@@ -47,6 +49,7 @@ pub fn generate_tile(
             Ok(mesh) => {
                 out.meshes.push(mesh);
                 out.types.push((m.mtype.clone(), m.height.is_some()));
+                out.districts.push(m.district.clone().unwrap_or_default());
             }
             Err(reason) => {
                 let (layer, file) = match m.height {

@@ -216,6 +216,13 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         &l.street_widths.encoding,
         "",
     )?;
+    let mut districts = open(
+        dir,
+        "districts",
+        &l.districts.file,
+        &l.districts.encoding,
+        "",
+    )?;
 
     let mut data = Dataset::default();
     let target = {
@@ -225,6 +232,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             &mut streets,
             &mut blocks,
             &mut widths,
+            &mut districts,
         ]
         .into_iter()
         .filter_map(|o| o.as_mut())
@@ -286,6 +294,9 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
     }
     if let Some(o) = &streets {
         read_streets(params, o, &target, widths.as_ref(), &mut data)?;
+    }
+    if let Some(o) = &districts {
+        assign_districts(params, o, &target, &mut data)?;
     }
     let something = !data.lots.is_empty() || !data.footprints.is_empty();
     if !something {
@@ -573,6 +584,7 @@ fn read_footprints(
                 record: f.record,
                 outline: poly,
                 mtype: mtype.value(&f.attrs),
+                district: None,
                 height: h,
                 ground: g,
             });
@@ -665,6 +677,69 @@ fn read_streets(
         streets = pieces;
     }
     data.streets = streets;
+    Ok(())
+}
+
+/// Gives every lot and footprint without a district the district holding its centroid.
+fn assign_districts(
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    use geo::{BoundingRect, Centroid, Contains};
+    let dp = &params.layers.districts;
+    let field =
+        resolve_field(&dp.id_field, &o.layer.fields, o.layer.text_encoding).ok_or_else(|| {
+            InputError::Layer {
+                file: o.file.clone(),
+                message: format!(
+                    "no district id field `{}` (fields: {}); set `layers.districts.id_field`",
+                    dp.id_field,
+                    o.layer.fields.join(", ")
+                ),
+            }
+        })?;
+    let mut polys = Vec::new();
+    for f in &o.layer.features {
+        let (parts, _) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "record {} is a {kind}; the districts layer must hold polygons",
+                f.record
+            ),
+        })?;
+        let id = f.attrs.get(field).cloned().unwrap_or_default();
+        for mut p in parts {
+            if map_polygon(&mut p, &mut |c| to_target(o, target, c)).is_ok() && !id.is_empty() {
+                if let Some(bb) = p.bounding_rect() {
+                    polys.push((bb, p, id.clone()));
+                }
+            }
+        }
+    }
+    let find = |poly: &geo_types::Polygon<f64>| -> Option<String> {
+        let c = poly.centroid()?;
+        polys
+            .iter()
+            .find(|(bb, p, _)| bb.contains(&c) && p.contains(&c))
+            .map(|(_, _, id)| id.clone())
+    };
+    let mut outside = 0;
+    for lot in data.lots.iter_mut().filter(|l| l.district.is_none()) {
+        lot.district = find(&lot.outline);
+        outside += lot.district.is_none() as usize;
+    }
+    for f in data.footprints.iter_mut().filter(|f| f.district.is_none()) {
+        f.district = find(&f.outline);
+        outside += f.district.is_none() as usize;
+    }
+    if outside > 0 {
+        data.warnings.push(format!(
+            "{}: {outside} lot(s) or footprint(s) lie in no district polygon and have no district",
+            o.file
+        ));
+    }
     Ok(())
 }
 

@@ -26,6 +26,8 @@ pub struct Counts {
     /// Machiya whose type came from the data / was drawn from `type_mix`.
     pub type_given: usize,
     pub type_drawn: usize,
+    /// Houses (machiya and footprints) per district; "" = no district.
+    pub by_district: BTreeMap<String, usize>,
     /// Lots where no pair passed the Fig.4 test and the nearest edge was taken.
     pub frontage_fallback: usize,
     pub tiles: usize,
