@@ -339,7 +339,7 @@ pub fn write_lots(path: &Path, lots: &[SynthLot]) -> Result<(), String> {
     sidecars(path, "SHIFT_JIS")
 }
 
-fn write_blocks(path: &Path, blocks: &[Vec<[f64; 2]>]) -> Result<(), String> {
+pub fn write_blocks(path: &Path, blocks: &[Vec<[f64; 2]>]) -> Result<(), String> {
     let table = dbase::TableWriterBuilder::new().add_numeric_field(field("id"), 10, 0);
     let mut w = shapefile::Writer::from_path(path, table).map_err(shp_err(path))?;
     for (i, b) in blocks.iter().enumerate() {
