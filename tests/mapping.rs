@@ -151,10 +151,8 @@ fn lon_lat_without_prj_is_recognised_as_degrees() {
         .map(|b| b.iter().map(|p| to_deg(*p)).collect())
         .collect();
     edo_city::synth::write_blocks(&dir.path().join("blocks.shp"), &blocks).unwrap();
-    for ext in ["prj"] {
-        let _ = std::fs::remove_file(dir.path().join("lots").with_extension(ext));
-        let _ = std::fs::remove_file(dir.path().join("blocks").with_extension(ext));
-    }
+    std::fs::remove_file(dir.path().join("lots.prj")).unwrap();
+    std::fs::remove_file(dir.path().join("blocks.prj")).unwrap();
     let r = build_ok(dir.path(), &dir.path().join("out"), &["--quiet"]);
     assert!(
         r["warnings"].to_string().contains("longitude/latitude"),
