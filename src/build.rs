@@ -1,14 +1,15 @@
 //! The whole pipeline, one line: read inputs => analyse => generate => write.
 //!
 //! ```text
-//! input::read_dataset -> analyse::analyse -> (per tile, in parallel)
+//! input::read_dataset -> analyse::analyse -> (per selected tile, in parallel)
 //!     generate::generate_tile -> output::write_tile
 //! -> report.json, manifest.json (last)
 //! ```
 //! Tiles are independent once analysis is done: each is generated and written by one rayon
 //! task and dropped, so memory holds one tile's meshes per thread, never the whole city.
+//! Reading and analysis always cover the whole input, so a tile built alone (`--tiles`) or in
+//! a shard (`--shard`) sees its neighbours and comes out byte-identical to a full build's.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -18,10 +19,12 @@ use thiserror::Error;
 use crate::analyse;
 use crate::generate;
 use crate::input::{self, InputError};
-use crate::model::LotUse;
+use crate::model::{Dataset, LotUse, Plan};
 use crate::output::{self, report};
 use crate::params::{Params, ParamsError};
 use crate::templates::{Catalog, TemplateError};
+
+pub mod shards;
 
 /// Progress of the long stages; the CLI draws bars, tests pass [`NoProgress`].
 pub trait Progress: Sync {
@@ -55,6 +58,18 @@ pub enum BuildError {
     },
 }
 
+/// Which tiles a run writes.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub enum Selection {
+    /// Every tile; report and manifest describe the whole city.
+    #[default]
+    All,
+    /// Only these tiles, rewritten inside an earlier full build (its manifest is updated).
+    Tiles(Vec<String>),
+    /// The I-th (from 1) of N balanced sets of tiles; writes `manifest.shard-I-of-N.json`.
+    Shard { index: usize, count: usize },
+}
+
 /// What to build, already validated by the CLI.
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
@@ -67,6 +82,9 @@ pub struct BuildOptions {
     pub threads: usize,
     /// Also draw `<out>/plan.png`.
     pub plan_image: bool,
+    pub selection: Selection,
+    /// Replace an output directory built from other parameters or input.
+    pub force: bool,
 }
 
 /// Wall time of each stage.
@@ -83,16 +101,16 @@ pub struct BuildOutcome {
     pub report: report::Report,
     pub timings: Timings,
     pub bytes_written: u64,
+    /// Tiles written by this run.
+    pub tiles_written: usize,
 }
 
-/// Runs the pipeline.
-pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcome, BuildError> {
-    let t0 = Instant::now();
-    let params = &opts.params;
-    let template_dir = opts.templates.clone().or_else(|| {
+/// Loads the machiya types and checks `type_mix` against them.
+pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog, BuildError> {
+    let dir = templates.map(Path::to_path_buf).or_else(|| {
         (!params.machiya.templates.is_empty()).then(|| PathBuf::from(&params.machiya.templates))
     });
-    let catalog = Catalog::load(template_dir.as_deref())?;
+    let catalog = Catalog::load(dir.as_deref())?;
     for name in params.type_mix.keys() {
         if catalog.get(name).is_none() {
             return Err(BuildError::Config(format!(
@@ -101,11 +119,52 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcom
             )));
         }
     }
+    Ok(catalog)
+}
+
+/// Reads and analyses the input: the part of a build every tile depends on. Returns the
+/// time each took.
+pub fn read_and_analyse(
+    input: &Path,
+    params: &Params,
+    catalog: &Catalog,
+    progress: &dyn Progress,
+) -> Result<(Dataset, Plan, Duration, Duration), BuildError> {
+    let t = Instant::now();
+    progress.start("reading", 0);
+    let data = input::read_dataset(input, params)?;
+    progress.finish();
+    let read = t.elapsed();
+    let t = Instant::now();
+    let lots_file = input.join(&params.layers.lots.file).display().to_string();
+    let machiya_lots = data
+        .lots
+        .iter()
+        .filter(|l| l.lot_use == LotUse::Machiya)
+        .count();
+    progress.start("analysing", machiya_lots as u64);
+    let plan = analyse::analyse(&data, params, catalog, &lots_file, &|n| progress.inc(n));
+    progress.finish();
+    Ok((data, plan, read, t.elapsed()))
+}
+
+/// Runs the pipeline.
+pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcome, BuildError> {
+    let t0 = Instant::now();
+    shards::check_out_dir(opts)?;
+    let catalog = load_catalog(&opts.params, opts.templates.as_deref())?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .build()
         .map_err(|e| BuildError::Config(format!("cannot start worker threads: {e}")))?;
     pool.install(|| run(opts, &catalog, progress, t0))
+}
+
+fn write_err(path: &Path, source: std::io::Error) -> BuildError {
+    BuildError::Write {
+        path: path.display().to_string(),
+        source,
+    }
 }
 
 fn run(
@@ -116,190 +175,136 @@ fn run(
 ) -> Result<BuildOutcome, BuildError> {
     let params = &opts.params;
     let mut timings = Timings::default();
-
-    progress.start("reading", 0);
-    let data = input::read_dataset(&opts.input, params)?;
-    progress.finish();
-    timings.read = t0.elapsed();
+    let (data, plan, read, analysed) = read_and_analyse(&opts.input, params, catalog, progress)?;
+    timings.read = read;
+    timings.analyse = analysed;
 
     let t = Instant::now();
-    let lots_file = opts
-        .input
-        .join(&params.layers.lots.file)
-        .display()
-        .to_string();
-    let machiya_lots = data
-        .lots
-        .iter()
-        .filter(|l| l.lot_use == LotUse::Machiya)
-        .count();
-    progress.start("analysing", machiya_lots as u64);
-    let plan = analyse::analyse(&data, params, catalog, &lots_file, &|n| progress.inc(n));
-    progress.finish();
-    timings.analyse = t.elapsed();
-
-    let t = Instant::now();
-    let write_err = |path: &Path, source| BuildError::Write {
-        path: path.display().to_string(),
-        source,
+    let selected = shards::select(&plan, &opts.selection)?;
+    let previous = match &opts.selection {
+        Selection::Tiles(_) => Some(shards::previous_manifest(&opts.out)?),
+        _ => None,
     };
     let tiles_dir = opts.out.join("tiles");
     std::fs::create_dir_all(&tiles_dir).map_err(|e| write_err(&tiles_dir, e))?;
     let textures = output::write_textures(&opts.out).map_err(|e| write_err(&opts.out, e))?;
 
     let files = generate::LayerFiles {
-        lots: lots_file.clone(),
+        lots: opts
+            .input
+            .join(&params.layers.lots.file)
+            .display()
+            .to_string(),
         footprints: opts
             .input
             .join(&params.layers.footprints.file)
             .display()
             .to_string(),
     };
-    let tiles: Vec<_> = plan.tiles.iter().collect();
+    let tiles: Vec<_> = plan
+        .tiles
+        .iter()
+        .filter(|(id, _)| selected.contains(id.as_str()))
+        .collect();
     progress.start("writing tiles", tiles.len() as u64);
-    let results: Vec<_> = tiles
+    let results: Vec<Result<report::ManifestTile, BuildError>> = tiles
         .par_iter()
         .map(|(id, lots)| {
             let meshes = generate::generate_tile(lots, catalog, params, plan.origin, &files);
             let written = output::write_tile(&opts.out, id, plan.origin, &meshes.meshes)
                 .map_err(|e| write_err(&tiles_dir.join(format!("{id}.obj")), e));
             progress.inc(1);
-            written.map(|m| (m, meshes.skipped, meshes.types, meshes.districts))
+            written.map(|(obj, mtl)| report::ManifestTile {
+                id: (*id).clone(),
+                obj,
+                mtl,
+                stats: meshes.stats,
+            })
         })
         .collect();
     progress.finish();
-    timings.generate_and_write = t.elapsed();
+    let mut written = Vec::with_capacity(results.len());
+    for r in results {
+        written.push(r?);
+    }
+    let tiles_written = written.len();
+    let bytes_written: u64 = written.iter().map(|t| t.obj.bytes + t.mtl.bytes).sum();
 
-    let mut rep = report::Report {
-        tool: "edo-city".into(),
-        version: env!("CARGO_PKG_VERSION").into(),
-        input: opts.input.display().to_string(),
-        crs: data.crs.clone(),
-        layers: data.layers.clone(),
-        ..Default::default()
+    // The manifest's tiles: what this run wrote, plus (for --tiles) the earlier build's
+    // entries for the tiles it did not touch.
+    let manifest_tiles = match previous {
+        Some(prev) => {
+            let mut new: std::collections::BTreeMap<String, report::ManifestTile> =
+                written.into_iter().map(|t| (t.id.clone(), t)).collect();
+            let mut out = Vec::new();
+            for id in plan.tiles.keys() {
+                if let Some(t) = new.remove(id) {
+                    out.push(t);
+                } else if let Some(t) = prev.tiles.iter().find(|t| &t.id == id) {
+                    out.push(t.clone());
+                }
+            }
+            out
+        }
+        None => written,
     };
-    rep.counts.footprints_read = data.footprints.len();
-    rep.counts.lots = data.lots.len();
-    for lot in &data.lots {
-        *rep.counts
-            .lots_by_use
-            .entry(lot.lot_use.name().to_string())
-            .or_default() += 1;
-    }
-    rep.skipped = data.skipped.clone();
-    rep.skipped.extend(plan.skipped.iter().cloned());
-    rep.warnings = data.warnings.clone();
-    rep.warnings.extend(plan.warnings.iter().cloned());
-    rep.tables = data.joins.clone();
-    rep.counts.frontage_fallback = plan.frontage_fallback;
-    let given: BTreeMap<&str, bool> = plan
-        .tiles
-        .values()
-        .flatten()
-        .filter(|m| m.height.is_none())
-        .map(|m| (m.id.as_str(), m.type_given))
-        .collect();
-
-    let mut manifest_tiles = Vec::new();
-    let mut bytes_written = 0;
-    for (result, (id, _)) in results.into_iter().zip(&tiles) {
-        let (mt, skipped, types, districts) = result?;
-        for d in districts {
-            *rep.counts.by_district.entry(d).or_default() += 1;
-        }
-        rep.tiles.push(report::TileReport {
-            id: (*id).clone(),
-            machiya: types.iter().filter(|t| !t.1).count(),
-            obj_bytes: mt.obj.bytes,
-        });
-        bytes_written += mt.obj.bytes + mt.mtl.bytes;
-        for (t, footprint) in types {
-            let map = if footprint {
-                &mut rep.counts.footprints_by_type
-            } else {
-                &mut rep.counts.by_type
-            };
-            *map.entry(t).or_default() += 1;
-        }
-        rep.skipped.extend(skipped);
-        manifest_tiles.push(mt);
-    }
-    rep.counts.machiya = rep.counts.by_type.values().sum();
-    rep.counts.footprints = rep.counts.footprints_by_type.values().sum();
-    let skipped_ids: std::collections::HashSet<&str> =
-        rep.skipped.iter().map(|s| s.id.as_str()).collect();
-    rep.counts.type_given = given
-        .iter()
-        .filter(|(id, g)| **g && !skipped_ids.contains(**id))
-        .count();
-    rep.counts.type_drawn = rep.counts.machiya.saturating_sub(rep.counts.type_given);
-    rep.counts.tiles = manifest_tiles.len();
-    rep.counts.skipped = rep.skipped.len();
-    for s in &rep.skipped {
-        *rep.skipped_by_reason
-            .entry(report::reason_class(&s.reason))
-            .or_default() += 1;
-    }
-
-    if opts.plan_image {
-        if let Some(png) = output::plan::draw_plan(&data, &plan) {
-            let path = opts.out.join("plan.png");
-            output::atomic::write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
-        }
-    }
-    let report_path = opts.out.join("report.json");
-    let report_json = serde_json::to_vec_pretty(&rep).expect("report serialises");
-    output::atomic::write_atomic(&report_path, &report_json)
-        .map_err(|e| write_err(&report_path, e))?;
-
     let manifest = report::Manifest {
         tool: "edo-city".into(),
         version: env!("CARGO_PKG_VERSION").into(),
+        shard: match opts.selection {
+            Selection::Shard { index, count } => Some([index, count]),
+            _ => None,
+        },
         origin: plan.origin,
         frame: "x = east - origin[0], y = up, z = -(north - origin[1]); metres".into(),
         crs: data.crs.clone(),
         crs_wkt: data.crs_wkt.clone(),
         tile_size: params.tile_size,
         params: params.clone(),
+        input: input_summary(&opts.input, &data, &plan),
         tiles: manifest_tiles,
         textures,
     };
-    let manifest_path = opts.out.join("manifest.json");
-    remove_stale_tiles(&manifest_path, &opts.out, &manifest.tiles);
-    let manifest_json = serde_json::to_vec_pretty(&manifest).expect("manifest serialises");
-    output::atomic::write_atomic(&manifest_path, &manifest_json)
-        .map_err(|e| write_err(&manifest_path, e))?;
-    bytes_written += (report_json.len() + manifest_json.len()) as u64;
+    if opts.plan_image {
+        if let Some(png) = output::plan::draw_plan(&data, &plan) {
+            let path = opts.out.join("plan.png");
+            output::atomic::write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
+        }
+    }
+    if opts.selection == Selection::All {
+        shards::remove_stale_tiles(&opts.out, &manifest.tiles);
+    }
+    let rep = shards::write_manifest_and_report(&opts.out, &manifest)?;
+    timings.generate_and_write = t.elapsed();
     timings.total = t0.elapsed();
     Ok(BuildOutcome {
         report: rep,
         timings,
         bytes_written,
+        tiles_written,
     })
 }
 
-/// Deletes the tiles a previous build into the same directory listed in its manifest that
-/// this build did not write, so the directory holds one consistent city. Files the tool did
-/// not write itself are never touched.
-fn remove_stale_tiles(manifest_path: &Path, out: &Path, tiles: &[report::ManifestTile]) {
-    let Ok(bytes) = std::fs::read(manifest_path) else {
-        return;
+/// The input-wide part of the report.
+fn input_summary(input: &Path, data: &Dataset, plan: &Plan) -> report::InputSummary {
+    let mut s = report::InputSummary {
+        input: input.display().to_string(),
+        crs: data.crs.clone(),
+        layers: data.layers.clone(),
+        lots: data.lots.len(),
+        footprints_read: data.footprints.len(),
+        frontage_fallback: plan.frontage_fallback,
+        skipped: data.skipped.clone(),
+        tables: data.joins.clone(),
+        warnings: data.warnings.clone(),
+        ..Default::default()
     };
-    let Ok(old) = serde_json::from_slice::<serde_json::Value>(&bytes) else {
-        return;
-    };
-    let current: std::collections::HashSet<&str> = tiles
-        .iter()
-        .flat_map(|t| [t.obj.path.as_str(), t.mtl.path.as_str()])
-        .collect();
-    for tile in old["tiles"].as_array().into_iter().flatten() {
-        for kind in ["obj", "mtl"] {
-            if let Some(path) = tile[kind]["path"].as_str() {
-                let safe = path.starts_with("tiles/") && !path.contains("..");
-                if safe && !current.contains(path) {
-                    let _ = std::fs::remove_file(out.join(path));
-                }
-            }
-        }
+    for lot in &data.lots {
+        *s.lots_by_use
+            .entry(lot.lot_use.name().to_string())
+            .or_default() += 1;
     }
+    s.skipped.extend(plan.skipped.iter().cloned());
+    s.warnings.extend(plan.warnings.iter().cloned());
+    s
 }

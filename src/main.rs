@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use edo_city::build::{build, BuildOptions, BuildOutcome, Progress};
+use edo_city::build::{build, shards, BuildOptions, BuildOutcome, NoProgress, Progress, Selection};
 use edo_city::params::Params;
 
 #[derive(Parser)]
@@ -51,6 +51,32 @@ enum Command {
         /// Also draw <out>/plan.png: lots, streets, and the frontage chosen for each house.
         #[arg(long)]
         plan: bool,
+        /// Rewrite only these tiles (comma-separated ids) of an earlier full build in --out;
+        /// each comes out byte-identical to the same tile of a full build.
+        #[arg(long, value_delimiter = ',', conflicts_with = "shard")]
+        tiles: Option<Vec<String>>,
+        /// Build the I-th of N balanced, disjoint sets of tiles (e.g. 2/8), for a cluster;
+        /// `edo-city merge` then writes the whole city's manifest and report.
+        #[arg(long, value_parser = parse_shard)]
+        shard: Option<(usize, usize)>,
+        /// Replace an output directory that holds a build of other parameters or input.
+        #[arg(long)]
+        force: bool,
+    },
+    /// List the tiles a build would write, with feature counts and bounds (for scripts).
+    Tiles {
+        input: PathBuf,
+        #[arg(short, long)]
+        params: Option<PathBuf>,
+        /// Machine-readable output.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Merge shard outputs (`build --shard I/N`) into the first directory: copies the other
+    /// directories' tiles, writes manifest.json and report.json for the whole city.
+    Merge {
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
     },
     /// Write a Kyoto-like shapefile directory of synthetic lots, blocks and streets.
     Synth {
@@ -100,6 +126,9 @@ fn run(cli: Cli) -> Result<()> {
             quiet,
             timings,
             plan,
+            tiles,
+            shard,
+            force,
         } => {
             let params = match &params {
                 Some(p) => Params::from_path(p)?,
@@ -112,6 +141,12 @@ fn run(cli: Cli) -> Result<()> {
                 templates,
                 threads,
                 plan_image: plan,
+                selection: match (tiles, shard) {
+                    (Some(t), _) => Selection::Tiles(t),
+                    (_, Some((index, count))) => Selection::Shard { index, count },
+                    _ => Selection::All,
+                },
+                force,
             };
             let bars = Bars::new(quiet || !std::io::stderr().is_terminal());
             let outcome = build(&opts, &bars).context("the build did not finish")?;
@@ -145,6 +180,50 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
+        Command::Tiles {
+            input,
+            params,
+            json,
+        } => {
+            let params = match &params {
+                Some(p) => Params::from_path(p)?,
+                None => Params::default(),
+            };
+            let catalog = edo_city::build::load_catalog(&params, None)?;
+            let (_, plan, _, _) =
+                edo_city::build::read_and_analyse(&input, &params, &catalog, &NoProgress)?;
+            let tiles = shards::list_tiles(&plan, params.tile_size, params.tile_origin);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&tiles)?);
+            } else {
+                println!("tile\tmachiya\tfootprints\txmin\tymin\txmax\tymax");
+                for t in tiles {
+                    println!(
+                        "{}\t{}\t{}\t{:.3}\t{:.3}\t{:.3}\t{:.3}",
+                        t.id,
+                        t.machiya,
+                        t.footprints,
+                        t.bounds[0],
+                        t.bounds[1],
+                        t.bounds[2],
+                        t.bounds[3]
+                    );
+                }
+            }
+            Ok(())
+        }
+        Command::Merge { dirs } => {
+            let report = shards::merge(&dirs)?;
+            println!(
+                "merged into {}: {} tiles, {} machiya, {} footprints, {} skipped",
+                dirs[0].display(),
+                report.counts.tiles,
+                report.counts.machiya,
+                report.counts.footprints,
+                report.counts.skipped
+            );
+            Ok(())
+        }
         Command::Init { dir, output, force } => {
             if !dir.is_dir() {
                 anyhow::bail!("{} is not a directory", dir.display());
@@ -175,6 +254,25 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// Parses `I/N` for `--shard`.
+fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let (i, n) = s
+        .split_once('/')
+        .ok_or_else(|| format!("`{s}`: give the shard as I/N, e.g. 2/8"))?;
+    let (i, n): (usize, usize) = (
+        i.trim()
+            .parse()
+            .map_err(|_| format!("`{i}` is not a number"))?,
+        n.trim()
+            .parse()
+            .map_err(|_| format!("`{n}` is not a number"))?,
+    );
+    if n == 0 || i == 0 || i > n {
+        return Err(format!("`{s}`: need 1 <= I <= N"));
+    }
+    Ok((i, n))
 }
 
 fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
@@ -219,8 +317,9 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
         c.frontage_fallback
     );
     println!(
-        "  tiles      {:>7}  ({:.1} MB written)",
+        "  tiles      {:>7}  ({} written now, {:.1} MB)",
         c.tiles,
+        o.tiles_written,
         o.bytes_written as f64 / 1e6
     );
     for t in &r.tables {

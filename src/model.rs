@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 
 use geo_types::{Coord, LineString, Polygon};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What a lot (shikichi 敷地) is used for; decides which generator it gets.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -86,7 +86,7 @@ pub struct Footprint {
 }
 
 /// What was read from one layer, for the report.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LayerInfo {
     pub role: String,
     pub file: String,
@@ -106,7 +106,7 @@ pub struct Street {
 }
 
 /// A feature left out of the build, with the reason, for `report.json`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Skipped {
     pub layer: String,
     pub file: String,
@@ -133,7 +133,7 @@ pub struct Dataset {
 }
 
 /// How an attribute table matched its layer.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TableJoin {
     pub layer: String,
     pub file: String,
@@ -220,4 +220,16 @@ pub struct Plan {
     pub footprints: usize,
     pub skipped: Vec<Skipped>,
     pub warnings: Vec<String>,
+}
+
+/// What generation found in one tile.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TileStats {
+    pub machiya: usize,
+    pub footprints: usize,
+    pub by_type: BTreeMap<String, usize>,
+    pub footprints_by_type: BTreeMap<String, usize>,
+    pub by_district: BTreeMap<String, usize>,
+    pub type_given: usize,
+    pub skipped: Vec<Skipped>,
 }

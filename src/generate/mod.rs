@@ -8,20 +8,18 @@ pub mod machiya;
 pub mod materials;
 pub mod mesh;
 
-use crate::model::{PlannedMachiya, Skipped};
+use crate::model::{PlannedMachiya, Skipped, TileStats};
 use crate::params::Params;
 use crate::templates::Catalog;
 use mesh::{Frame, Mesh};
 
-/// Meshes of one tile, in plan (input) order, and the lots that could not be built.
+/// Meshes of one tile, in plan (input) order, and what they are (with the lots that could
+/// not be built).
 #[derive(Debug, Default)]
 pub struct TileMeshes {
     pub meshes: Vec<Mesh>,
-    pub skipped: Vec<Skipped>,
-    /// Type name of each mesh and whether it is a footprint, parallel to `meshes`.
-    pub types: Vec<(String, bool)>,
-    /// District of each mesh ("" = none), parallel to `meshes`.
-    pub districts: Vec<String>,
+    /// What the tile holds, for the report.
+    pub stats: TileStats,
 }
 
 /// The files features came from, for skip reports.
@@ -48,15 +46,26 @@ pub fn generate_tile(
         match result {
             Ok(mesh) => {
                 out.meshes.push(mesh);
-                out.types.push((m.mtype.clone(), m.height.is_some()));
-                out.districts.push(m.district.clone().unwrap_or_default());
+                let st = &mut out.stats;
+                let by_type = if m.height.is_some() {
+                    st.footprints += 1;
+                    &mut st.footprints_by_type
+                } else {
+                    st.machiya += 1;
+                    st.type_given += m.type_given as usize;
+                    &mut st.by_type
+                };
+                *by_type.entry(m.mtype.clone()).or_default() += 1;
+                *st.by_district
+                    .entry(m.district.clone().unwrap_or_default())
+                    .or_default() += 1;
             }
             Err(reason) => {
                 let (layer, file) = match m.height {
                     None => ("lots", &files.lots),
                     Some(_) => ("footprints", &files.footprints),
                 };
-                out.skipped.push(Skipped {
+                out.stats.skipped.push(Skipped {
                     layer: layer.into(),
                     file: file.clone(),
                     id: m.id.clone(),

@@ -15,7 +15,7 @@ use sha2::{Digest, Sha256};
 
 use crate::generate::materials::TEXTURES;
 use crate::generate::mesh::Mesh;
-use report::{ManifestFile, ManifestTile};
+use report::ManifestFile;
 
 pub fn sha256_hex(bytes: &[u8]) -> String {
     let digest = Sha256::digest(bytes);
@@ -28,26 +28,25 @@ pub fn write_tile(
     tile: &str,
     origin: [f64; 2],
     meshes: &[Mesh],
-) -> std::io::Result<ManifestTile> {
+) -> std::io::Result<(ManifestFile, ManifestFile)> {
     let mut obj = Vec::with_capacity(meshes.len() * 4096);
     obj::write_tile(&mut obj, tile, origin, meshes);
     let mtl = mtl::mtl_text().into_bytes();
     let dir = out.join("tiles");
     atomic::write_atomic(&dir.join(format!("{tile}.obj")), &obj)?;
     atomic::write_atomic(&dir.join(format!("{tile}.mtl")), &mtl)?;
-    Ok(ManifestTile {
-        id: tile.to_string(),
-        obj: ManifestFile {
+    Ok((
+        ManifestFile {
             path: format!("tiles/{tile}.obj"),
             bytes: obj.len() as u64,
             sha256: sha256_hex(&obj),
         },
-        mtl: ManifestFile {
+        ManifestFile {
             path: format!("tiles/{tile}.mtl"),
             bytes: mtl.len() as u64,
             sha256: sha256_hex(&mtl),
         },
-    })
+    ))
 }
 
 /// Copies the texture library to `<out>/textures/`.

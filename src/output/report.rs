@@ -1,12 +1,16 @@
 //! `report.json` and `manifest.json`: what was built, what was skipped, and how to check it.
 //!
-//! Both are deterministic (no clock, no paths of the machine that built them beyond what the
-//! user typed), so two builds of the same hypothesis can be compared with `diff`.
+//! The manifest holds everything the report says: the input-wide part (what was read and
+//! analysed) and, per tile, its files and statistics. So a report can always be rebuilt from
+//! a manifest, a `--tiles` run keeps the other tiles' entries, and `merge` unions the
+//! manifests of shards into exactly the manifest and report of a full build.
+//! Both files are deterministic (no clock), so two builds can be compared with `diff`.
 
 use std::collections::BTreeMap;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+pub use crate::model::TileStats;
 use crate::model::{LayerInfo, Skipped, TableJoin};
 use crate::params::Params;
 
@@ -55,13 +59,32 @@ pub struct Report {
 pub struct TileReport {
     pub id: String,
     pub machiya: usize,
+    pub footprints: usize,
     pub obj_bytes: u64,
 }
 
-#[derive(Debug, Clone, Serialize)]
+/// The part of the report that comes from reading and analysis, the same for every tile.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct InputSummary {
+    pub input: String,
+    pub crs: String,
+    pub layers: Vec<LayerInfo>,
+    pub lots: usize,
+    pub lots_by_use: BTreeMap<String, usize>,
+    pub footprints_read: usize,
+    pub frontage_fallback: usize,
+    pub skipped: Vec<Skipped>,
+    pub tables: Vec<TableJoin>,
+    pub warnings: Vec<String>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Manifest {
     pub tool: String,
     pub version: String,
+    /// Set on a shard's manifest: [index, count], index from 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<[usize; 2]>,
     /// Output coordinates are relative to this point, in the input's projected metres.
     pub origin: [f64; 2],
     pub frame: String,
@@ -71,22 +94,75 @@ pub struct Manifest {
     pub crs_wkt: Option<String>,
     pub tile_size: f64,
     pub params: Params,
+    pub input: InputSummary,
     pub tiles: Vec<ManifestTile>,
     pub textures: Vec<ManifestFile>,
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ManifestTile {
     pub id: String,
     pub obj: ManifestFile,
     pub mtl: ManifestFile,
+    pub stats: TileStats,
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ManifestFile {
     pub path: String,
     pub bytes: u64,
     pub sha256: String,
+}
+
+/// The report a manifest describes.
+pub fn assemble_report(m: &Manifest) -> Report {
+    let i = &m.input;
+    let mut r = Report {
+        tool: m.tool.clone(),
+        version: m.version.clone(),
+        input: i.input.clone(),
+        crs: i.crs.clone(),
+        layers: i.layers.clone(),
+        tables: i.tables.clone(),
+        warnings: i.warnings.clone(),
+        skipped: i.skipped.clone(),
+        ..Report::default()
+    };
+    let c = &mut r.counts;
+    c.lots = i.lots;
+    c.lots_by_use = i.lots_by_use.clone();
+    c.footprints_read = i.footprints_read;
+    c.frontage_fallback = i.frontage_fallback;
+    let add = |to: &mut BTreeMap<String, usize>, from: &BTreeMap<String, usize>| {
+        for (k, v) in from {
+            *to.entry(k.clone()).or_default() += v;
+        }
+    };
+    for t in &m.tiles {
+        let s = &t.stats;
+        c.machiya += s.machiya;
+        c.footprints += s.footprints;
+        c.type_given += s.type_given;
+        add(&mut c.by_type, &s.by_type);
+        add(&mut c.footprints_by_type, &s.footprints_by_type);
+        add(&mut c.by_district, &s.by_district);
+        r.skipped.extend(s.skipped.iter().cloned());
+        r.tiles.push(TileReport {
+            id: t.id.clone(),
+            machiya: s.machiya,
+            footprints: s.footprints,
+            obj_bytes: t.obj.bytes,
+        });
+    }
+    c.type_drawn = c.machiya.saturating_sub(c.type_given);
+    c.tiles = m.tiles.len();
+    c.skipped = r.skipped.len();
+    for s in &r.skipped {
+        *r.skipped_by_reason
+            .entry(reason_class(&s.reason))
+            .or_default() += 1;
+    }
+    r
 }
 
 /// Groups skip reasons for the summary: the reason up to its first digit or colon.

@@ -202,3 +202,14 @@ pub fn build_cmd(input: &Path, out: &Path, extra: &[&str]) -> Command {
         .args(extra);
     cmd
 }
+
+/// Runs a build and asserts it succeeded, without reading its report (shards write theirs
+/// under another name).
+pub fn run_ok(input: &Path, out: &Path, extra: &[&str]) {
+    let output = build_cmd(input, out, extra).output().expect("runs");
+    assert!(
+        output.status.success(),
+        "build failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}

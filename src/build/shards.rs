@@ -1,0 +1,406 @@
+//! Building part of a city: single tiles, shards for a cluster, and merging shard outputs.
+//!
+//! A hypothesis's output directory belongs to one input and one parameter set: a run with
+//! others refuses unless `--force`, so that two hypotheses never mix in one directory.
+
+use std::collections::{BTreeMap, HashSet};
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::{write_err, BuildError, BuildOptions, Selection};
+use crate::model::Plan;
+use crate::output::atomic::write_atomic;
+use crate::output::report::{self, Manifest, Report};
+
+/// Manifests found in an output directory: the full build's and any shards'.
+fn manifests_in(out: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return found;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name == "manifest.json"
+            || (name.starts_with("manifest.shard-") && name.ends_with(".json"))
+        {
+            found.push(e.path());
+        }
+    }
+    found.sort();
+    found
+}
+
+fn read_manifest(path: &Path) -> Result<Manifest, BuildError> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| BuildError::Config(format!("cannot read {}: {e}", path.display())))?;
+    serde_json::from_slice(&bytes).map_err(|e| {
+        BuildError::Config(format!(
+            "{} is not a manifest of this edo-city version ({e}); use another --out or --force",
+            path.display()
+        ))
+    })
+}
+
+/// The first key where two JSON values differ, as a dotted path.
+fn first_difference(a: &serde_json::Value, b: &serde_json::Value, path: &str) -> Option<String> {
+    use serde_json::Value as V;
+    match (a, b) {
+        (V::Object(x), V::Object(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            keys.into_iter().find_map(|k| {
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                match (x.get(k), y.get(k)) {
+                    (Some(va), Some(vb)) => first_difference(va, vb, &p),
+                    _ => Some(p),
+                }
+            })
+        }
+        _ if a == b => None,
+        _ => Some(if path.is_empty() {
+            "(whole value)".into()
+        } else {
+            path.to_string()
+        }),
+    }
+}
+
+/// Refuses to write into a directory built from another input or other parameters.
+pub fn check_out_dir(opts: &BuildOptions) -> Result<(), BuildError> {
+    if opts.force {
+        return Ok(());
+    }
+    let current = serde_json::to_value(&opts.params).expect("parameters serialise");
+    for path in manifests_in(&opts.out) {
+        let Ok(bytes) = std::fs::read(&path) else {
+            continue;
+        };
+        let old: serde_json::Value = serde_json::from_slice(&bytes).unwrap_or_default();
+        let diff = first_difference(&old["params"], &current, "")
+            .map(|k| format!("the parameter `{k}` differs"))
+            .or_else(|| {
+                let old_input = old["input"]["input"].as_str().unwrap_or_default();
+                (old_input != opts.input.display().to_string())
+                    .then(|| format!("it was built from {old_input}"))
+            });
+        if let Some(why) = diff {
+            return Err(BuildError::Config(format!(
+                "{} holds another build ({} in {}): give --force to replace it, or build this \
+                 hypothesis into another --out",
+                opts.out.display(),
+                why,
+                path.file_name().unwrap_or_default().to_string_lossy()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The manifest of the earlier full build that `--tiles` updates.
+pub fn previous_manifest(out: &Path) -> Result<Manifest, BuildError> {
+    let path = out.join("manifest.json");
+    if !path.exists() {
+        return Err(BuildError::Config(format!(
+            "--tiles rewrites tiles of an earlier full build, but {} has no manifest.json: build \
+             the whole city into it first",
+            out.display()
+        )));
+    }
+    read_manifest(&path)
+}
+
+/// Features per tile, for balancing and listing.
+fn features(plan: &Plan) -> BTreeMap<&str, usize> {
+    plan.tiles
+        .iter()
+        .map(|(id, lots)| (id.as_str(), lots.len()))
+        .collect()
+}
+
+/// Shard (0-based) of every tile: the heaviest tiles first, each to the lightest shard so far
+/// (ties to the lowest shard, then tile id order), so shards are balanced by feature count
+/// and the assignment depends on nothing but the plan.
+pub fn shard_of_tiles(plan: &Plan, count: usize) -> BTreeMap<String, usize> {
+    let mut tiles: Vec<(&str, usize)> = features(plan).into_iter().collect();
+    tiles.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+    let mut load = vec![0usize; count.max(1)];
+    let mut out = BTreeMap::new();
+    for (id, n) in tiles {
+        let (shard, _) = load
+            .iter()
+            .enumerate()
+            .min_by_key(|(i, l)| (**l, *i))
+            .expect("at least one shard");
+        load[shard] += n;
+        out.insert(id.to_string(), shard);
+    }
+    out
+}
+
+/// The ids of the tiles this run writes.
+pub fn select(plan: &Plan, selection: &Selection) -> Result<HashSet<String>, BuildError> {
+    match selection {
+        Selection::All => Ok(plan.tiles.keys().cloned().collect()),
+        Selection::Tiles(ids) => {
+            let unknown: Vec<&String> = ids
+                .iter()
+                .filter(|id| !plan.tiles.contains_key(*id))
+                .collect();
+            if !unknown.is_empty() {
+                return Err(BuildError::Config(format!(
+                    "no feature falls in tile(s) {}; `edo-city tiles <input>` lists the {} tiles of this input",
+                    unknown.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", "),
+                    plan.tiles.len()
+                )));
+            }
+            Ok(ids.iter().cloned().collect())
+        }
+        Selection::Shard { index, count } => {
+            if *count == 0 || *index == 0 || index > count {
+                return Err(BuildError::Config(format!(
+                    "--shard {index}/{count}: give I/N with 1 <= I <= N"
+                )));
+            }
+            Ok(shard_of_tiles(plan, *count)
+                .into_iter()
+                .filter(|(_, s)| *s == index - 1)
+                .map(|(id, _)| id)
+                .collect())
+        }
+    }
+}
+
+fn names(shard: Option<[usize; 2]>) -> (String, String) {
+    match shard {
+        Some([i, n]) => (
+            format!("manifest.shard-{i}-of-{n}.json"),
+            format!("report.shard-{i}-of-{n}.json"),
+        ),
+        None => ("manifest.json".into(), "report.json".into()),
+    }
+}
+
+/// Writes the report, then the manifest (last: a manifest always describes complete tiles).
+pub fn write_manifest_and_report(out: &Path, manifest: &Manifest) -> Result<Report, BuildError> {
+    let (manifest_name, report_name) = names(manifest.shard);
+    let rep = report::assemble_report(manifest);
+    write_json(&out.join(report_name), &rep)?;
+    write_json(&out.join(manifest_name), manifest)?;
+    Ok(rep)
+}
+
+fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), BuildError> {
+    let bytes = serde_json::to_vec_pretty(value).expect("serialises");
+    write_atomic(path, &bytes).map_err(|e| write_err(path, e))
+}
+
+/// Deletes the tiles an earlier build into the same directory listed in its manifest that
+/// this build did not write, so the directory holds one consistent city. Files the tool did
+/// not write itself are never touched.
+pub fn remove_stale_tiles(out: &Path, tiles: &[report::ManifestTile]) {
+    let Ok(old) = read_manifest(&out.join("manifest.json")) else {
+        return;
+    };
+    let current: HashSet<&str> = tiles
+        .iter()
+        .flat_map(|t| [t.obj.path.as_str(), t.mtl.path.as_str()])
+        .collect();
+    for tile in &old.tiles {
+        for path in [&tile.obj.path, &tile.mtl.path] {
+            let safe = path.starts_with("tiles/") && !path.contains("..");
+            if safe && !current.contains(path.as_str()) {
+                let _ = std::fs::remove_file(out.join(path));
+            }
+        }
+    }
+}
+
+/// Merges the shard outputs in `dirs` into the first: tiles of the others are copied over,
+/// then `manifest.json` and `report.json` are written for the whole city, byte-identical to
+/// a full build's, and the shard manifests are removed.
+pub fn merge(dirs: &[PathBuf]) -> Result<Report, BuildError> {
+    let Some(target) = dirs.first() else {
+        return Err(BuildError::Config(
+            "merge needs at least one directory".into(),
+        ));
+    };
+    let mut shards: Vec<(PathBuf, PathBuf, Manifest)> = Vec::new();
+    for dir in dirs {
+        for path in manifests_in(dir) {
+            let m = read_manifest(&path)?;
+            if m.shard.is_some() {
+                shards.push((dir.clone(), path, m));
+            }
+        }
+    }
+    let Some((_, _, first)) = shards.first() else {
+        return Err(BuildError::Config(format!(
+            "no shard manifests (manifest.shard-I-of-N.json) in {}",
+            dirs.iter()
+                .map(|d| d.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    };
+    let count = first.shard.map(|s| s[1]).unwrap_or(0);
+    let mut seen = vec![false; count];
+    for (_, path, m) in &shards {
+        let same = m.params == first.params && m.input == first.input && m.origin == first.origin;
+        if !same || m.shard.map(|s| s[1]) != Some(count) {
+            return Err(BuildError::Config(format!(
+                "{} belongs to another build than {} (parameters, input or shard count differ)",
+                path.display(),
+                dirs[0].display()
+            )));
+        }
+        if let Some([i, _]) = m.shard {
+            seen[i - 1] = true;
+        }
+    }
+    let missing: Vec<String> = (1..=count)
+        .filter(|i| !seen[i - 1])
+        .map(|i| format!("{i}/{count}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(BuildError::Config(format!(
+            "shard(s) {} have not finished (no manifest): run them, then merge again",
+            missing.join(", ")
+        )));
+    }
+    let mut tiles: BTreeMap<String, report::ManifestTile> = BTreeMap::new();
+    for (dir, _, m) in &shards {
+        for t in &m.tiles {
+            if dir != target {
+                for f in [&t.obj.path, &t.mtl.path] {
+                    let to = target.join(f);
+                    std::fs::copy(dir.join(f), &to).map_err(|e| write_err(&to, e))?;
+                }
+            }
+            tiles.insert(t.id.clone(), t.clone());
+        }
+    }
+    let mut merged = first.clone();
+    merged.shard = None;
+    merged.tiles = tiles.into_values().collect();
+    if dirs.len() > 1 {
+        let dir = target.join("textures");
+        std::fs::create_dir_all(&dir).map_err(|e| write_err(&dir, e))?;
+        crate::output::write_textures(target).map_err(|e| write_err(target, e))?;
+    }
+    let rep = write_manifest_and_report(target, &merged)?;
+    for (_, path, m) in &shards {
+        let _ = std::fs::remove_file(path);
+        let (_, report_name) = names(m.shard);
+        let _ = std::fs::remove_file(path.with_file_name(report_name));
+    }
+    Ok(rep)
+}
+
+/// One line of `edo-city tiles`.
+#[derive(Debug, Clone, Serialize)]
+pub struct TileInfo {
+    pub id: String,
+    pub machiya: usize,
+    pub footprints: usize,
+    /// [xmin, ymin, xmax, ymax] of the tile, projected metres.
+    pub bounds: [f64; 4],
+}
+
+/// The tiles a build of this plan would write, with what falls in each.
+pub fn list_tiles(plan: &Plan, tile_size: f64, origin: [f64; 2]) -> Vec<TileInfo> {
+    plan.tiles
+        .iter()
+        .map(|(id, lots)| {
+            let bounds = match crate::analyse::tiling::parse_tile_id(id) {
+                Some((c, r)) => {
+                    let x = origin[0] + c as f64 * tile_size;
+                    let y = origin[1] + r as f64 * tile_size;
+                    [x, y, x + tile_size, y + tile_size]
+                }
+                // A tile named in the data: the extent of its features.
+                None => lots
+                    .iter()
+                    .flat_map(|m| m.outline.exterior().0.iter())
+                    .fold([f64::MAX, f64::MAX, f64::MIN, f64::MIN], |b, c| {
+                        [b[0].min(c.x), b[1].min(c.y), b[2].max(c.x), b[3].max(c.y)]
+                    }),
+            };
+            TileInfo {
+                id: id.clone(),
+                machiya: lots.iter().filter(|m| m.height.is_none()).count(),
+                footprints: lots.iter().filter(|m| m.height.is_some()).count(),
+                bounds,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Frontage, PlannedMachiya};
+    use geo_types::{Coord, LineString, Polygon};
+
+    fn plan_with(counts: &[(&str, usize)]) -> Plan {
+        let lot = PlannedMachiya {
+            id: "x".into(),
+            record: 0,
+            outline: Polygon::new(LineString::from(vec![(0., 0.), (1., 0.), (1., 1.)]), vec![]),
+            frontage: Frontage {
+                a: Coord { x: 0., y: 0. },
+                b: Coord { x: 1., y: 0. },
+                fallback: false,
+            },
+            mtype: "hiraya".into(),
+            type_given: false,
+            district: None,
+            tile: String::new(),
+            ground: 0.0,
+            height: None,
+        };
+        let mut plan = Plan::default();
+        for (id, n) in counts {
+            plan.tiles.insert(id.to_string(), vec![lot.clone(); *n]);
+        }
+        plan
+    }
+
+    #[test]
+    fn shards_are_balanced_disjoint_and_cover_every_tile() {
+        let plan = plan_with(&[
+            ("a", 50),
+            ("b", 40),
+            ("c", 30),
+            ("d", 20),
+            ("e", 10),
+            ("f", 10),
+        ]);
+        let shards = shard_of_tiles(&plan, 3);
+        assert_eq!(shards.len(), 6);
+        let mut load = [0; 3];
+        for (id, s) in &shards {
+            load[*s] += plan.tiles[id].len();
+        }
+        assert_eq!(load.iter().sum::<usize>(), 160);
+        assert!(
+            load.iter().max().unwrap() - load.iter().min().unwrap() <= 10,
+            "{load:?}"
+        );
+        assert_eq!(shards, shard_of_tiles(&plan, 3), "deterministic");
+    }
+
+    #[test]
+    fn first_difference_names_the_key() {
+        let a = serde_json::json!({"seed": 1, "machiya": {"depth": 12.0}});
+        let b = serde_json::json!({"seed": 1, "machiya": {"depth": 10.0}});
+        assert_eq!(
+            first_difference(&a, &b, "").as_deref(),
+            Some("machiya.depth")
+        );
+        assert_eq!(first_difference(&a, &a, ""), None);
+    }
+}

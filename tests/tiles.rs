@@ -1,0 +1,146 @@
+//! Building part of a city: single tiles, shards and merge, and the output-directory guard.
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+use predicates::prelude::*;
+
+fn assert_same_tree(a: &Path, b: &Path) {
+    let (fa, fb) = (all_files(a), all_files(b));
+    assert_eq!(
+        fa.keys().collect::<Vec<_>>(),
+        fb.keys().collect::<Vec<_>>(),
+        "same files"
+    );
+    for (name, bytes) in &fa {
+        assert!(bytes == &fb[name], "{name} differs");
+    }
+}
+
+#[test]
+fn regenerated_tiles_are_byte_identical_to_a_full_build() {
+    let work = tempfile::tempdir().unwrap();
+    let (full, partial) = (work.path().join("full"), work.path().join("partial"));
+    build_ok(&fixture("kyoto-small"), &full, &["--quiet"]);
+    build_ok(&fixture("kyoto-small"), &partial, &["--quiet"]);
+    let ids: Vec<String> = read_json(&full.join("manifest.json"))["tiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["id"].as_str().unwrap().to_string())
+        .collect();
+    // Lose one tile, damage another, then regenerate just those two.
+    std::fs::remove_file(partial.join(format!("tiles/{}.obj", ids[0]))).unwrap();
+    std::fs::write(partial.join(format!("tiles/{}.obj", ids[1])), "damaged").unwrap();
+    let before = std::fs::read(partial.join(format!("tiles/{}.obj", ids[2]))).unwrap();
+    let list = format!("{},{}", ids[0], ids[1]);
+    build_ok(
+        &fixture("kyoto-small"),
+        &partial,
+        &["--quiet", "--tiles", &list],
+    );
+    assert_same_tree(&full, &partial);
+    let after = std::fs::read(partial.join(format!("tiles/{}.obj", ids[2]))).unwrap();
+    assert_eq!(before, after);
+}
+
+#[test]
+fn an_unknown_tile_is_an_error_that_points_to_the_tiles_command() {
+    let work = tempfile::tempdir().unwrap();
+    build_ok(&fixture("kyoto-small"), work.path(), &["--quiet"]);
+    build_cmd(&fixture("kyoto-small"), work.path(), &["--tiles", "1_1"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("1_1").and(predicate::str::contains("edo-city tiles")));
+}
+
+#[test]
+fn the_union_of_shards_is_the_full_build() {
+    let work = tempfile::tempdir().unwrap();
+    let full = work.path().join("full");
+    build_ok(&fixture("kyoto-small"), &full, &["--quiet"]);
+    for n in 1..=3 {
+        // All shards into one shared directory, as on a cluster's shared file system.
+        let shared = work.path().join(format!("shared-{n}"));
+        for i in 1..=n {
+            let shard = format!("{i}/{n}");
+            run_ok(
+                &fixture("kyoto-small"),
+                &shared,
+                &["--quiet", "--shard", &shard],
+            );
+        }
+        edo_city().arg("merge").arg(&shared).assert().success();
+        assert_same_tree(&full, &shared);
+    }
+    // Shards in separate directories, merged into the first.
+    let (a, b) = (work.path().join("a"), work.path().join("b"));
+    run_ok(&fixture("kyoto-small"), &a, &["--quiet", "--shard", "1/2"]);
+    run_ok(&fixture("kyoto-small"), &b, &["--quiet", "--shard", "2/2"]);
+    edo_city().arg("merge").arg(&a).arg(&b).assert().success();
+    assert_same_tree(&full, &a);
+}
+
+#[test]
+fn merge_says_which_shards_are_missing() {
+    let work = tempfile::tempdir().unwrap();
+    run_ok(
+        &fixture("kyoto-small"),
+        work.path(),
+        &["--quiet", "--shard", "2/3"],
+    );
+    edo_city()
+        .arg("merge")
+        .arg(work.path())
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("1/3, 3/3"));
+}
+
+#[test]
+fn another_hypothesis_does_not_overwrite_a_build_without_force() {
+    let work = tempfile::tempdir().unwrap();
+    let out = work.path().join("out");
+    build_ok(&fixture("kyoto-small"), &out, &["--quiet"]);
+    let before = all_files(&out);
+    let params = work.path().join("h.toml");
+    std::fs::write(&params, "[machiya]\ndepth = 9.0\n").unwrap();
+    build_cmd(
+        &fixture("kyoto-small"),
+        &out,
+        &["--params", params.to_str().unwrap()],
+    )
+    .assert()
+    .code(2)
+    .stderr(predicate::str::contains("machiya.depth").and(predicate::str::contains("--force")));
+    assert_eq!(before, all_files(&out), "nothing was touched");
+    build_ok(
+        &fixture("kyoto-small"),
+        &out,
+        &["--quiet", "--force", "--params", params.to_str().unwrap()],
+    );
+    assert_eq!(
+        read_json(&out.join("manifest.json"))["params"]["machiya"]["depth"],
+        9.0
+    );
+}
+
+#[test]
+fn tiles_lists_ids_counts_and_bounds() {
+    let out = edo_city()
+        .arg("tiles")
+        .arg(fixture("kyoto-small"))
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let tiles: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let tiles = tiles.as_array().unwrap();
+    assert_eq!(tiles.len(), 4);
+    let machiya: u64 = tiles.iter().map(|t| t["machiya"].as_u64().unwrap()).sum();
+    assert_eq!(machiya, 398);
+    let b = &tiles[0]["bounds"];
+    assert_eq!(b[2].as_f64().unwrap() - b[0].as_f64().unwrap(), 250.0);
+}
