@@ -266,7 +266,10 @@ fn run(
         textures,
     };
     if opts.plan_image {
-        if let Some(png) = output::plan::draw_plan(&data, &plan) {
+        let grid = (params.tile_size, params.tile_origin);
+        let image = output::plan::View::fit(&data, None)
+            .and_then(|view| output::plan::draw_plan(&data, &plan, &view, grid));
+        if let Some(png) = image {
             let path = opts.out.join("plan.png");
             output::atomic::write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
         }
@@ -283,6 +286,33 @@ fn run(
         bytes_written,
         tiles_written,
     })
+}
+
+/// Draws the plan of an earlier build (its manifest names the input and the parameters);
+/// with `tile`, only that tile at full resolution.
+pub fn draw_plan_of(out: &Path, tile: Option<&str>) -> Result<Vec<u8>, BuildError> {
+    let manifest = shards::previous_manifest(out)?;
+    let params = &manifest.params;
+    let catalog = load_catalog(params, None)?;
+    let input = PathBuf::from(&manifest.input.input);
+    let (data, plan, _, _) = read_and_analyse(&input, params, &catalog, &NoProgress)?;
+    let bounds = match tile {
+        None => None,
+        Some(id) => {
+            let tiles = shards::list_tiles(&plan, params.tile_size, params.tile_origin);
+            let t = tiles.iter().find(|t| t.id == id).ok_or_else(|| {
+                BuildError::Config(format!(
+                    "no tile {id} in this build; `edo-city tiles {}` lists them",
+                    input.display()
+                ))
+            })?;
+            Some(t.bounds)
+        }
+    };
+    let grid = (params.tile_size, params.tile_origin);
+    output::plan::View::fit(&data, bounds)
+        .and_then(|view| output::plan::draw_plan(&data, &plan, &view, grid))
+        .ok_or_else(|| BuildError::Config("nothing to draw: no lots or footprints".into()))
 }
 
 /// The input-wide part of the report.

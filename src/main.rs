@@ -48,9 +48,9 @@ enum Command {
         /// Print the time of each stage.
         #[arg(long)]
         timings: bool,
-        /// Also draw <out>/plan.png: lots, streets, and the frontage chosen for each house.
+        /// Do not draw <out>/plan.png (lots by type, streets, each house's frontage, tiles).
         #[arg(long)]
-        plan: bool,
+        no_plan: bool,
         /// Rewrite only these tiles (comma-separated ids) of an earlier full build in --out;
         /// each comes out byte-identical to the same tile of a full build.
         #[arg(long, value_delimiter = ',', conflicts_with = "shard")]
@@ -62,6 +62,17 @@ enum Command {
         /// Replace an output directory that holds a build of other parameters or input.
         #[arg(long)]
         force: bool,
+    },
+    /// Draw the plan of a build: lots by type, streets, frontages, tiles, legend, scale.
+    Plan {
+        /// The output directory of a build (its manifest names the input and parameters).
+        out: PathBuf,
+        /// Image to write.
+        #[arg(short, long, default_value = "plan.png")]
+        output: PathBuf,
+        /// Only this tile, at full resolution.
+        #[arg(long)]
+        tile: Option<String>,
     },
     /// List the tiles a build would write, with feature counts and bounds (for scripts).
     Tiles {
@@ -77,6 +88,9 @@ enum Command {
     Merge {
         #[arg(required = true)]
         dirs: Vec<PathBuf>,
+        /// Do not draw plan.png (it re-reads the input named in the manifests).
+        #[arg(long)]
+        no_plan: bool,
     },
     /// Write a Kyoto-like shapefile directory of synthetic lots, blocks and streets.
     Synth {
@@ -125,7 +139,7 @@ fn run(cli: Cli) -> Result<()> {
             threads,
             quiet,
             timings,
-            plan,
+            no_plan,
             tiles,
             shard,
             force,
@@ -140,7 +154,8 @@ fn run(cli: Cli) -> Result<()> {
                 params,
                 templates,
                 threads,
-                plan_image: plan,
+                // A plan of the whole city; shards and single tiles leave it to the full build.
+                plan_image: !no_plan && tiles.is_none() && shard.is_none(),
                 selection: match (tiles, shard) {
                     (Some(t), _) => Selection::Tiles(t),
                     (_, Some((index, count))) => Selection::Shard { index, count },
@@ -212,8 +227,15 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Merge { dirs } => {
-            let report = shards::merge(&dirs)?;
+        Command::Plan { out, output, tile } => {
+            let png = edo_city::build::draw_plan_of(&out, tile.as_deref())?;
+            edo_city::output::atomic::write_atomic(&output, &png)
+                .with_context(|| format!("cannot write {}", output.display()))?;
+            println!("wrote {}", output.display());
+            Ok(())
+        }
+        Command::Merge { dirs, no_plan } => {
+            let report = shards::merge(&dirs, !no_plan)?;
             println!(
                 "merged into {}: {} tiles, {} machiya, {} footprints, {} skipped",
                 dirs[0].display(),

@@ -215,24 +215,23 @@ impl Params {
             path: path.display().to_string(),
             source,
         })?;
-        Params::from_toml_str(&text, &path.display().to_string())
+        let base = path.parent().unwrap_or(Path::new("."));
+        Params::from_toml_in(&text, &path.display().to_string(), base, &mut Vec::new())
     }
 
     /// Parses parameter text over the defaults: a user file may give only the keys it changes.
+    /// `extends` paths are relative to the current directory.
     pub fn from_toml_str(text: &str, path: &str) -> Result<Params, ParamsError> {
-        let parse = |t: &str| -> Result<toml::Table, ParamsError> {
-            t.parse::<toml::Table>().map_err(|e| ParamsError::Parse {
-                path: path.to_string(),
-                message: e.to_string(),
-            })
-        };
-        let mut merged = parse(DEFAULT_TOML)?;
-        let user = parse(text)?;
-        // `type_mix` is replaced whole: a user who lists types means exactly those.
-        merge(&mut merged, user);
-        // Re-serialise and parse with spans so that errors point into the user's text when the
-        // key is theirs. Type errors are found by parsing the user's text alone first.
-        check_user_keys(text, path)?;
+        Params::from_toml_in(text, path, Path::new("."), &mut Vec::new())
+    }
+
+    fn from_toml_in(
+        text: &str,
+        path: &str,
+        base_dir: &Path,
+        chain: &mut Vec<String>,
+    ) -> Result<Params, ParamsError> {
+        let merged = resolved_table(text, path, base_dir, chain)?;
         let merged_text = toml::to_string(&merged).map_err(|e| ParamsError::Parse {
             path: path.to_string(),
             message: e.to_string(),
@@ -318,6 +317,61 @@ impl Params {
     }
 }
 
+/// The defaults, then every file of an `extends` chain from the root down, each overlaid on
+/// the one it extends. Each file's own keys are checked against the schema first, so an
+/// error carries that file's name, line and column.
+fn resolved_table(
+    text: &str,
+    path: &str,
+    base_dir: &Path,
+    chain: &mut Vec<String>,
+) -> Result<toml::Table, ParamsError> {
+    let parse = |t: &str, p: &str| -> Result<toml::Table, ParamsError> {
+        t.parse::<toml::Table>().map_err(|e| ParamsError::Parse {
+            path: p.to_string(),
+            message: e.to_string(),
+        })
+    };
+    check_user_keys(text, path)?;
+    let mut user = parse(text, path)?;
+    let mut merged = match user.remove("extends") {
+        None => parse(DEFAULT_TOML, "params/default.toml")?,
+        Some(toml::Value::String(name)) => {
+            let file = base_dir.join(&name);
+            if !file.exists() && (name == "default" || name == "default.toml") {
+                // The shipped defaults, wherever the tool runs from.
+                parse(DEFAULT_TOML, "params/default.toml")?
+            } else {
+                let key = file.display().to_string();
+                if chain.contains(&key) {
+                    return Err(ParamsError::Invalid {
+                        path: path.to_string(),
+                        message: format!("`extends` loops back to {key}"),
+                    });
+                }
+                chain.push(key.clone());
+                let parent_text =
+                    std::fs::read_to_string(&file).map_err(|source| ParamsError::Io {
+                        path: format!("{key} (extended by {path})"),
+                        source,
+                    })?;
+                let dir = file.parent().unwrap_or(Path::new("."));
+                resolved_table(&parent_text, &key, dir, chain)?
+            }
+        }
+        Some(other) => {
+            return Err(ParamsError::Invalid {
+                path: path.to_string(),
+                message: format!("`extends` must be a file name, got {other}"),
+            })
+        }
+    };
+    // `type_mix`, `values` and `constants` are replaced whole: a user who lists types means
+    // exactly those.
+    merge(&mut merged, user);
+    Ok(merged)
+}
+
 /// Overlays `user` on `base`, table by table; `type_mix` is replaced whole.
 fn merge(base: &mut toml::Table, user: toml::Table) {
     for (key, value) in user {
@@ -354,6 +408,7 @@ mod partial {
     #[serde(deny_unknown_fields)]
     #[allow(dead_code)]
     pub struct Params {
+        extends: Option<String>,
         seed: Option<u64>,
         tile_size: Option<f64>,
         tile_origin: Option<[f64; 2]>,
@@ -518,6 +573,42 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("tile_size"), "{err}");
+    }
+
+    #[test]
+    fn extends_overlays_a_chain_and_catches_loops() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("base.toml"),
+            "extends = \"default.toml\"\nseed = 5\n[machiya]\ndepth = 10.0\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("h.toml"),
+            "extends = \"base.toml\"\n[machiya]\nmin_depth = 3.0\n",
+        )
+        .unwrap();
+        let p = Params::from_path(&dir.path().join("h.toml")).unwrap();
+        assert_eq!(
+            (p.seed, p.machiya.depth, p.machiya.min_depth),
+            (5, 10.0, 3.0)
+        );
+        assert_eq!(p.tile_size, 250.0);
+        std::fs::write(dir.path().join("a.toml"), "extends = \"b.toml\"\n").unwrap();
+        std::fs::write(dir.path().join("b.toml"), "extends = \"a.toml\"\n").unwrap();
+        let err = Params::from_path(&dir.path().join("a.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("loops"), "{err}");
+        std::fs::write(
+            dir.path().join("c.toml"),
+            "extends = \"b.toml\"\nseeed = 1\n",
+        )
+        .unwrap();
+        let err = Params::from_path(&dir.path().join("c.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("c.toml") && err.contains("seeed"), "{err}");
     }
 
     #[test]

@@ -220,9 +220,9 @@ pub fn remove_stale_tiles(out: &Path, tiles: &[report::ManifestTile]) {
 }
 
 /// Merges the shard outputs in `dirs` into the first: tiles of the others are copied over,
-/// then `manifest.json` and `report.json` are written for the whole city, byte-identical to
-/// a full build's, and the shard manifests are removed.
-pub fn merge(dirs: &[PathBuf]) -> Result<Report, BuildError> {
+/// then `manifest.json`, `report.json` and (with `draw_plan`) `plan.png` are written for the
+/// whole city, byte-identical to a full build's, and the shard manifests are removed.
+pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     let Some(target) = dirs.first() else {
         return Err(BuildError::Config(
             "merge needs at least one directory".into(),
@@ -292,6 +292,12 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Report, BuildError> {
         crate::output::write_textures(target).map_err(|e| write_err(target, e))?;
     }
     let rep = write_manifest_and_report(target, &merged)?;
+    // The whole city's plan, as a full build draws it (shards leave it to the merge).
+    if draw_plan {
+        let png = super::draw_plan_of(target, None)?;
+        let path = target.join("plan.png");
+        write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
+    }
     for (_, path, m) in &shards {
         let _ = std::fs::remove_file(path);
         let (_, report_name) = names(m.shard);

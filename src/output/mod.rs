@@ -8,6 +8,7 @@ pub mod mtl;
 pub mod obj;
 pub mod plan;
 pub mod report;
+pub mod text;
 
 use std::path::Path;
 

@@ -1,178 +1,212 @@
 //! `plan.png`: the city seen from above, to check the input and the analysis at a glance.
 //!
-//! Streets (grey bands, blue centrelines) and block outlines, lots filled by what was built on them (machiya by
-//! type, footprints blue-grey, skipped lots red), and the frontage the paper's Fig.4 chose
-//! for each house as a thick red edge: a wrong frontage shows up as a red line away from the
-//! street.
+//! Streets (grey bands, blue centrelines) and block outlines; lots filled by what was built
+//! on them (machiya by type, footprints blue-grey, skipped lots red, other uses green); the
+//! frontage the paper's Fig.4 chose for each house as a thick red edge (a red line away from
+//! the street is a wrong frontage); the tile grid with ids; a legend and a scale bar.
 
 use std::collections::{BTreeMap, HashSet};
 
 use geo_types::{Coord, Polygon};
-use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
+use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
+use super::text::{draw_text, text_width};
+use crate::analyse::tiling::parse_tile_id;
 use crate::model::{Dataset, Plan};
 
 /// Longest side of the image in pixels.
-const MAX_SIDE: f64 = 2400.0;
+pub const MAX_SIDE: f64 = 2400.0;
 
-/// Fill colours of the machiya types, cycling for types beyond the list.
-const TYPE_COLOURS: &[[u8; 3]] = &[
-    [214, 180, 120],
-    [190, 140, 90],
-    [160, 110, 70],
-    [230, 205, 150],
-    [150, 160, 110],
-    [200, 160, 160],
-    [170, 150, 190],
-    [120, 150, 170],
+/// Fill colours of the machiya types, in type-name order, cycling beyond the list.
+pub const TYPE_COLOURS: &[[u8; 3]] = &[
+    [214, 170, 100],
+    [176, 120, 70],
+    [120, 150, 90],
+    [230, 200, 130],
+    [150, 110, 160],
+    [200, 130, 130],
+    [100, 150, 170],
+    [190, 190, 90],
 ];
+pub const FOOTPRINT: [u8; 3] = [140, 155, 175];
+pub const SKIPPED: [u8; 3] = [220, 90, 80];
+pub const OTHER_USE: [u8; 3] = [200, 215, 190];
+pub const FRONTAGE: [u8; 3] = [200, 30, 30];
 
-/// Draws the plan; `None` when there is nothing to draw.
-pub fn draw_plan(data: &Dataset, plan: &Plan) -> Option<Vec<u8>> {
-    let outlines = data
-        .lots
-        .iter()
-        .map(|l| &l.outline)
-        .chain(data.footprints.iter().map(|f| &f.outline));
-    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
-    for c in outlines.flat_map(|p| p.exterior().0.iter()) {
-        x0 = x0.min(c.x);
-        y0 = y0.min(c.y);
-        x1 = x1.max(c.x);
-        y1 = y1.max(c.y);
-    }
-    if x0 >= x1 || y0 >= y1 {
-        return None;
-    }
-    let margin = 0.03 * (x1 - x0).max(y1 - y0);
-    let (x0, y0, x1, y1) = (x0 - margin, y0 - margin, x1 + margin, y1 + margin);
-    let scale = MAX_SIDE / (x1 - x0).max(y1 - y0);
-    let (w, h) = (
-        ((x1 - x0) * scale).ceil() as u32,
-        ((y1 - y0) * scale).ceil() as u32,
-    );
-    let mut pm = Pixmap::new(w.max(1), h.max(1))?;
-    pm.fill(Color::from_rgba8(250, 248, 242, 255));
-    // Map metres to pixels, north up.
-    let px = |c: &Coord<f64>| (((c.x - x0) * scale) as f32, ((y1 - c.y) * scale) as f32);
+/// What the image shows and how metres map to pixels.
+#[derive(Debug, Clone, Copy)]
+pub struct View {
+    /// [xmin, ymin, xmax, ymax] in projected metres.
+    pub bounds: [f64; 4],
+    /// Pixels per metre.
+    pub scale: f64,
+}
 
-    let paint = |rgb: [u8; 3], a: u8| {
-        let mut p = Paint::default();
-        p.set_color_rgba8(rgb[0], rgb[1], rgb[2], a);
-        p
-    };
-    let polygon_path = |poly: &Polygon<f64>| {
-        let mut pb = PathBuilder::new();
-        for ring in std::iter::once(poly.exterior()).chain(poly.interiors()) {
-            for (i, c) in ring.0.iter().enumerate() {
-                let (x, y) = px(c);
-                if i == 0 {
-                    pb.move_to(x, y)
-                } else {
-                    pb.line_to(x, y)
+impl View {
+    /// The whole data set with a small margin, or one tile's square.
+    pub fn fit(data: &Dataset, tile: Option<[f64; 4]>) -> Option<View> {
+        let bounds = match tile {
+            Some(b) => b,
+            None => {
+                let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+                let outlines = data
+                    .lots
+                    .iter()
+                    .map(|l| &l.outline)
+                    .chain(data.footprints.iter().map(|f| &f.outline));
+                for c in outlines.flat_map(|p| p.exterior().0.iter()) {
+                    x0 = x0.min(c.x);
+                    y0 = y0.min(c.y);
+                    x1 = x1.max(c.x);
+                    y1 = y1.max(c.y);
                 }
+                if x0 >= x1 || y0 >= y1 {
+                    return None;
+                }
+                let m = 0.03 * (x1 - x0).max(y1 - y0);
+                [x0 - m, y0 - m, x1 + m, y1 + m]
             }
-            pb.close();
+        };
+        let scale = MAX_SIDE / (bounds[2] - bounds[0]).max(bounds[3] - bounds[1]);
+        Some(View { bounds, scale })
+    }
+
+    /// Pixel of a map point (north up).
+    pub fn pixel(&self, c: &Coord<f64>) -> (f32, f32) {
+        (
+            ((c.x - self.bounds[0]) * self.scale) as f32,
+            ((self.bounds[3] - c.y) * self.scale) as f32,
+        )
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (
+            ((self.bounds[2] - self.bounds[0]) * self.scale)
+                .ceil()
+                .max(1.0) as u32,
+            ((self.bounds[3] - self.bounds[1]) * self.scale)
+                .ceil()
+                .max(1.0) as u32,
+        )
+    }
+}
+
+/// The colour each machiya type gets: by type-name order among the types in the plan.
+pub fn type_colours(plan: &Plan) -> BTreeMap<String, [u8; 3]> {
+    plan.tiles
+        .values()
+        .flatten()
+        .filter(|m| m.height.is_none())
+        .map(|m| m.mtype.clone())
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| (t, TYPE_COLOURS[i % TYPE_COLOURS.len()]))
+        .collect()
+}
+
+fn paint(rgb: [u8; 3], a: u8) -> Paint<'static> {
+    let mut p = Paint::default();
+    p.set_color_rgba8(rgb[0], rgb[1], rgb[2], a);
+    p
+}
+
+fn line_path(view: &View, pts: &[Coord<f64>]) -> Option<tiny_skia::Path> {
+    let mut pb = PathBuilder::new();
+    for (i, c) in pts.iter().enumerate() {
+        let (x, y) = view.pixel(c);
+        if i == 0 {
+            pb.move_to(x, y)
+        } else {
+            pb.line_to(x, y)
         }
-        pb.finish()
-    };
+    }
+    pb.finish()
+}
+
+fn polygon_path(view: &View, poly: &Polygon<f64>) -> Option<tiny_skia::Path> {
+    let mut pb = PathBuilder::new();
+    for ring in std::iter::once(poly.exterior()).chain(poly.interiors()) {
+        for (i, c) in ring.0.iter().enumerate() {
+            let (x, y) = view.pixel(c);
+            if i == 0 {
+                pb.move_to(x, y)
+            } else {
+                pb.line_to(x, y)
+            }
+        }
+        pb.close();
+    }
+    pb.finish()
+}
+
+/// Draws the plan; `None` when there is nothing to draw. `tile_grid` = (size, origin).
+pub fn draw_plan(
+    data: &Dataset,
+    plan: &Plan,
+    view: &View,
+    tile_grid: (f64, [f64; 2]),
+) -> Option<Vec<u8>> {
+    let (w, h) = view.size();
+    let mut pm = Pixmap::new(w, h)?;
+    pm.fill(Color::from_rgba8(250, 248, 242, 255));
+    let id = Transform::identity();
     let thin = Stroke {
         width: 1.0,
         ..Stroke::default()
     };
 
     for street in &data.streets {
-        let mut pb = PathBuilder::new();
-        for (i, c) in street.line.0.iter().enumerate() {
-            let (x, y) = px(c);
-            if i == 0 {
-                pb.move_to(x, y)
-            } else {
-                pb.line_to(x, y)
-            }
-        }
-        if let Some(path) = pb.finish() {
+        if let Some(path) = line_path(view, &street.line.0) {
             let stroke = Stroke {
-                width: ((street.width * scale) as f32).max(1.0),
+                width: ((street.width * view.scale) as f32).max(1.0),
                 ..Stroke::default()
             };
-            pm.stroke_path(
-                &path,
-                &paint([215, 212, 205], 255),
-                &stroke,
-                Transform::identity(),
-                None,
-            );
+            pm.stroke_path(&path, &paint([215, 212, 205], 255), &stroke, id, None);
         }
     }
     for block in &data.blocks {
-        if let Some(path) = polygon_path(block) {
-            pm.stroke_path(
-                &path,
-                &paint([160, 160, 160], 255),
-                &thin,
-                Transform::identity(),
-                None,
-            );
+        if let Some(path) = polygon_path(view, block) {
+            pm.stroke_path(&path, &paint([160, 160, 160], 255), &thin, id, None);
         }
     }
-
-    let types: BTreeMap<&str, usize> = plan
-        .tiles
-        .values()
-        .flatten()
-        .map(|m| m.mtype.as_str())
-        .collect::<std::collections::BTreeSet<_>>()
-        .into_iter()
-        .enumerate()
-        .map(|(i, t)| (t, i))
-        .collect();
+    let colours = type_colours(plan);
     let skipped: HashSet<&str> = plan.skipped.iter().map(|s| s.id.as_str()).collect();
     let planned: HashSet<&str> = plan
         .tiles
         .values()
         .flatten()
+        .filter(|m| m.height.is_none())
         .map(|m| m.id.as_str())
         .collect();
     for lot in &data.lots {
-        if let Some(path) = polygon_path(&lot.outline) {
+        if planned.contains(lot.id.as_str()) {
+            continue;
+        }
+        if let Some(path) = polygon_path(view, &lot.outline) {
             let fill = if skipped.contains(lot.id.as_str()) {
-                paint([220, 90, 80], 200)
-            } else if planned.contains(lot.id.as_str()) {
-                paint([235, 225, 200], 255)
+                SKIPPED
             } else {
-                // Not a town lot (buke, kuge, jisha, other): built by later stages.
-                paint([200, 215, 190], 255)
+                OTHER_USE
             };
-            pm.fill_path(&path, &fill, FillRule::EvenOdd, Transform::identity(), None);
-            pm.stroke_path(
-                &path,
-                &paint([90, 80, 70], 255),
-                &thin,
-                Transform::identity(),
-                None,
-            );
+            pm.fill_path(&path, &paint(fill, 255), FillRule::EvenOdd, id, None);
+            pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin, id, None);
+        }
+    }
+    for m in plan.tiles.values().flatten() {
+        let colour = match m.height {
+            Some(_) => FOOTPRINT,
+            None => colours.get(&m.mtype).copied().unwrap_or(TYPE_COLOURS[0]),
+        };
+        if let Some(path) = polygon_path(view, &m.outline) {
+            pm.fill_path(&path, &paint(colour, 255), FillRule::EvenOdd, id, None);
+            pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin, id, None);
         }
     }
     // Centrelines on top: in cadastral data the roads are parcels too and hide the bands.
     for street in &data.streets {
-        let mut pb = PathBuilder::new();
-        for (i, c) in street.line.0.iter().enumerate() {
-            let (x, y) = px(c);
-            if i == 0 {
-                pb.move_to(x, y)
-            } else {
-                pb.line_to(x, y)
-            }
-        }
-        if let Some(path) = pb.finish() {
-            pm.stroke_path(
-                &path,
-                &paint([60, 90, 140], 160),
-                &thin,
-                Transform::identity(),
-                None,
-            );
+        if let Some(path) = line_path(view, &street.line.0) {
+            pm.stroke_path(&path, &paint([60, 90, 140], 160), &thin, id, None);
         }
     }
     let frontage = Stroke {
@@ -180,50 +214,118 @@ pub fn draw_plan(data: &Dataset, plan: &Plan) -> Option<Vec<u8>> {
         ..Stroke::default()
     };
     for m in plan.tiles.values().flatten() {
-        let colour = match m.height {
-            Some(_) => [140, 155, 175],
-            None => TYPE_COLOURS[types[m.mtype.as_str()] % TYPE_COLOURS.len()],
-        };
-        if m.height.is_some() {
-            if let Some(path) = polygon_path(&m.outline) {
-                pm.fill_path(
-                    &path,
-                    &paint(colour, 255),
-                    FillRule::EvenOdd,
-                    Transform::identity(),
-                    None,
-                );
-                pm.stroke_path(
-                    &path,
-                    &paint([70, 80, 95], 255),
-                    &thin,
-                    Transform::identity(),
-                    None,
-                );
-            }
-        } else if let Some(path) = polygon_path(&m.outline) {
-            pm.fill_path(
-                &path,
-                &paint(colour, 150),
-                FillRule::EvenOdd,
-                Transform::identity(),
-                None,
-            );
-        }
-        let mut pb = PathBuilder::new();
-        let (ax, ay) = px(&m.frontage.a);
-        let (bx, by) = px(&m.frontage.b);
-        pb.move_to(ax, ay);
-        pb.line_to(bx, by);
-        if let Some(path) = pb.finish() {
-            pm.stroke_path(
-                &path,
-                &paint([200, 30, 30], 255),
-                &frontage,
-                Transform::identity(),
-                None,
-            );
+        if let Some(path) = line_path(view, &[m.frontage.a, m.frontage.b]) {
+            pm.stroke_path(&path, &paint(FRONTAGE, 255), &frontage, id, None);
         }
     }
+    draw_tile_grid(&mut pm, view, plan, tile_grid);
+    draw_scale_bar(&mut pm, view);
+    draw_legend(&mut pm, &colours, !data.footprints.is_empty());
     pm.encode_png().ok()
+}
+
+fn draw_tile_grid(pm: &mut Pixmap, view: &View, plan: &Plan, (size, origin): (f64, [f64; 2])) {
+    let tile_px = size * view.scale;
+    let dash = Stroke {
+        width: 1.0,
+        dash: tiny_skia::StrokeDash::new(vec![6.0, 4.0], 0.0),
+        ..Stroke::default()
+    };
+    for id in plan.tiles.keys() {
+        let Some((c, r)) = parse_tile_id(id) else {
+            continue;
+        };
+        let (x0, y0) = (origin[0] + c as f64 * size, origin[1] + r as f64 * size);
+        let corners = [
+            Coord { x: x0, y: y0 },
+            Coord {
+                x: x0 + size,
+                y: y0,
+            },
+            Coord {
+                x: x0 + size,
+                y: y0 + size,
+            },
+            Coord {
+                x: x0,
+                y: y0 + size,
+            },
+            Coord { x: x0, y: y0 },
+        ];
+        if let Some(path) = line_path(view, &corners) {
+            pm.stroke_path(
+                &path,
+                &paint([90, 90, 160], 200),
+                &dash,
+                Transform::identity(),
+                None,
+            );
+        }
+        let scale = if tile_px > 400.0 { 2 } else { 1 };
+        if tile_px > f64::from(text_width(id, scale) + 8) {
+            // The tile's top-left corner, kept inside the image when the tile is cut off.
+            let (x, y) = view.pixel(&corners[3]);
+            let (x, y) = (x.max(0.0) + 4.0, y.max(0.0) + 4.0);
+            draw_text(pm, x, y, id, scale, [70, 70, 150]);
+        }
+    }
+}
+
+fn draw_scale_bar(pm: &mut Pixmap, view: &View) {
+    let target = (pm.width() as f64 / 5.0) / view.scale;
+    let steps = [
+        1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0,
+    ];
+    // The longest round length that fits a fifth of the width.
+    let metres = steps
+        .iter()
+        .rev()
+        .copied()
+        .find(|s| *s <= target)
+        .unwrap_or(1.0);
+    let len = (metres * view.scale) as f32;
+    let (x, y) = (20.0, pm.height() as f32 - 30.0);
+    for (i, colour) in [[30, 30, 30], [250, 250, 250], [30, 30, 30], [250, 250, 250]]
+        .iter()
+        .enumerate()
+    {
+        if let Some(r) = Rect::from_xywh(x + i as f32 * len / 4.0, y, len / 4.0, 8.0) {
+            pm.fill_rect(r, &paint(*colour, 255), Transform::identity(), None);
+        }
+    }
+    if let Some(r) = Rect::from_xywh(x, y, len, 8.0) {
+        let path = PathBuilder::from_rect(r);
+        pm.stroke_path(
+            &path,
+            &paint([30, 30, 30], 255),
+            &Stroke::default(),
+            Transform::identity(),
+            None,
+        );
+    }
+    draw_text(pm, x, y - 20.0, &format!("{metres} m"), 2, [30, 30, 30]);
+}
+
+fn draw_legend(pm: &mut Pixmap, colours: &BTreeMap<String, [u8; 3]>, footprints: bool) {
+    let mut rows: Vec<(String, [u8; 3])> = colours.iter().map(|(t, c)| (t.clone(), *c)).collect();
+    if footprints {
+        rows.push(("footprint".into(), FOOTPRINT));
+    }
+    rows.push(("other use".into(), OTHER_USE));
+    rows.push(("skipped".into(), SKIPPED));
+    rows.push(("frontage".into(), FRONTAGE));
+    let width = rows.iter().map(|r| text_width(&r.0, 2)).max().unwrap_or(0) as f32 + 60.0;
+    let height = rows.len() as f32 * 24.0 + 16.0;
+    // Top right: tile ids sit at the top left of their tiles.
+    let x0 = (pm.width() as f32 - width - 10.0).max(0.0);
+    if let Some(r) = Rect::from_xywh(x0, 10.0, width, height) {
+        pm.fill_rect(r, &paint([255, 255, 255], 230), Transform::identity(), None);
+    }
+    for (i, (name, colour)) in rows.iter().enumerate() {
+        let y = 18.0 + i as f32 * 24.0;
+        if let Some(r) = Rect::from_xywh(x0 + 8.0, y, 28.0, 16.0) {
+            pm.fill_rect(r, &paint(*colour, 255), Transform::identity(), None);
+        }
+        draw_text(pm, x0 + 44.0, y, name, 2, [30, 30, 30]);
+    }
 }

@@ -1,0 +1,80 @@
+//! The plan image: every house's lot shows its type's colour where the plan says it is.
+
+mod common;
+
+use common::*;
+use geo::Centroid;
+
+#[test]
+fn lots_are_painted_in_their_types_colours() {
+    let out = tempfile::tempdir().unwrap();
+    build_ok(&fixture("kyoto-small"), out.path(), &["--quiet"]);
+    let png = image::open(out.path().join("plan.png"))
+        .expect("every build draws plan.png")
+        .to_rgba8();
+
+    // The same plan, through the library, to know where each lot is and what it became.
+    let params = edo_city::params::Params::default();
+    let catalog = edo_city::build::load_catalog(&params, None).unwrap();
+    let (data, plan, _, _) = edo_city::build::read_and_analyse(
+        &fixture("kyoto-small"),
+        &params,
+        &catalog,
+        &edo_city::build::NoProgress,
+    )
+    .unwrap();
+    let view = edo_city::output::plan::View::fit(&data, None).unwrap();
+    let colours = edo_city::output::plan::type_colours(&plan);
+    assert_eq!((png.width(), png.height()), (2400, 2400));
+
+    let (mut checked, mut types) = (0, std::collections::BTreeSet::new());
+    for m in plan.tiles.values().flatten() {
+        let c = m.outline.centroid().unwrap();
+        let (x, y) = view.pixel(&c.0);
+        // Leave out what the legend (top right) and the scale bar (bottom left) cover.
+        let under_legend = x > 2400.0 - 480.0 && y < 340.0;
+        let under_scale = x < 400.0 && y > 2400.0 - 80.0;
+        if under_legend || under_scale {
+            continue;
+        }
+        let p = png.get_pixel(x as u32, y as u32);
+        let want = colours[&m.mtype];
+        assert_eq!(
+            [p[0], p[1], p[2]],
+            want,
+            "lot {} ({}) at pixel ({x:.0}, {y:.0})",
+            m.id,
+            m.mtype
+        );
+        checked += 1;
+        types.insert(m.mtype.clone());
+    }
+    assert!(checked > 350, "{checked} lots checked");
+    assert!(types.len() >= 6, "{types:?}");
+}
+
+#[test]
+fn one_tile_at_full_resolution() {
+    let out = tempfile::tempdir().unwrap();
+    build_ok(
+        &fixture("kyoto-small"),
+        &out.path().join("out"),
+        &["--quiet"],
+    );
+    let png = out.path().join("tile.png");
+    edo_city()
+        .arg("plan")
+        .arg(out.path().join("out"))
+        .arg("-o")
+        .arg(&png)
+        .arg("--tile")
+        .arg("1108_760")
+        .assert()
+        .success();
+    let img = image::open(&png).unwrap();
+    assert_eq!(
+        (img.width(), img.height()),
+        (2400, 2400),
+        "one 250 m tile on 2400 px"
+    );
+}
