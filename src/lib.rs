@@ -7,6 +7,7 @@
 
 pub mod analyse;
 pub mod build;
+pub mod compare;
 pub mod generate;
 pub mod init;
 pub mod input;

@@ -63,6 +63,17 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Compare two builds (two hypotheses): parameters, counts per type and district, tiles.
+    Compare {
+        a: PathBuf,
+        b: PathBuf,
+        /// Machine-readable output.
+        #[arg(long)]
+        json: bool,
+        /// Also draw a map of the tiles that changed.
+        #[arg(long)]
+        plan: Option<PathBuf>,
+    },
     /// Draw the plan of a build: lots by type, streets, frontages, tiles, legend, scale.
     Plan {
         /// The output directory of a build (its manifest names the input and parameters).
@@ -223,6 +234,23 @@ fn run(cli: Cli) -> Result<()> {
                         t.bounds[2],
                         t.bounds[3]
                     );
+                }
+            }
+            Ok(())
+        }
+        Command::Compare { a, b, json, plan } => {
+            let c = edo_city::compare::compare(&a, &b)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&c)?);
+            } else {
+                print!("{}", edo_city::compare::render(&c));
+            }
+            if let Some(path) = plan {
+                let png = edo_city::compare::difference_map(&c, &a)?;
+                edo_city::output::atomic::write_atomic(&path, &png)
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+                if !json {
+                    println!("wrote {}", path.display());
                 }
             }
             Ok(())

@@ -1,0 +1,273 @@
+//! `edo-city compare outA outB`: what changed between two builds (two hypotheses).
+//!
+//! Reads only the two manifests: the parameters that differ, the counts side by side (per
+//! type and per district), and which tiles' bytes differ. `--plan` draws the tiles that
+//! changed on a map.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write;
+use std::path::Path;
+
+use serde::Serialize;
+use tiny_skia::{Color, Paint, Pixmap, Rect, Transform};
+
+use crate::analyse::tiling::parse_tile_id;
+use crate::build::{shards, BuildError};
+use crate::output::report::{assemble_report, Manifest, Report};
+use crate::output::text::{draw_text, text_width};
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ParamDiff {
+    pub key: String,
+    pub a: String,
+    pub b: String,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Row {
+    pub name: String,
+    pub a: usize,
+    pub b: usize,
+}
+
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct TileDiff {
+    pub same: usize,
+    pub differ: Vec<String>,
+    pub only_a: Vec<String>,
+    pub only_b: Vec<String>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Comparison {
+    pub a: String,
+    pub b: String,
+    pub params: Vec<ParamDiff>,
+    pub totals: Vec<Row>,
+    pub by_type: Vec<Row>,
+    pub by_district: Vec<Row>,
+    pub tiles: TileDiff,
+}
+
+/// Leaf values of a JSON value by dotted key.
+fn flatten(v: &serde_json::Value, prefix: &str, out: &mut BTreeMap<String, String>) {
+    match v {
+        serde_json::Value::Object(m) => {
+            for (k, x) in m {
+                let key = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                flatten(x, &key, out);
+            }
+        }
+        other => {
+            out.insert(prefix.to_string(), other.to_string());
+        }
+    }
+}
+
+fn rows(a: &BTreeMap<String, usize>, b: &BTreeMap<String, usize>) -> Vec<Row> {
+    let keys: BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+    keys.into_iter()
+        .map(|k| Row {
+            name: if k.is_empty() {
+                "(none)".into()
+            } else {
+                k.clone()
+            },
+            a: a.get(k).copied().unwrap_or(0),
+            b: b.get(k).copied().unwrap_or(0),
+        })
+        .collect()
+}
+
+fn load(dir: &Path) -> Result<(Manifest, Report), BuildError> {
+    let m = shards::previous_manifest(dir)?;
+    let r = assemble_report(&m);
+    Ok((m, r))
+}
+
+/// Compares the builds in two output directories.
+pub fn compare(dir_a: &Path, dir_b: &Path) -> Result<Comparison, BuildError> {
+    let (ma, ra) = load(dir_a)?;
+    let (mb, rb) = load(dir_b)?;
+    let (mut pa, mut pb) = (BTreeMap::new(), BTreeMap::new());
+    flatten(
+        &serde_json::to_value(&ma.params).expect("serialises"),
+        "",
+        &mut pa,
+    );
+    flatten(
+        &serde_json::to_value(&mb.params).expect("serialises"),
+        "",
+        &mut pb,
+    );
+    let keys: BTreeSet<&String> = pa.keys().chain(pb.keys()).collect();
+    let params = keys
+        .into_iter()
+        .filter(|k| pa.get(*k) != pb.get(*k))
+        .map(|k| ParamDiff {
+            key: k.clone(),
+            a: pa.get(k).cloned().unwrap_or_else(|| "-".into()),
+            b: pb.get(k).cloned().unwrap_or_else(|| "-".into()),
+        })
+        .collect();
+    let (ca, cb) = (&ra.counts, &rb.counts);
+    let totals = [
+        ("lots", ca.lots, cb.lots),
+        ("machiya", ca.machiya, cb.machiya),
+        ("type from data", ca.type_given, cb.type_given),
+        ("type drawn", ca.type_drawn, cb.type_drawn),
+        ("footprints", ca.footprints, cb.footprints),
+        (
+            "frontage fallback",
+            ca.frontage_fallback,
+            cb.frontage_fallback,
+        ),
+        ("skipped", ca.skipped, cb.skipped),
+        ("tiles", ca.tiles, cb.tiles),
+    ]
+    .into_iter()
+    .map(|(n, a, b)| Row {
+        name: n.into(),
+        a,
+        b,
+    })
+    .collect();
+    let hashes = |m: &Manifest| -> BTreeMap<String, String> {
+        m.tiles
+            .iter()
+            .map(|t| (t.id.clone(), t.obj.sha256.clone()))
+            .collect()
+    };
+    let (ha, hb) = (hashes(&ma), hashes(&mb));
+    let mut tiles = TileDiff::default();
+    for (id, h) in &ha {
+        match hb.get(id) {
+            Some(x) if x == h => tiles.same += 1,
+            Some(_) => tiles.differ.push(id.clone()),
+            None => tiles.only_a.push(id.clone()),
+        }
+    }
+    tiles.only_b = hb
+        .keys()
+        .filter(|id| !ha.contains_key(*id))
+        .cloned()
+        .collect();
+    Ok(Comparison {
+        a: dir_a.display().to_string(),
+        b: dir_b.display().to_string(),
+        params,
+        totals,
+        by_type: rows(&ca.by_type, &cb.by_type),
+        by_district: rows(&ca.by_district, &cb.by_district),
+        tiles,
+    })
+}
+
+/// The comparison as a table for people.
+pub fn render(c: &Comparison) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "A = {}\nB = {}\n", c.a, c.b);
+    if c.params.is_empty() {
+        let _ = writeln!(s, "parameters: the same");
+    } else {
+        let _ = writeln!(s, "parameters that differ:");
+        for p in &c.params {
+            let _ = writeln!(s, "  {:<36} {:>14} {:>14}", p.key, p.a, p.b);
+        }
+    }
+    let table = |s: &mut String, title: &str, rows: &[Row]| {
+        let _ = writeln!(s, "\n{title:<24} {:>9} {:>9} {:>9}", "A", "B", "B-A");
+        for r in rows {
+            let d = r.b as i64 - r.a as i64;
+            let _ = writeln!(s, "  {:<22} {:>9} {:>9} {:>+9}", r.name, r.a, r.b, d);
+        }
+    };
+    table(&mut s, "counts", &c.totals);
+    table(&mut s, "machiya by type", &c.by_type);
+    table(&mut s, "houses by district", &c.by_district);
+    let t = &c.tiles;
+    let list = |v: &[String]| {
+        if v.is_empty() {
+            "-".to_string()
+        } else {
+            v.join(", ")
+        }
+    };
+    let _ = writeln!(
+        s,
+        "\ntiles: {} identical, {} differ ({}), only in A: {}, only in B: {}",
+        t.same,
+        t.differ.len(),
+        list(&t.differ),
+        list(&t.only_a),
+        list(&t.only_b)
+    );
+    s
+}
+
+/// A map of the tile grid: unchanged tiles grey, changed orange, only in A blue, only in B
+/// green, with their ids. Tiles named in the data (not `col_row`) are left out.
+pub fn difference_map(c: &Comparison, dir_a: &Path) -> Result<Vec<u8>, BuildError> {
+    let m = shards::previous_manifest(dir_a)?;
+    let (size, origin) = (m.params.tile_size, m.params.tile_origin);
+    let mut cells: Vec<(i64, i64, &String, [u8; 3])> = Vec::new();
+    let same: Vec<String> = m
+        .tiles
+        .iter()
+        .map(|t| t.id.clone())
+        .filter(|id| !c.tiles.differ.contains(id) && !c.tiles.only_a.contains(id))
+        .collect();
+    for (ids, colour) in [
+        (&same, [215, 215, 210]),
+        (&c.tiles.differ, [240, 150, 60]),
+        (&c.tiles.only_a, [90, 130, 210]),
+        (&c.tiles.only_b, [100, 180, 100]),
+    ] {
+        for id in ids {
+            if let Some((col, row)) = parse_tile_id(id) {
+                cells.push((col, row, id, colour));
+            }
+        }
+    }
+    if cells.is_empty() {
+        return Err(BuildError::Config("no tiles on the grid to draw".into()));
+    }
+    let (c0, c1) = (
+        cells.iter().map(|x| x.0).min().unwrap_or(0),
+        cells.iter().map(|x| x.0).max().unwrap_or(0),
+    );
+    let (r0, r1) = (
+        cells.iter().map(|x| x.1).min().unwrap_or(0),
+        cells.iter().map(|x| x.1).max().unwrap_or(0),
+    );
+    let cell = (1200 / ((c1 - c0 + 1).max(r1 - r0 + 1)) as u32).clamp(8, 200);
+    let (w, h) = (
+        ((c1 - c0 + 1) as u32) * cell,
+        ((r1 - r0 + 1) as u32) * cell + 40,
+    );
+    let mut pm = Pixmap::new(w, h).ok_or_else(|| BuildError::Config("map too large".into()))?;
+    pm.fill(Color::from_rgba8(250, 248, 242, 255));
+    for (col, row, id, colour) in &cells {
+        let x = ((col - c0) as u32 * cell) as f32;
+        let y = ((r1 - row) as u32 * cell) as f32 + 40.0;
+        let mut p = Paint::default();
+        p.set_color_rgba8(colour[0], colour[1], colour[2], 255);
+        if let Some(r) = Rect::from_xywh(x + 1.0, y + 1.0, cell as f32 - 2.0, cell as f32 - 2.0) {
+            pm.fill_rect(r, &p, Transform::identity(), None);
+        }
+        if text_width(id, 1) + 4 < cell {
+            draw_text(&mut pm, x + 3.0, y + 3.0, id, 1, [40, 40, 40]);
+        }
+    }
+    let caption = format!(
+        "{} m tiles from x {} y {}: grey same, orange differ, blue only A, green only B",
+        size, origin[0], origin[1]
+    );
+    draw_text(&mut pm, 4.0, 4.0, &caption, 1, [30, 30, 30]);
+    pm.encode_png()
+        .map_err(|e| BuildError::Config(format!("cannot encode the map: {e}")))
+}
