@@ -93,6 +93,8 @@ pub struct Timings {
     pub read: Duration,
     pub analyse: Duration,
     pub generate_and_write: Duration,
+    /// Drawing plan.png.
+    pub plan: Duration,
     pub total: Duration,
 }
 
@@ -265,6 +267,8 @@ fn run(
         tiles: manifest_tiles,
         textures,
     };
+    timings.generate_and_write = t.elapsed();
+    let t = Instant::now();
     if opts.plan_image {
         let grid = (params.tile_size, params.tile_origin);
         let image = output::plan::View::fit(&data, None)
@@ -277,8 +281,8 @@ fn run(
     if opts.selection == Selection::All {
         shards::remove_stale_tiles(&opts.out, &manifest.tiles);
     }
+    timings.plan = t.elapsed();
     let rep = shards::write_manifest_and_report(&opts.out, &manifest)?;
-    timings.generate_and_write = t.elapsed();
     timings.total = t0.elapsed();
     Ok(BuildOutcome {
         report: rep,
