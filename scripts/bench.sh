@@ -1,26 +1,53 @@
 #!/usr/bin/env bash
-# Builds a synthetic Kyoto of 30,052 lots (the paper's machiya count) three times and prints
-# wall time, throughput, output size and peak RSS. Not part of `make test`: speed is measured
-# here, never asserted in tests.
+# make bench: the paper's scale (30,052 lots) three times, the scaling at 7,500 / 30,052 /
+# 120,000 lots, single-tile regeneration, and the raw write of the same bytes as the limit.
+# Speed is measured here, never asserted in tests. Results go into BENCHMARKS.md by hand.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-LOTS=${LOTS:-30052}
 RUNS=${RUNS:-3}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+cargo build --release --quiet --example raw_write
 cargo build --release --quiet
 bin=target/release/edo-city
-$bin synth "$work/town" --lots "$LOTS" --seed 1
-echo "machine: $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB"
-for i in $(seq 1 "$RUNS"); do
-  rm -rf "$work/out"
+echo "machine: $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB; $(rustc --version)"
+
+# build LOTS RUN: one timed build into $work/out-LOTS, one result line.
+build() {
+  local lots=$1 run=$2 out="$work/out-$1"
+  rm -rf "$out"
+  local start end wall mb rss
   start=$(date +%s.%N)
-  /usr/bin/time -f "%M" -o "$work/rss" $bin build "$work/town" --out "$work/out" --quiet --timings 2> "$work/timings"
+  /usr/bin/time -f "%M" -o "$work/rss" $bin build "$work/town-$lots" --out "$out" --quiet --timings 2> "$work/timings"
   end=$(date +%s.%N)
   wall=$(echo "$end - $start" | bc -l)
-  mb=$(du -sm --apparent-size "$work/out/tiles" | cut -f1)
+  mb=$(du -sm --apparent-size "$out/tiles" | cut -f1)
   rss=$(( $(cat "$work/rss") / 1024 ))
-  printf 'run %d: %.2f s, %.0f lots/s, %s MB tiles, %.0f MB/s, peak RSS %d MB | %s\n' \
-    "$i" "$wall" "$(echo "$LOTS / $wall" | bc -l)" "$mb" "$(echo "$mb / $wall" | bc -l)" "$rss" \
-    "$(grep timings "$work/timings")"
+  printf '%7d lots run %d: %6.2f s %8.0f lots/s %5s MB tiles %6.0f MB/s  peak RSS %5d MB | %s\n' \
+    "$lots" "$run" "$wall" "$(echo "$lots / $wall" | bc -l)" "$mb" "$(echo "$mb / $wall" | bc -l)" "$rss" \
+    "$(sed -n 's/^timings: //p' "$work/timings")"
+}
+
+for lots in 30052 7500 120000; do
+  $bin synth "$work/town-$lots" --lots "$lots" --seed 1 > /dev/null
+done
+echo "== the paper's scale"
+for i in $(seq 1 "$RUNS"); do build 30052 "$i"; done
+echo "== scaling"
+build 7500 1
+build 120000 1
+
+echo "== the limit: raw fixed-point write of the same bytes (30,052 lots)"
+bytes=$(du -sb --apparent-size "$work/out-30052/tiles" | cut -f1)
+raw=$(target/release/examples/raw_write "$bytes" "$work/raw.obj")
+rm -f "$work/raw.obj"
+echo "tiles: $bytes bytes; raw write: $raw s ($(echo "$bytes / $raw / 1000000" | bc -l | cut -c1-6) MB/s)"
+
+echo "== single-tile regeneration (30,052 lots, the largest tile)"
+tile=$(python3 -c "import json,sys; r=json.load(open('$work/out-30052/report.json')); print(max(r['tiles'], key=lambda t: t['obj_bytes'])['id'])")
+for i in $(seq 1 "$RUNS"); do
+  start=$(date +%s.%N)
+  $bin build "$work/town-30052" --out "$work/out-30052" --tiles "$tile" --quiet
+  end=$(date +%s.%N)
+  printf 'tile %s run %d: %.3f s\n' "$tile" "$i" "$(echo "$end - $start" | bc -l)"
 done

@@ -40,6 +40,9 @@ struct Opened {
     role: &'static str,
     layer: shp::Layer,
     src: Option<Crs>,
+    /// Whether `src` differs from the output CRS (decided once: comparing per polygon cost
+    /// a fifth of the read stage).
+    reproject: bool,
     file: String,
 }
 
@@ -72,6 +75,7 @@ fn open(
         file: path.display().to_string(),
         layer,
         src: None,
+        reproject: false,
     }))
 }
 
@@ -171,7 +175,7 @@ fn resolve_crs(
 /// Reprojects a layer's feature geometry as it is converted.
 fn to_target(o: &Opened, target: &Option<Crs>, coords: &mut [Coord<f64>]) -> Result<(), String> {
     match (&o.src, target) {
-        (Some(src), Some(dst)) => crs::reproject(coords, src, dst),
+        (Some(src), Some(dst)) if o.reproject => crs::reproject(coords, src, dst),
         _ => Ok(()),
     }
 }
@@ -239,6 +243,19 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         .collect();
         resolve_crs(params, &mut all, &mut data.warnings)?
     };
+    for o in [
+        &mut lots,
+        &mut footprints,
+        &mut streets,
+        &mut blocks,
+        &mut widths,
+        &mut districts,
+    ]
+    .into_iter()
+    .flatten()
+    {
+        o.reproject = matches!((&o.src, &target), (Some(s), Some(t)) if !s.same_as(t));
+    }
     data.crs = target
         .as_ref()
         .map(|c| c.definition.clone())
@@ -258,11 +275,11 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
                 .as_ref()
                 .map(|c| c.definition.clone())
                 .unwrap_or_else(|| "unknown (no .prj)".into()),
-            reprojected: matches!((&o.src, &target), (Some(s), Some(t)) if !s.same_as(t)),
+            reprojected: o.reproject,
         });
     }
 
-    if let Some(o) = &lots {
+    if let Some(o) = &mut lots {
         data.crs_wkt = o.layer.prj.clone();
         read_lots(dir, params, o, &target, &mut data)?;
     }
@@ -348,7 +365,7 @@ fn rule(
 fn read_lots(
     dir: &Path,
     params: &Params,
-    o: &Opened,
+    o: &mut Opened,
     target: &Option<Crs>,
     data: &mut Dataset,
 ) -> Result<(), InputError> {
@@ -391,7 +408,10 @@ fn read_lots(
 
     let mut seen = HashSet::new();
     let mut lots = Vec::with_capacity(o.layer.features.len());
-    for f in &o.layer.features {
+    // The features are used up here: their attributes move into the lots.
+    let features = std::mem::take(&mut o.layer.features);
+    let o = &*o;
+    for f in features {
         let skip = |id: String, reason: String| Skipped {
             layer: "lots".into(),
             file: o.file.clone(),
@@ -421,6 +441,8 @@ fn read_lots(
             continue;
         }
         let multi = polys.len() > 1;
+        let parts = polys.len();
+        let mut record_attrs = Some(f.attrs);
         for (part, mut poly) in polys.into_iter().enumerate() {
             // A multipart lot becomes one lot per part, ids suffixed, so that every id stays
             // unique and the parts can still be traced to their record.
@@ -446,7 +468,12 @@ fn read_lots(
                 ));
                 continue;
             }
-            let mut attrs = f.attrs.clone();
+            // The last part takes the record's attributes; earlier parts get a copy.
+            let mut attrs = if part + 1 == parts {
+                record_attrs.take().unwrap_or_default()
+            } else {
+                record_attrs.clone().unwrap_or_default()
+            };
             attrs.insert("\u{0}base_id".into(), base_id.clone());
             lots.push(Lot {
                 id,
