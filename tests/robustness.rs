@@ -1,0 +1,171 @@
+//! Never a panic on user data: damaged files give an error with the file's name, and random
+//! geometry goes through the whole pipeline with finite output inside its lot.
+
+mod common;
+
+use common::*;
+use rand::{RngExt, SeedableRng};
+
+/// Runs a build on a copy of the fixture whose `file` was damaged by `damage`; the tool must
+/// either build or exit with code 2 and a message, never crash (exit 101 is a Rust panic).
+fn build_damaged(file: &str, damage: impl Fn(&mut Vec<u8>)) -> (i32, String) {
+    let dir = tempfile::tempdir().unwrap();
+    copy_fixture("kyoto-small", dir.path());
+    let path = dir.path().join(file);
+    let mut bytes = std::fs::read(&path).unwrap();
+    damage(&mut bytes);
+    std::fs::write(&path, &bytes).unwrap();
+    let out = build_cmd(dir.path(), &dir.path().join("out"), &["--quiet"])
+        .output()
+        .unwrap();
+    let code = out.status.code().unwrap_or(-1);
+    (code, String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+#[test]
+fn truncated_and_scrambled_layers_never_panic() {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+    let (mut built, mut refused) = (0, 0);
+    for file in [
+        "lots.shp",
+        "lots.shx",
+        "lots.dbf",
+        "streets.shp",
+        "blocks.dbf",
+    ] {
+        let len = std::fs::metadata(fixture("kyoto-small").join(file))
+            .unwrap()
+            .len() as usize;
+        let mut cases: Vec<Box<dyn Fn(&mut Vec<u8>)>> = Vec::new();
+        for cut in [0, 10, 50, 100, 101, len / 3, len / 2, len - 1] {
+            cases.push(Box::new(move |b: &mut Vec<u8>| {
+                b.truncate(cut.min(b.len()))
+            }));
+        }
+        for _ in 0..12 {
+            let (at, n, seed) = (
+                rng.random_range(0..len),
+                rng.random_range(1..64),
+                rng.random::<u64>(),
+            );
+            cases.push(Box::new(move |b: &mut Vec<u8>| {
+                let mut r = rand_pcg::Pcg64::seed_from_u64(seed);
+                for i in at..(at + n).min(b.len()) {
+                    b[i] = r.random();
+                }
+            }));
+        }
+        for (k, damage) in cases.iter().enumerate() {
+            let (code, stderr) = build_damaged(file, damage);
+            assert!(
+                code == 0 || code == 2,
+                "{file} case {k}: exit {code}\n{stderr}"
+            );
+            if code == 2 {
+                assert!(
+                    stderr.contains("error:") && stderr.contains(file.split('.').next().unwrap()),
+                    "{file} case {k}: {stderr}"
+                );
+                refused += 1;
+            } else {
+                built += 1;
+            }
+        }
+    }
+    // Both outcomes occur: damage that leaves a readable layer builds (with skips), the rest
+    // is refused with the file named.
+    assert!(
+        built > 5 && refused > 10,
+        "built {built}, refused {refused}"
+    );
+}
+
+mod random_geometry {
+    use edo_city::model::{Dataset, Lot, LotUse, Street};
+    use edo_city::params::Params;
+    use geo::{orient::Direction, Contains, Distance, Euclidean, Orient};
+    use geo_types::{Coord, LineString, Point, Polygon};
+    use proptest::prelude::*;
+
+    /// A star-shaped polygon around (cx, cy): any radii, so concave, thin and tiny ones come up.
+    fn star(cx: f64, cy: f64, radii: &[f64], twist: f64) -> Polygon<f64> {
+        let n = radii.len();
+        let mut pts: Vec<Coord<f64>> = radii
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let a = twist + i as f64 / n as f64 * std::f64::consts::TAU;
+                Coord {
+                    x: cx + r * a.cos(),
+                    y: cy + r * a.sin(),
+                }
+            })
+            .collect();
+        pts.push(pts[0]);
+        Polygon::new(LineString(pts), vec![]).orient(Direction::Default)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        #[test]
+        fn any_lot_is_built_inside_itself_or_skipped_with_a_reason(
+            radii in prop::collection::vec(0.05f64..40.0, 3..12),
+            twist in 0.0f64..6.3,
+            far in prop::bool::ANY,
+            street_y in -80.0f64..80.0,
+            width in 0.5f64..30.0,
+        ) {
+            let (cx, cy) = if far { (-23_456.7, -110_123.4) } else { (0.0, 0.0) };
+            let outline = star(cx, cy, &radii, twist);
+            prop_assume!(geo::Area::unsigned_area(&outline) > 1e-3);
+            let data = Dataset {
+                lots: vec![Lot {
+                    id: "1".into(),
+                    record: 0,
+                    outline: outline.clone(),
+                    lot_use: LotUse::Machiya,
+                    mtype: None,
+                    district: None,
+                    tile: None,
+                    attrs: Default::default(),
+                    ground: 0.0,
+                }],
+                streets: vec![Street {
+                    id: "s".into(),
+                    line: LineString::from(vec![(cx - 100.0, cy + street_y), (cx + 100.0, cy + street_y)]),
+                    width,
+                }],
+                ..Default::default()
+            };
+            let params = Params::default();
+            let catalog = edo_city::templates::Catalog::load(None).unwrap();
+            let plan = edo_city::analyse::analyse(&data, &params, &catalog, "lots.shp", &|_| {});
+            let files = edo_city::generate::LayerFiles::default();
+            let mut houses = 0;
+            for lots in plan.tiles.values() {
+                let t = edo_city::generate::generate_tile(lots, &catalog, &params, plan.origin, &files);
+                for s in &t.stats.skipped {
+                    prop_assert!(!s.reason.is_empty());
+                }
+                for mesh in &t.meshes {
+                    houses += 1;
+                    for p in &mesh.positions {
+                        let (x, h, z) = (p[0] as f64 / 1000.0 + plan.origin[0], p[1] as f64 / 1000.0, -(p[2] as f64) / 1000.0 + plan.origin[1]);
+                        prop_assert!(x.is_finite() && h.is_finite() && z.is_finite());
+                        let q = Point::new(x, z);
+                        let d = if outline.contains(&q) { 0.0 } else { Euclidean.distance(&q, outline.exterior()) };
+                        if h <= 0.001 {
+                            prop_assert!(d <= 0.01, "ground vertex {:?} is {d} m outside", q);
+                        } else {
+                            prop_assert!(d <= 0.78, "vertex {:?} at {h} m is {d} m outside", q);
+                        }
+                    }
+                }
+            }
+            let skipped = plan.skipped.len()
+                + plan.tiles.values().flatten().count() - houses;
+            prop_assert_eq!(houses + skipped, 1, "the lot is either built or skipped");
+        }
+    }
+}
