@@ -193,6 +193,10 @@ fn run(
     };
     let tiles_dir = opts.out.join("tiles");
     std::fs::create_dir_all(&tiles_dir).map_err(|e| write_err(&tiles_dir, e))?;
+    // A run killed before its renames leaves temporaries; they are never valid output.
+    for dir in [&opts.out, &tiles_dir, &opts.out.join("textures")] {
+        output::atomic::remove_leftover_temporaries(dir);
+    }
     let textures = output::write_textures(&opts.out).map_err(|e| write_err(&opts.out, e))?;
 
     let files = generate::LayerFiles {

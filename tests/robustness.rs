@@ -169,3 +169,70 @@ mod random_geometry {
         }
     }
 }
+
+/// A build killed at random moments leaves every tile either the complete old or the complete
+/// new version, and the next run finishes the job.
+#[test]
+fn a_killed_build_loses_nothing() {
+    let work = tempfile::tempdir().unwrap();
+    let town = work.path().join("town");
+    edo_city::synth::write_town(&town, 4000, 5).unwrap();
+    let (old_params, new_params) = (work.path().join("old.toml"), work.path().join("new.toml"));
+    std::fs::write(&old_params, "seed = 1\n").unwrap();
+    std::fs::write(&new_params, "seed = 2\n").unwrap();
+    let p = |f: &std::path::Path| f.to_str().unwrap().to_string();
+    // References: the complete old and new cities.
+    let (old_ref, new_ref) = (work.path().join("old"), work.path().join("new"));
+    build_ok(&town, &old_ref, &["--quiet", "--params", &p(&old_params)]);
+    build_ok(&town, &new_ref, &["--quiet", "--params", &p(&new_params)]);
+    let (old_files, new_files) = (all_files(&old_ref), all_files(&new_ref));
+
+    let out = work.path().join("out");
+    build_ok(&town, &out, &["--quiet", "--params", &p(&old_params)]);
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
+    for round in 0..6 {
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"))
+            .args([
+                "build",
+                town.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .args([
+                "--quiet",
+                "--force",
+                "--threads",
+                "2",
+                "--params",
+                &p(&new_params),
+            ])
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(rng.random_range(5..400)));
+        let _ = child.kill(); // SIGKILL
+        let _ = child.wait();
+        for (name, bytes) in all_files(&out) {
+            if name.contains(".tmp-") {
+                continue; // a killed run's temporary: never read, swept by the next run
+            }
+            let whole =
+                old_files.get(&name) == Some(&bytes) || new_files.get(&name) == Some(&bytes);
+            assert!(
+                whole,
+                "round {round}: {name} is neither the old nor the new version"
+            );
+        }
+    }
+    build_ok(
+        &town,
+        &out,
+        &["--quiet", "--force", "--params", &p(&new_params)],
+    );
+    let done = all_files(&out);
+    assert_eq!(
+        done.keys().collect::<Vec<_>>(),
+        new_files.keys().collect::<Vec<_>>(),
+        "no leftovers"
+    );
+    assert!(done == new_files, "the next run finishes the job");
+}
