@@ -6,6 +6,9 @@ mod common;
 use common::*;
 use rand::{RngExt, SeedableRng};
 
+/// A way to damage a file's bytes.
+type Damage = Box<dyn Fn(&mut Vec<u8>)>;
+
 /// Runs a build on a copy of the fixture whose `file` was damaged by `damage`; the tool must
 /// either build or exit with code 2 and a message, never crash (exit 101 is a Rust panic).
 fn build_damaged(file: &str, damage: impl Fn(&mut Vec<u8>)) -> (i32, String) {
@@ -36,7 +39,7 @@ fn truncated_and_scrambled_layers_never_panic() {
         let len = std::fs::metadata(fixture("kyoto-small").join(file))
             .unwrap()
             .len() as usize;
-        let mut cases: Vec<Box<dyn Fn(&mut Vec<u8>)>> = Vec::new();
+        let mut cases: Vec<Damage> = Vec::new();
         for cut in [0, 10, 50, 100, 101, len / 3, len / 2, len - 1] {
             cases.push(Box::new(move |b: &mut Vec<u8>| {
                 b.truncate(cut.min(b.len()))
