@@ -308,6 +308,57 @@ fn run(
     })
 }
 
+/// What `edo-city check` found: the build's report, as it would be, with nothing written.
+pub fn check(
+    input: &Path,
+    params: &Params,
+    templates: Option<&Path>,
+) -> Result<report::Report, BuildError> {
+    let catalog = load_catalog(params, templates)?;
+    let (data, plan, _, _) = read_and_analyse(input, params, &catalog, &NoProgress)?;
+    let files = generate::LayerFiles {
+        lots: input.join(&params.layers.lots.file).display().to_string(),
+        footprints: input
+            .join(&params.layers.footprints.file)
+            .display()
+            .to_string(),
+    };
+    // Generate every tile (to find the houses that cannot be built), write nothing.
+    let tiles: Vec<report::ManifestTile> = plan
+        .tiles
+        .par_iter()
+        .map(|(id, lots)| {
+            let meshes = generate::generate_tile(lots, &catalog, params, plan.origin, &files);
+            let none = report::ManifestFile {
+                path: String::new(),
+                bytes: 0,
+                sha256: String::new(),
+            };
+            report::ManifestTile {
+                id: id.clone(),
+                obj: none.clone(),
+                mtl: none,
+                stats: meshes.stats,
+            }
+        })
+        .collect();
+    let manifest = report::Manifest {
+        tool: "edo-city".into(),
+        version: env!("CARGO_PKG_VERSION").into(),
+        shard: None,
+        origin: plan.origin,
+        frame: String::new(),
+        crs: data.crs.clone(),
+        crs_wkt: data.crs_wkt.clone(),
+        tile_size: params.tile_size,
+        params: params.clone(),
+        input: input_summary(input, &data, &plan),
+        tiles,
+        textures: Vec::new(),
+    };
+    Ok(report::assemble_report(&manifest))
+}
+
 /// Draws the plan of an earlier build (its manifest names the input and the parameters);
 /// with `tile`, only that tile at full resolution.
 pub fn draw_plan_of(out: &Path, tile: Option<&str>) -> Result<Vec<u8>, BuildError> {

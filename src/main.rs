@@ -85,6 +85,19 @@ enum Command {
         #[arg(long)]
         tile: Option<String>,
     },
+    /// Check an input directory without building: layers, counts, CRS, encodings and every
+    /// problem. Exit 0 when all would be built, 1 when something would be skipped or warned
+    /// about, 2 on an error.
+    Check {
+        input: PathBuf,
+        #[arg(short, long)]
+        params: Option<PathBuf>,
+        #[arg(long)]
+        templates: Option<PathBuf>,
+        /// Machine-readable output (the report a build would write).
+        #[arg(long)]
+        json: bool,
+    },
     /// List the tiles a build would write, with feature counts and bounds (for scripts).
     Tiles {
         input: PathBuf,
@@ -129,14 +142,100 @@ enum Command {
     },
 }
 
+/// `check` found features it would skip or warnings: not an error, exit code 1.
+#[derive(Debug)]
+struct Problems(usize);
+
+impl std::fmt::Display for Problems {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} problem(s) found", self.0)
+    }
+}
+
+impl std::error::Error for Problems {}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<Problems>().is_some() => {
+            eprintln!("{e}");
+            ExitCode::from(1)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// The table `edo-city check` prints.
+fn print_check(r: &edo_city::output::report::Report) {
+    println!("input {}", r.input);
+    println!(
+        "CRS   {}",
+        if r.crs.is_empty() {
+            "unknown (no .prj)"
+        } else {
+            &r.crs
+        }
+    );
+    println!(
+        "\n{:<14} {:>9}  {:<24} {:<8} file",
+        "layer", "features", "text", "reproj."
+    );
+    for l in &r.layers {
+        println!(
+            "{:<14} {:>9}  {:<24} {:<8} {}",
+            l.role,
+            l.features,
+            l.encoding,
+            if l.reprojected { "yes" } else { "no" },
+            l.file
+        );
+    }
+    let c = &r.counts;
+    println!(
+        "\nlots {} ({}), machiya {}, footprints {} of {}, tiles {}, frontage fallback {}",
+        c.lots,
+        c.lots_by_use
+            .iter()
+            .map(|(k, v)| format!("{k} {v}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        c.machiya,
+        c.footprints,
+        c.footprints_read,
+        c.tiles,
+        c.frontage_fallback
+    );
+    for t in &r.tables {
+        println!(
+            "table {}: {} rows, {} matched, {} without a lot ({}), {} lots without a row",
+            t.file,
+            t.rows,
+            t.matched,
+            t.rows_without_feature,
+            t.rows_without_feature_ids.join(", "),
+            t.features_without_row
+        );
+    }
+    if r.skipped.is_empty() && r.warnings.is_empty() {
+        println!("\nno problems: every feature would be built");
+        return;
+    }
+    println!("\nproblems:");
+    for w in &r.warnings {
+        println!("  warning: {w}");
+    }
+    for s in r.skipped.iter().take(50) {
+        println!("  skip {} {} ({}): {}", s.layer, s.id, s.file, s.reason);
+    }
+    if r.skipped.len() > 50 {
+        println!(
+            "  ... {} more skipped features (--json lists all)",
+            r.skipped.len() - 50
+        );
     }
 }
 
@@ -238,6 +337,28 @@ fn run(cli: Cli) -> Result<()> {
                         t.bounds[3]
                     );
                 }
+            }
+            Ok(())
+        }
+        Command::Check {
+            input,
+            params,
+            templates,
+            json,
+        } => {
+            let params = match &params {
+                Some(p) => Params::from_path(p)?,
+                None => Params::default(),
+            };
+            let r = edo_city::build::check(&input, &params, templates.as_deref())?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&r)?);
+            } else {
+                print_check(&r);
+            }
+            let problems = r.counts.skipped + r.warnings.len();
+            if problems > 0 {
+                return Err(Problems(problems).into());
             }
             Ok(())
         }

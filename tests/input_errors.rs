@@ -161,3 +161,30 @@ fn points_as_lots_are_refused_with_the_record() {
         .code(2)
         .stderr(predicate::str::contains("lots.shp").and(predicate::str::contains("point")));
 }
+
+#[test]
+fn check_reports_without_writing_and_says_by_its_exit_code() {
+    // Clean input: exit 0.
+    edo_city()
+        .arg("check")
+        .arg(fixture("kyoto-small"))
+        .assert()
+        .code(0)
+        .stdout(predicate::str::contains("no problems").and(predicate::str::contains("Shift_JIS")));
+    // A type nobody knows: a warning, exit 1, and the lot named.
+    let dir = tempfile::tempdir().unwrap();
+    copy_fixture("kyoto-small", dir.path());
+    std::fs::write(dir.path().join("lots.csv"), "id,mtype\n12,castle\n").unwrap();
+    edo_city()
+        .arg("check")
+        .arg(dir.path())
+        .assert()
+        .code(1)
+        .stdout(predicate::str::contains(
+            "lot 12: unknown machiya type `castle`",
+        ));
+    assert!(!dir.path().join("out").exists(), "check writes nothing");
+    // No lots layer: an error, exit 2.
+    let empty = tempfile::tempdir().unwrap();
+    edo_city().arg("check").arg(empty.path()).assert().code(2);
+}
