@@ -41,8 +41,27 @@ pub fn polygons_of(shape: &Shape) -> Result<(Vec<Polygon<f64>>, Option<f64>), &'
         Shape::NullShape => return Ok((Vec::new(), None)),
         other => return Err(shape_kind(other)),
     };
+    // geo's orient compares coordinates with partial_cmp().unwrap(): a NaN would panic. Rings
+    // with a non-finite coordinate go through unoriented; check_polygon skips them.
+    let finite = |p: &Polygon<f64>| {
+        p.exterior()
+            .0
+            .iter()
+            .chain(p.interiors().iter().flat_map(|r| r.0.iter()))
+            .all(|c| c.x.is_finite() && c.y.is_finite())
+    };
     let polys = mp
-        .map(|m| m.orient(Direction::Default).0)
+        .map(|m| {
+            m.0.into_iter()
+                .map(|p| {
+                    if finite(&p) {
+                        p.orient(Direction::Default)
+                    } else {
+                        p
+                    }
+                })
+                .collect()
+        })
         .unwrap_or_default();
     Ok((polys, z))
 }
