@@ -43,6 +43,9 @@ fn town(dir: &Path, lots: &[(&str, Vec<(f64, f64)>)]) {
     w.write_shape_and_record(&line, &rec).unwrap();
 }
 
+/// A lot: its id, its ring, and the reason it must be skipped for (None = built).
+type Case = (&'static str, Vec<(f64, f64)>, Option<&'static str>);
+
 fn strip(x: f64) -> Vec<(f64, f64)> {
     vec![(x, 0.0), (x + 5.0, 0.0), (x + 5.0, 25.0), (x, 25.0)]
 }
@@ -59,7 +62,7 @@ fn each_broken_lot_is_skipped_with_its_reason_and_the_rest_built() {
         let x = 15.0 - 5.0 * i as f64 / n as f64;
         many.push((x, 25.0 + 0.001 * ((i % 2) as f64)));
     }
-    let cases: Vec<(&str, Vec<(f64, f64)>, Option<&str>)> = vec![
+    let cases: Vec<Case> = vec![
         ("ok-1", strip(0.0), None),
         ("ok-2", strip(100.0), None),
         ("dup", strip(200.0), None),

@@ -440,36 +440,20 @@ fn read_lots(
             ));
             continue;
         }
-        let multi = polys.len() > 1;
-        let parts = polys.len();
+        let parts = checked_parts(
+            o,
+            target,
+            polys,
+            &base_id,
+            f.record,
+            &mut seen,
+            &mut data.skipped,
+        );
+        let count = parts.len();
         let mut record_attrs = Some(f.attrs);
-        for (part, mut poly) in polys.into_iter().enumerate() {
-            // A multipart lot becomes one lot per part, ids suffixed, so that every id stays
-            // unique and the parts can still be traced to their record.
-            let id = if multi {
-                format!("{base_id}-{}", part + 1)
-            } else {
-                base_id.clone()
-            };
-            // Reproject first: the area check is in metres.
-            if let Err(reason) = map_polygon(&mut poly, &mut |c| to_target(o, target, c))
-                .and_then(|_| check_polygon(&poly))
-            {
-                data.skipped.push(skip(id, reason));
-                continue;
-            }
-            if !seen.insert(id.clone()) {
-                data.skipped.push(skip(
-                    id,
-                    format!(
-                        "duplicate id: record {} repeats an earlier lot's id",
-                        f.record
-                    ),
-                ));
-                continue;
-            }
+        for (part, (id, poly)) in parts.into_iter().enumerate() {
             // The last part takes the record's attributes; earlier parts get a copy.
-            let mut attrs = if part + 1 == parts {
+            let mut attrs = if part + 1 == count {
                 record_attrs.take().unwrap_or_default()
             } else {
                 record_attrs.clone().unwrap_or_default()
@@ -588,24 +572,15 @@ fn read_footprints(
             .filter(|v| v.is_finite())
             .or(z)
             .unwrap_or(0.0);
-        let multi = polys.len() > 1;
-        for (part, mut poly) in polys.into_iter().enumerate() {
-            let id = if multi {
-                format!("{base_id}-{}", part + 1)
-            } else {
-                base_id.clone()
-            };
-            if let Err(reason) = map_polygon(&mut poly, &mut |c| to_target(o, target, c))
-                .and_then(|_| check_polygon(&poly))
-            {
-                data.skipped.push(skip(id, reason));
-                continue;
-            }
-            if !seen.insert(id.clone()) {
-                data.skipped
-                    .push(skip(id, format!("duplicate id: record {}", f.record)));
-                continue;
-            }
+        for (id, poly) in checked_parts(
+            o,
+            target,
+            polys,
+            &base_id,
+            f.record,
+            &mut seen,
+            &mut data.skipped,
+        ) {
             data.footprints.push(Footprint {
                 id,
                 record: f.record,
@@ -768,6 +743,48 @@ fn assign_districts(
         ));
     }
     Ok(())
+}
+
+/// The usable parts of one record's polygons, each with its id: a multipart record becomes one
+/// feature per part, ids suffixed `-<n>` so every id stays unique and traceable to its record.
+/// Each part is reprojected, then checked (the area check is in metres); a bad part or a
+/// repeated id is skipped with the reason.
+fn checked_parts(
+    o: &Opened,
+    target: &Option<Crs>,
+    polys: Vec<geo_types::Polygon<f64>>,
+    base_id: &str,
+    record: usize,
+    seen: &mut HashSet<String>,
+    skipped: &mut Vec<Skipped>,
+) -> Vec<(String, geo_types::Polygon<f64>)> {
+    let multi = polys.len() > 1;
+    let mut out = Vec::with_capacity(polys.len());
+    for (part, mut poly) in polys.into_iter().enumerate() {
+        let id = if multi {
+            format!("{base_id}-{}", part + 1)
+        } else {
+            base_id.to_string()
+        };
+        let reason = map_polygon(&mut poly, &mut |c| to_target(o, target, c))
+            .and_then(|_| check_polygon(&poly))
+            .err()
+            .or_else(|| {
+                (!seen.insert(id.clone())).then(|| {
+                    format!("duplicate id: record {record} repeats an earlier feature's id")
+                })
+            });
+        match reason {
+            Some(reason) => skipped.push(Skipped {
+                layer: o.role.into(),
+                file: o.file.clone(),
+                id,
+                reason,
+            }),
+            None => out.push((id, poly)),
+        }
+    }
+    out
 }
 
 /// Applies a table to the lots: table values win. Returns the match counts.
