@@ -199,6 +199,12 @@ fn swellendam_erven_and_buildings_from_two_utm_zones() {
     // listed with that reason.
     assert_eq!(r["counts"]["footprints"], 4708);
     assert_eq!(r["counts"]["machiya"], 549);
+    // OSM values that are not numbers are counted, not silently replaced.
+    let warnings = r["warnings"].to_string();
+    assert!(
+        warnings.contains("3 footprint(s) have a `building_l`"),
+        "{warnings}"
+    );
     assert_eq!(r["counts"]["skipped"], 8);
     for s in r["skipped"].as_array().unwrap() {
         assert_eq!(s["layer"], "lots");

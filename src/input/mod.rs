@@ -475,20 +475,26 @@ fn read_lots(
     if let Some(t) = table {
         data.joins.push(join(&mut lots, t, "lots"));
     }
+    let mut bad_ground = 0usize;
     for lot in &mut lots {
         lot.lot_use = LotUse::parse(&use_rule.value(&lot.attrs).unwrap_or_default());
         lot.mtype = mtype_rule.value(&lot.attrs);
         lot.district = district_rule.value(&lot.attrs);
         lot.tile = tile_rule.value(&lot.attrs);
-        if let Some(g) = ground_rule
-            .value(&lot.attrs)
-            .and_then(|g| g.parse::<f64>().ok())
-        {
-            if g.is_finite() {
-                lot.ground = g;
+        if let Some(raw) = ground_rule.value(&lot.attrs) {
+            match raw.parse::<f64>() {
+                Ok(g) if g.is_finite() => lot.ground = g,
+                _ => bad_ground += 1,
             }
         }
         lot.attrs.remove("\u{0}base_id");
+    }
+    if bad_ground > 0 {
+        data.warnings.push(format!(
+            "{}: {bad_ground} lot(s) have a `{}` that is not a number; they stand on the \
+             lowest Z of their outline, else 0",
+            o.file, lp.fields.ground
+        ));
     }
     data.lots = lots;
     Ok(())
@@ -536,10 +542,20 @@ fn read_footprints(
     );
     let ground = rule(o, &[], "ground", &fp.fields.ground, "", &nv, &nc, w);
     let mut seen = HashSet::new();
+    // Values that are there but are not positive numbers: counted per field and reported,
+    // since the default then stands in for the data.
+    let unusable = std::cell::RefCell::new(std::collections::BTreeMap::<String, usize>::new());
     let number = |r: &AttributeRule, a| {
-        r.value(a)
-            .and_then(|v| v.parse::<f64>().ok())
-            .filter(|v| v.is_finite() && *v > 0.0)
+        let raw = r.value(a)?;
+        let n = raw
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v > 0.0);
+        if n.is_none() {
+            let field = r.field.clone().unwrap_or_default();
+            *unusable.borrow_mut().entry(field).or_default() += 1;
+        }
+        n
     };
     for f in &o.layer.features {
         let skip = |id: String, reason: String| Skipped {
@@ -591,6 +607,13 @@ fn read_footprints(
                 ground: g,
             });
         }
+    }
+    for (field, n) in unusable.into_inner() {
+        data.warnings.push(format!(
+            "{}: {n} footprint(s) have a `{field}` that is not a positive number; their \
+             height came from the next source (height, storeys x storey_height, default_height)",
+            o.file
+        ));
     }
     Ok(())
 }
