@@ -412,34 +412,10 @@ fn read_lots(
     let features = std::mem::take(&mut o.layer.features);
     let o = &*o;
     for f in features {
-        let skip = |id: String, reason: String| Skipped {
-            layer: "lots".into(),
-            file: o.file.clone(),
-            id,
-            reason,
-        };
-        let (polys, z) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
-            file: o.file.clone(),
-            message: match kind {
-                "multipatch" => format!(
-                    "record {} is a MultiPatch (3D surfaces); edo-city builds from 2D lot \
-                     polygons: export the footprints as Polygon/PolygonZ",
-                    f.record
-                ),
-                _ => format!(
-                    "record {} is a {kind}; the lots layer must hold polygons",
-                    f.record
-                ),
-            },
-        })?;
-        let base_id = f.attrs.get(&id_field).cloned().unwrap_or_default();
-        if base_id.is_empty() {
-            data.skipped.push(skip(
-                format!("record {}", f.record),
-                format!("no value in the id field `{id_field}`"),
-            ));
+        let Some((polys, z, base_id)) = record_polygons(o, &f, &id_field, &mut data.skipped)?
+        else {
             continue;
-        }
+        };
         let parts = checked_parts(
             o,
             target,
@@ -558,27 +534,9 @@ fn read_footprints(
         n
     };
     for f in &o.layer.features {
-        let skip = |id: String, reason: String| Skipped {
-            layer: "footprints".into(),
-            file: o.file.clone(),
-            id,
-            reason,
-        };
-        let (polys, z) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
-            file: o.file.clone(),
-            message: format!(
-                "record {} is a {kind}; the footprints layer must hold polygons",
-                f.record
-            ),
-        })?;
-        let base_id = f.attrs.get(&id_field).cloned().unwrap_or_default();
-        if base_id.is_empty() {
-            data.skipped.push(skip(
-                format!("record {}", f.record),
-                format!("no value in `{id_field}`"),
-            ));
+        let Some((polys, z, base_id)) = record_polygons(o, f, &id_field, &mut data.skipped)? else {
             continue;
-        }
+        };
         let h = number(&height, &f.attrs)
             .or_else(|| number(&storeys, &f.attrs).map(|s| s * fp.storey_height + 1.0))
             .unwrap_or(fp.default_height);
@@ -766,6 +724,43 @@ fn assign_districts(
         ));
     }
     Ok(())
+}
+
+/// A record's polygons, lowest Z and id. A shape that is not a polygon stops the build (the
+/// layer is the wrong one); a record without an id is skipped (`None`).
+type RecordPolygons = (Vec<geo_types::Polygon<f64>>, Option<f64>, String);
+
+fn record_polygons(
+    o: &Opened,
+    f: &shp::Feature,
+    id_field: &str,
+    skipped: &mut Vec<Skipped>,
+) -> Result<Option<RecordPolygons>, InputError> {
+    let (polys, z) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
+        file: o.file.clone(),
+        message: match kind {
+            "multipatch" => format!(
+                "record {} is a MultiPatch (3D surfaces); edo-city builds from 2D polygons: \
+                 export the {} as Polygon/PolygonZ",
+                f.record, o.role
+            ),
+            _ => format!(
+                "record {} is a {kind}; the {} layer must hold polygons",
+                f.record, o.role
+            ),
+        },
+    })?;
+    let id = f.attrs.get(id_field).cloned().unwrap_or_default();
+    if id.is_empty() {
+        skipped.push(Skipped {
+            layer: o.role.into(),
+            file: o.file.clone(),
+            id: format!("record {}", f.record),
+            reason: format!("no value in the id field `{id_field}`"),
+        });
+        return Ok(None);
+    }
+    Ok(Some((polys, z, id)))
 }
 
 /// The usable parts of one record's polygons, each with its id: a multipart record becomes one
