@@ -157,7 +157,6 @@ pub fn read_and_analyse(
 /// Runs the pipeline.
 pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcome, BuildError> {
     let t0 = Instant::now();
-    shards::check_out_dir(opts)?;
     let catalog = load_catalog(&opts.params, opts.templates.as_deref())?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
@@ -184,6 +183,8 @@ fn run(
     let (data, plan, read, analysed) = read_and_analyse(&opts.input, params, catalog, progress)?;
     timings.read = read;
     timings.analyse = analysed;
+    // After reading (a mistyped input is reported as that), before writing anything.
+    shards::check_out_dir(opts)?;
 
     let t = Instant::now();
     let selected = shards::select(&plan, &opts.selection)?;

@@ -144,3 +144,17 @@ fn tiles_lists_ids_counts_and_bounds() {
     let b = &tiles[0]["bounds"];
     assert_eq!(b[2].as_f64().unwrap() - b[0].as_f64().unwrap(), 250.0);
 }
+
+#[test]
+fn a_mistyped_input_is_reported_as_such_even_into_an_existing_build() {
+    let work = tempfile::tempdir().unwrap();
+    let out = work.path().join("out");
+    build_ok(&fixture("kyoto-small"), &out, &["--quiet"]);
+    build_cmd(&work.path().join("kyoto-smal"), &out, &[])
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("does not exist")
+                .and(predicate::str::contains("another build").not()),
+        );
+}
