@@ -46,6 +46,22 @@ struct Opened {
     file: String,
 }
 
+impl Opened {
+    /// The layer's field that `wanted` names (see [`resolve_field`]), or an error listing the
+    /// layer's fields and the parameter `key` that sets the name.
+    fn required_field(&self, wanted: &str, what: &str, key: &str) -> Result<String, InputError> {
+        resolve_field(wanted, &self.layer.fields, self.layer.text_encoding)
+            .map(String::from)
+            .ok_or_else(|| InputError::Layer {
+                file: self.file.clone(),
+                message: format!(
+                    "no {what} field `{wanted}` (fields: {}); set `{key}`",
+                    self.layer.fields.join(", ")
+                ),
+            })
+    }
+}
+
 /// Opens a role's layer. `None` when the role is switched off (`file = ""`) or when an
 /// optional role's default file is not there.
 fn open(
@@ -371,16 +387,7 @@ fn read_lots(
 ) -> Result<(), InputError> {
     let lp = &params.layers.lots;
     let defaults = Params::default().layers.lots.fields;
-    let id_field = resolve_field(&lp.fields.id, &o.layer.fields, o.layer.text_encoding)
-        .map(String::from)
-        .ok_or_else(|| InputError::Layer {
-            file: o.file.clone(),
-            message: format!(
-                "no id field `{}` (fields: {}); set `layers.lots.fields.id`",
-                lp.fields.id,
-                o.layer.fields.join(", ")
-            ),
-        })?;
+    let id_field = o.required_field(&lp.fields.id, "id", "layers.lots.fields.id")?;
     let table = table::find_and_read(dir, &lp.table, &lp.sheet, &lp.fields.id)?;
     // Table columns count as fields of the layer: a user may keep `mtype` only in lots.csv.
     let columns: Vec<String> = table
@@ -483,16 +490,7 @@ fn read_footprints(
     data: &mut Dataset,
 ) -> Result<(), InputError> {
     let fp = &params.layers.footprints;
-    let id_field = resolve_field(&fp.fields.id, &o.layer.fields, o.layer.text_encoding)
-        .map(String::from)
-        .ok_or_else(|| InputError::Layer {
-            file: o.file.clone(),
-            message: format!(
-                "no id field `{}` (fields: {}); set `layers.footprints.fields.id`",
-                fp.fields.id,
-                o.layer.fields.join(", ")
-            ),
-        })?;
+    let id_field = o.required_field(&fp.fields.id, "id", "layers.footprints.fields.id")?;
     let (nv, nc) = (Default::default(), Default::default());
     let w = &mut data.warnings;
     let mtype = rule(
@@ -627,18 +625,11 @@ fn read_streets(
     }
     if let Some(wl) = widths {
         let wp = &params.layers.street_widths;
-        let field = resolve_field(&wp.width_field, &wl.layer.fields, wl.layer.text_encoding)
-            .ok_or_else(|| InputError::Layer {
-                file: wl.file.clone(),
-                message: format!(
-                    "no width field `{}` (fields: {}); set `layers.street_widths.width_field`",
-                    wp.width_field,
-                    wl.layer.fields.join(", ")
-                ),
-            })?;
+        let field =
+            wl.required_field(&wp.width_field, "width", "layers.street_widths.width_field")?;
         let mut lines: Vec<(LineString<f64>, f64)> = Vec::new();
         for f in &wl.layer.features {
-            let Some(w) = f.attrs.get(field).and_then(|v| v.parse::<f64>().ok()) else {
+            let Some(w) = f.attrs.get(&field).and_then(|v| v.parse::<f64>().ok()) else {
                 continue;
             };
             if !(w.is_finite() && w > 0.0) {
@@ -672,17 +663,7 @@ fn assign_districts(
 ) -> Result<(), InputError> {
     use geo::{BoundingRect, Centroid, Contains};
     let dp = &params.layers.districts;
-    let field =
-        resolve_field(&dp.id_field, &o.layer.fields, o.layer.text_encoding).ok_or_else(|| {
-            InputError::Layer {
-                file: o.file.clone(),
-                message: format!(
-                    "no district id field `{}` (fields: {}); set `layers.districts.id_field`",
-                    dp.id_field,
-                    o.layer.fields.join(", ")
-                ),
-            }
-        })?;
+    let field = o.required_field(&dp.id_field, "district id", "layers.districts.id_field")?;
     let mut polys = Vec::new();
     for f in &o.layer.features {
         let (parts, _) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
@@ -692,7 +673,7 @@ fn assign_districts(
                 f.record
             ),
         })?;
-        let id = f.attrs.get(field).cloned().unwrap_or_default();
+        let id = f.attrs.get(&field).cloned().unwrap_or_default();
         for mut p in parts {
             if map_polygon(&mut p, &mut |c| to_target(o, target, c)).is_ok() && !id.is_empty() {
                 if let Some(bb) = p.bounding_rect() {
