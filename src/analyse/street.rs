@@ -9,23 +9,24 @@ use rstar::{PointDistance, RTree, RTreeObject, AABB};
 
 use crate::model::Street;
 
-/// One straight piece of street edge.
+/// A straight segment carrying a value, in an R-tree: here a street edge with its half-width
+/// (0 for block boundaries, which are the edge itself); `input::widths` uses it for lines
+/// carrying a street width.
 #[derive(Debug, Clone, Copy)]
-struct EdgeSegment {
-    a: [f64; 2],
-    b: [f64; 2],
-    /// Half the street width; 0 for block boundaries, which are the edge itself.
-    half_width: f64,
+pub struct Segment {
+    pub a: [f64; 2],
+    pub b: [f64; 2],
+    pub value: f64,
 }
 
-impl RTreeObject for EdgeSegment {
+impl RTreeObject for Segment {
     type Envelope = AABB<[f64; 2]>;
     fn envelope(&self) -> Self::Envelope {
         AABB::from_corners(self.a, self.b)
     }
 }
 
-impl PointDistance for EdgeSegment {
+impl PointDistance for Segment {
     fn distance_2(&self, p: &[f64; 2]) -> f64 {
         segment_distance_2(*p, self.a, self.b)
     }
@@ -46,7 +47,7 @@ pub fn segment_distance_2(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 
 /// All street edges of a dataset, indexed for nearest-edge queries.
 pub struct StreetEdges {
-    tree: RTree<EdgeSegment>,
+    tree: RTree<Segment>,
     max_half_width: f64,
 }
 
@@ -56,24 +57,24 @@ impl StreetEdges {
         for block in blocks {
             for ring in std::iter::once(block.exterior()).chain(block.interiors()) {
                 for line in ring.lines() {
-                    segs.push(EdgeSegment {
+                    segs.push(Segment {
                         a: [line.start.x, line.start.y],
                         b: [line.end.x, line.end.y],
-                        half_width: 0.0,
+                        value: 0.0,
                     });
                 }
             }
         }
         for street in streets {
             for line in street.line.lines() {
-                segs.push(EdgeSegment {
+                segs.push(Segment {
                     a: [line.start.x, line.start.y],
                     b: [line.end.x, line.end.y],
-                    half_width: street.width / 2.0,
+                    value: street.width / 2.0,
                 });
             }
         }
-        let max_half_width = segs.iter().map(|s| s.half_width).fold(0.0, f64::max);
+        let max_half_width = segs.iter().map(|s| s.value).fold(0.0, f64::max);
         StreetEdges {
             tree: RTree::bulk_load(segs),
             max_half_width,
@@ -90,11 +91,11 @@ impl StreetEdges {
         let Some(nearest) = self.tree.nearest_neighbor(&q) else {
             return f64::INFINITY;
         };
-        let mut best = nearest.distance_2(&q).sqrt() - nearest.half_width;
+        let mut best = nearest.distance_2(&q).sqrt() - nearest.value;
         if self.max_half_width > 0.0 {
             let reach = best + self.max_half_width;
             for seg in self.tree.locate_within_distance(q, reach * reach) {
-                best = best.min(seg.distance_2(&q).sqrt() - seg.half_width);
+                best = best.min(seg.distance_2(&q).sqrt() - seg.value);
             }
         }
         best

@@ -2,29 +2,10 @@
 //! the road): each straight piece of centreline takes the width of the nearest width line.
 
 use geo_types::LineString;
-use rstar::{PointDistance, RTree, RTreeObject, AABB};
+use rstar::{PointDistance, RTree};
 
-use crate::analyse::street::segment_distance_2;
+use crate::analyse::street::Segment;
 use crate::model::Street;
-
-struct WidthLine {
-    a: [f64; 2],
-    b: [f64; 2],
-    width: f64,
-}
-
-impl RTreeObject for WidthLine {
-    type Envelope = AABB<[f64; 2]>;
-    fn envelope(&self) -> Self::Envelope {
-        AABB::from_corners(self.a, self.b)
-    }
-}
-
-impl PointDistance for WidthLine {
-    fn distance_2(&self, p: &[f64; 2]) -> f64 {
-        segment_distance_2(*p, self.a, self.b)
-    }
-}
 
 /// Splits streets into straight pieces and gives each the width of the nearest width line
 /// within `max_distance` of its midpoint. Returns the pieces and how many got a width.
@@ -37,10 +18,10 @@ pub fn apply_widths(
         width_lines
             .iter()
             .flat_map(|(line, w)| {
-                line.lines().map(move |l| WidthLine {
+                line.lines().map(move |l| Segment {
                     a: [l.start.x, l.start.y],
                     b: [l.end.x, l.end.y],
-                    width: *w,
+                    value: *w,
                 })
             })
             .collect(),
@@ -56,7 +37,7 @@ pub fn apply_widths(
             let width = match tree.nearest_neighbor(&mid) {
                 Some(w) if w.distance_2(&mid) <= max_distance * max_distance => {
                     matched += 1;
-                    w.width
+                    w.value
                 }
                 _ => street.width,
             };
