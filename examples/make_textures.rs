@@ -69,6 +69,140 @@ impl Canvas {
     }
 }
 
+/// A transparent canvas for billboards: everything not drawn stays alpha 0.
+fn clear(w: u32, h: u32) -> Canvas {
+    let mut c = Canvas::new(w, h);
+    for p in c.img.pixels_mut() {
+        *p = Rgba([0, 0, 0, 0]);
+    }
+    c
+}
+
+/// Paints every pixel of `c` for which `inside(x, y)` (y up from the bottom, in pixels) holds.
+fn paint(c: &mut Canvas, inside: impl Fn(f32, f32) -> bool, colour: impl Fn(u32, u32) -> Rgba<u8>) {
+    let h = c.h();
+    for y in 0..h {
+        for x in 0..c.w() {
+            if inside(x as f32 + 0.5, (h - 1 - y) as f32 + 0.5) {
+                c.img.put_pixel(x, y, colour(x, y));
+            }
+        }
+    }
+}
+
+/// One tree billboard: a trunk and a crown of overlapping blobs, `kind` choosing the shape
+/// (0 broad, 1 pine pads, 2 cone, 3 weeping) and `leaf` the colour.
+fn tree(name: &str, variant: u32, kind: u32, leaf: Px) {
+    let (w, h) = (128u32, 256u32);
+    let mut c = clear(w, h);
+    let cx = w as f32 / 2.0;
+    let trunk_w = 6.0 + (variant % 3) as f32 * 2.0;
+    let lean = (noise(variant, 1, 30)) * 6.0;
+    let trunk_top = if kind == 2 { 200.0 } else { 150.0 };
+    paint(
+        &mut c,
+        |x, y| y < trunk_top && (x - cx - lean * y / trunk_top).abs() < trunk_w * (1.0 - y / 400.0),
+        |x, y| shade([74, 52, 36], noise(x, y, 31) * 0.12),
+    );
+    // Crown: blobs placed by the variant's noise.
+    let blobs: Vec<(f32, f32, f32)> = (0..14u32)
+        .map(|i| {
+            let (nx, ny, nr) = (
+                noise(variant, i, 32),
+                noise(variant, i, 33),
+                noise(variant, i, 34),
+            );
+            match kind {
+                // Pine (matsu 松): flat pads in tiers.
+                1 => (
+                    cx + nx * 44.0,
+                    120.0 + (i % 4) as f32 * 30.0 + ny * 6.0,
+                    16.0 + nr * 4.0,
+                ),
+                // Cedar-like cone: radius shrinking upwards.
+                2 => {
+                    let t = i as f32 / 14.0;
+                    (cx + nx * 8.0, 40.0 + t * 190.0, 44.0 * (1.0 - t) + 8.0)
+                }
+                // Weeping (yanagi 柳): a high crown whose blobs hang down the sides.
+                3 => (cx + nx * 50.0, 90.0 + ny.abs() * 140.0, 14.0 + nr * 4.0),
+                _ => (cx + nx * 40.0, 170.0 + ny * 40.0, 26.0 + nr * 8.0),
+            }
+        })
+        .collect();
+    let flat = kind == 1;
+    paint(
+        &mut c,
+        |x, y| {
+            blobs.iter().any(|&(bx, by, r)| {
+                let dy = if flat { (y - by) * 2.2 } else { y - by };
+                (x - bx).powi(2) + dy.powi(2) < r * r
+            })
+        },
+        |x, y| shade(leaf, noise(x / 3, y / 3, 35 + variant) * 0.22),
+    );
+    c.save(name);
+}
+
+/// One person billboard: head, hair, kimono with an obi, legs; `hat` adds a straw kasa,
+/// `load` a bundle carried on the back.
+fn person(name: &str, variant: u32, kimono: Px, hat: bool, load: bool) {
+    let (w, h) = (64u32, 160u32);
+    let mut c = clear(w, h);
+    let cx = w as f32 / 2.0 + noise(variant, 2, 40) * 2.0;
+    let skin = [224, 188, 150];
+    // Legs and sandals.
+    paint(
+        &mut c,
+        |x, y| y < 22.0 && ((x - cx + 5.0).abs() < 3.0 || (x - cx - 5.0).abs() < 3.0),
+        |_, _| shade(skin, -0.1),
+    );
+    // Kimono: a trapezoid from the ankles to the shoulders.
+    paint(
+        &mut c,
+        |x, y| (14.0..120.0).contains(&y) && (x - cx).abs() < 14.0 - (y - 14.0) / 40.0 + 2.0,
+        |x, y| shade(kimono, noise(x / 2, y / 2, 41 + variant) * 0.1),
+    );
+    // Obi sash.
+    paint(
+        &mut c,
+        |x, y| (72.0..82.0).contains(&y) && (x - cx).abs() < 13.0,
+        |_, _| shade([60, 48, 40], 0.0),
+    );
+    // Sleeves.
+    paint(
+        &mut c,
+        |x, y| (70.0..112.0).contains(&y) && ((x - cx).abs() - 15.0).abs() < 4.0,
+        |x, y| shade(kimono, -0.15 + noise(x, y, 42) * 0.05),
+    );
+    // Head and hair.
+    paint(
+        &mut c,
+        |x, y| (x - cx).powi(2) + (y - 132.0).powi(2) < 81.0,
+        |_, _| shade(skin, 0.0),
+    );
+    paint(
+        &mut c,
+        |x, y| (x - cx).powi(2) + (y - 137.0).powi(2) < 64.0 && y > 134.0,
+        |_, _| shade([26, 22, 20], 0.0),
+    );
+    if hat {
+        paint(
+            &mut c,
+            |x, y| y > 136.0 && y < 150.0 && (x - cx).abs() < 26.0 - (y - 136.0) * 1.8,
+            |x, y| shade([186, 160, 96], noise(x, y, 43) * 0.1),
+        );
+    }
+    if load {
+        paint(
+            &mut c,
+            |x, y| (84.0..118.0).contains(&y) && x > cx + 6.0 && x < cx + 22.0,
+            |x, y| shade([150, 130, 100], noise(x, y, 44) * 0.1),
+        );
+    }
+    c.save(name);
+}
+
 /// Vertical lattice slats: `period` pixels per slat, `slat` of them wood.
 fn lattice(period: u32, slat: u32) -> impl Fn(u32, u32) -> Rgba<u8> {
     move |x, y| {
@@ -217,4 +351,86 @@ fn main() {
         )
     });
     c.save("tsuchikabe.png");
+
+    // Koshi (格子) lattice on its own, tileable: 8 slats per repeat.
+    let mut c = Canvas::new(128, 128);
+    c.band(0.0, 1.0, lattice(16, 7));
+    c.save("koshi.png");
+
+    // Gate leaves: vertical planks, two horizontal battens, iron studs.
+    let mut c = Canvas::new(128, 256);
+    c.band(0.0, 1.0, |x, y| {
+        let seam = if x % 32 < 2 || x == 63 || x == 64 {
+            -0.35
+        } else {
+            0.0
+        };
+        let batten = if (60..76).contains(&y) || (180..196).contains(&y) {
+            0.15
+        } else {
+            0.0
+        };
+        let stud = if y % 120 == 68 && x % 16 == 8 {
+            -0.6
+        } else {
+            0.0
+        };
+        shade(
+            [96, 64, 38],
+            seam + batten + stud + noise(x, y / 4, 45) * 0.06,
+        )
+    });
+    c.save("gate.png");
+
+    // Namako-kabe (海鼠壁): square tiles set diagonally with raised white plaster joints, the
+    // skirt of a kura. Tileable: the diagonal grid has period 32 in both directions.
+    let mut c = Canvas::new(128, 128);
+    c.band(0.0, 1.0, |x, y| {
+        let (a, b) = ((x + y) % 32, (x + 128 - y % 128) % 32);
+        if a < 4 || b < 4 {
+            shade(PLASTER, noise(x, y, 46) * 0.04)
+        } else {
+            shade([58, 60, 66], noise(x, y, 47) * 0.06)
+        }
+    });
+    c.save("namako.png");
+
+    // Ten tree billboards: broad trees, pines, cones and willows in several greens, a
+    // cherry in blossom and a maple in autumn.
+    let trees: [(u32, Px); 10] = [
+        (0, [62, 98, 52]),
+        (0, [80, 112, 60]),
+        (1, [46, 78, 50]),
+        (1, [54, 86, 44]),
+        (2, [40, 70, 48]),
+        (2, [50, 84, 56]),
+        (3, [110, 140, 70]),
+        (0, [232, 180, 196]),
+        (0, [180, 64, 40]),
+        (3, [92, 126, 64]),
+    ];
+    for (i, (kind, leaf)) in trees.iter().enumerate() {
+        tree(&format!("tree_{:02}.png", i + 1), i as u32, *kind, *leaf);
+    }
+
+    // Eight people in kimono of the period's common dyes (indigo, brown, grey, persimmon).
+    let people: [(Px, bool, bool); 8] = [
+        ([40, 56, 96], false, false),
+        ([40, 56, 96], true, true),
+        ([110, 80, 50], false, true),
+        ([120, 120, 116], true, false),
+        ([170, 96, 56], false, false),
+        ([60, 90, 80], false, false),
+        ([90, 50, 60], true, false),
+        ([30, 36, 50], false, true),
+    ];
+    for (i, (kimono, hat, load)) in people.iter().enumerate() {
+        person(
+            &format!("person_{:02}.png", i + 1),
+            i as u32,
+            *kimono,
+            *hat,
+            *load,
+        );
+    }
 }

@@ -23,7 +23,7 @@ use crate::input::{self, InputError};
 use crate::model::{Dataset, LotUse, Plan};
 use crate::output::{self, report};
 use crate::params::{Params, ParamsError};
-use crate::templates::{Catalog, TemplateError};
+use crate::templates::{Catalog, Kind, TemplateError};
 
 pub mod shards;
 
@@ -116,12 +116,13 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
     let dir = templates.map(Path::to_path_buf).or_else(|| {
         (!params.machiya.templates.is_empty()).then(|| PathBuf::from(&params.machiya.templates))
     });
-    let catalog = Catalog::load(dir.as_deref())?;
+    let mut catalog = Catalog::load(dir.as_deref())?;
+    catalog.configure(&params.template, &params.district_templates())?;
     for name in params.type_mix.keys() {
-        if catalog.get(name).is_none() {
+        if catalog.machiya(name).is_none() {
             return Err(BuildError::Config(format!(
-                "type_mix names `{name}`, which has no machiya type file (known types: {})",
-                catalog.types.keys().cloned().collect::<Vec<_>>().join(", ")
+                "type_mix names `{name}`, which has no machiya template (known types: {})",
+                catalog.names_of(Kind::Machiya).join(", ")
             )));
         }
     }

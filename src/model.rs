@@ -196,6 +196,8 @@ pub struct PlannedMachiya {
     pub ground: f64,
     /// Total height for a footprint house; `None` for a lot-filling machiya.
     pub height: Option<f64>,
+    /// The feature's numeric attributes that its template declares (`[attributes]`).
+    pub attrs: Vec<(String, f64)>,
 }
 
 impl PlannedMachiya {

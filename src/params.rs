@@ -49,6 +49,36 @@ pub struct Params {
     pub machiya: MachiyaParams,
     /// Relative weights of the machiya types drawn for lots of unknown type.
     pub type_mix: BTreeMap<String, f64>,
+    /// Directory of textures that replace the shipped ones by file name (a texture set, as
+    /// the paper compared texture libraries); "" = the shipped set. Relative to the
+    /// parameter file's directory when read from a file.
+    #[serde(default)]
+    pub textures: String,
+    /// Template parameter values: `[template.<name>] <param> = <number>`.
+    #[serde(default)]
+    pub template: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Settings per district id: `[district.<id>.template.<name>]`.
+    #[serde(default)]
+    pub district: BTreeMap<String, DistrictParams>,
+}
+
+/// What a district may change.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistrictParams {
+    /// Template parameter values in this district, on top of `[template.<name>]`.
+    #[serde(default)]
+    pub template: BTreeMap<String, BTreeMap<String, f64>>,
+}
+
+impl Params {
+    /// `[district.<id>.template...]` of every district, as the catalog takes them.
+    pub fn district_templates(&self) -> BTreeMap<String, BTreeMap<String, BTreeMap<String, f64>>> {
+        self.district
+            .iter()
+            .map(|(k, d)| (k.clone(), d.template.clone()))
+            .collect()
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -418,6 +448,15 @@ mod partial {
         frontage: Option<Frontage>,
         machiya: Option<Machiya>,
         type_mix: Option<BTreeMap<String, f64>>,
+        textures: Option<String>,
+        template: Option<BTreeMap<String, BTreeMap<String, f64>>>,
+        district: Option<BTreeMap<String, District>>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct District {
+        template: Option<BTreeMap<String, BTreeMap<String, f64>>>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]

@@ -144,6 +144,7 @@ fn plan_lot(
         }
         None => computed(),
     };
+    let attrs = template_attributes(lot, &mtype, catalog, lots_file, &mut warnings);
     Outcome::Planned(
         Box::new(PlannedMachiya {
             id: lot.id.clone(),
@@ -156,9 +157,45 @@ fn plan_lot(
             tile,
             ground: lot.ground,
             height: None,
+            attrs,
         }),
         warnings,
     )
+}
+
+/// The lot's values of the attributes its template declares (`[attributes]` of the template),
+/// matched by field name without regard to case. A value that is not a number is left to
+/// the template's default, with a warning.
+fn template_attributes(
+    lot: &Lot,
+    mtype: &str,
+    catalog: &Catalog,
+    lots_file: &str,
+    warnings: &mut Vec<String>,
+) -> Vec<(String, f64)> {
+    let Some(t) = catalog.machiya(mtype) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for name in t.attribute_names() {
+        let Some((field, raw)) = lot.attrs.iter().find(|(k, _)| k.eq_ignore_ascii_case(name))
+        else {
+            continue;
+        };
+        let raw = raw.trim();
+        if raw.is_empty() {
+            continue;
+        }
+        match raw.parse::<f64>() {
+            Ok(x) if x.is_finite() => out.push((name.to_string(), x)),
+            _ => warnings.push(format!(
+                "{lots_file}: lot {}: attribute `{field}` = `{raw}` is not a number; template \
+                 {mtype} used its default",
+                lot.id
+            )),
+        }
+    }
+    out
 }
 
 /// A footprint: frontage towards the nearest street edge like a lot; its type from its
@@ -205,6 +242,7 @@ fn plan_footprint(
             tile: tiling::tile_id(centroid.0, params.tile_size, params.tile_origin),
             ground: f.ground,
             height: Some(f.height),
+            attrs: Vec::new(),
         }),
         warnings,
     )

@@ -367,6 +367,7 @@ mod tests {
             tile: String::new(),
             ground: 0.0,
             height: None,
+            attrs: Vec::new(),
         };
         let mut plan = Plan::default();
         for (id, n) in counts {

@@ -55,6 +55,62 @@ pub fn clip_band(poly: &LocalPoly, lo: f64, hi: f64) -> Vec<LocalPoly> {
     }
 }
 
+/// The parts of `poly` with `lo <= u <= hi`: the band clip in a frame turned a quarter,
+/// so that both clips share one implementation.
+pub fn clip_band_u(poly: &LocalPoly, lo: f64, hi: f64) -> Vec<LocalPoly> {
+    if !lo.is_finite() && !hi.is_finite() {
+        return vec![poly.clone()];
+    }
+    // (u, v) -> (-v, u) is a rotation, so rings keep their orientation.
+    let turn = |r: &LocalRing| r.iter().map(|p| [-p[1], p[0]]).collect::<LocalRing>();
+    let back = |r: &LocalRing| r.iter().map(|p| [p[1], -p[0]]).collect::<LocalRing>();
+    let turned = LocalPoly {
+        exterior: turn(&poly.exterior),
+        holes: poly.holes.iter().map(turn).collect(),
+    };
+    clip_band(&turned, lo, hi)
+        .into_iter()
+        .map(|p| LocalPoly {
+            exterior: back(&p.exterior),
+            holes: p.holes.iter().map(back).collect(),
+        })
+        .collect()
+}
+
+/// The lot's extent along u on the line at depth `v`, clamped to 0.1 mm inside the lot's
+/// depth range: at its very edge a frontage that is not exactly level in floating point
+/// would give a single point instead of the frontage.
+pub fn extent_at(ring: &[[f64; 2]], v: f64) -> (f64, f64) {
+    let (vmin, vmax) = ring
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p[1]), b.max(p[1])));
+    let inset = if vmax - vmin > 4e-4 { 1e-4 } else { 0.0 };
+    let v = v.clamp(vmin + inset, vmax - inset);
+    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+    let n = ring.len();
+    for i in 0..n {
+        let (p, q) = (ring[i], ring[(i + 1) % n]);
+        let (a, b) = if p[1] <= q[1] { (p, q) } else { (q, p) };
+        if v < a[1] || v > b[1] {
+            continue;
+        }
+        let us: &[f64] = if b[1] - a[1] < 1e-12 {
+            &[a[0], b[0]]
+        } else {
+            &[a[0] + (v - a[1]) / (b[1] - a[1]) * (b[0] - a[0])]
+        };
+        for &u in us {
+            lo = lo.min(u);
+            hi = hi.max(u);
+        }
+    }
+    if lo > hi {
+        (f64::NAN, f64::NAN)
+    } else {
+        (lo, hi)
+    }
+}
+
 /// Sutherland-Hodgman against one line `v = c`, keeping `v >= c` (`above`) or `v <= c`.
 /// Points made on the line get `v = c` exactly, so two halves split at the same line share
 /// their cut points bit for bit.
@@ -158,8 +214,30 @@ pub fn is_convex(r: &[[f64; 2]]) -> bool {
     })
 }
 
-/// Drops consecutive points closer than 0.1 mm.
+/// Drops consecutive points closer than 0.1 mm, and spikes: points where the ring runs out
+/// and straight back (they would give a wall of no thickness, used from both sides).
 pub fn dedup(r: LocalRing) -> LocalRing {
+    let mut out = dedup_points(r);
+    let mut i = 0;
+    while out.len() >= 3 && i < out.len() {
+        let n = out.len();
+        let (p, q, s) = (out[(i + n - 1) % n], out[i], out[(i + 1) % n]);
+        let (a, b) = ([q[0] - p[0], q[1] - p[1]], [s[0] - q[0], s[1] - q[1]]);
+        let cross = a[0] * b[1] - a[1] * b[0];
+        let dot = a[0] * b[0] + a[1] * b[1];
+        let scale = (a[0].hypot(a[1]) * b[0].hypot(b[1])).max(1e-12);
+        if cross.abs() / scale < 1e-9 && dot < 0.0 {
+            out.remove(i);
+            out = dedup_points(out);
+            i = 0;
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+fn dedup_points(r: LocalRing) -> LocalRing {
     let mut out: LocalRing = Vec::with_capacity(r.len());
     for p in r {
         if out
@@ -214,6 +292,41 @@ mod tests {
         assert_eq!(parts.len(), 2);
         let total: f64 = parts.iter().map(|p| area(&p.exterior)).sum();
         assert!((total - 16.0).abs() < 1e-6, "{total}");
+    }
+
+    #[test]
+    fn spikes_are_removed() {
+        let r = dedup(vec![
+            [0., 0.],
+            [4., 0.],
+            [6., 0.],
+            [4., 0.],
+            [4., 3.],
+            [0., 3.],
+        ]);
+        assert_eq!(r, vec![[0., 0.], [4., 0.], [4., 3.], [0., 3.]]);
+    }
+
+    #[test]
+    fn u_band_and_extent_follow_a_slanted_lot() {
+        let lot = LocalPoly::simple(vec![[0., 0.], [5., 0.], [6., 20.], [1., 20.]]);
+        let parts = clip_band_u(&lot, 2.0, 4.0);
+        assert_eq!(parts.len(), 1);
+        assert!(area(&parts[0].exterior) > 0.0, "still counter-clockwise");
+        assert!(parts[0]
+            .exterior
+            .iter()
+            .all(|p| p[0] >= 2.0 - 1e-9 && p[0] <= 4.0 + 1e-9));
+        let (lo, hi) = extent_at(&lot.exterior, 10.0);
+        assert!(
+            (lo - 0.5).abs() < 1e-9 && (hi - 5.5).abs() < 1e-9,
+            "{lo} {hi}"
+        );
+        let (lo, hi) = extent_at(&lot.exterior, -3.0);
+        assert!(
+            lo.abs() < 1e-4 && (hi - 5.0).abs() < 1e-4,
+            "clamped to the frontage"
+        );
     }
 
     #[test]

@@ -11,6 +11,8 @@ pub struct Material {
     pub kd: [f32; 3],
     /// Texture file name in `textures/`, if the material is textured.
     pub texture: Option<&'static str>,
+    /// The texture's alpha cuts the face out (billboards): the MTL adds `map_d`.
+    pub alpha: bool,
 }
 
 /// All materials, in the order MTL files list them.
@@ -18,57 +20,194 @@ pub const MATERIALS: &[Material] = &[
     Material {
         name: "facade_hiraya",
         kd: [0.45, 0.33, 0.22],
+        alpha: false,
         texture: Some("facade_hiraya.png"),
     },
     Material {
         name: "facade_nakanikai",
         kd: [0.55, 0.45, 0.35],
+        alpha: false,
         texture: Some("facade_nakanikai.png"),
     },
     Material {
         name: "facade_sounikai",
         kd: [0.45, 0.33, 0.22],
+        alpha: false,
         texture: Some("facade_sounikai.png"),
     },
     Material {
         name: "facade_sangai",
         kd: [0.45, 0.33, 0.22],
+        alpha: false,
         texture: Some("facade_sangai.png"),
     },
     Material {
         name: "facade_shimoutaya",
         kd: [0.40, 0.30, 0.20],
+        alpha: false,
         texture: Some("facade_shimoutaya.png"),
     },
     Material {
         name: "facade_kanban",
         kd: [0.50, 0.45, 0.40],
+        alpha: false,
         texture: Some("facade_kanban.png"),
     },
     Material {
         name: "shikkui_wall",
         kd: [0.90, 0.88, 0.82],
+        alpha: false,
         texture: Some("shikkui.png"),
     },
     Material {
         name: "kawara_roof",
         kd: [0.30, 0.31, 0.33],
+        alpha: false,
         texture: Some("kawara.png"),
     },
     Material {
         name: "wood",
         kd: [0.35, 0.25, 0.16],
+        alpha: false,
         texture: Some("wood.png"),
     },
     Material {
         name: "tsuchikabe_wall",
         kd: [0.72, 0.60, 0.42],
+        alpha: false,
         texture: Some("tsuchikabe.png"),
     },
     Material {
         name: "floor",
         kd: [0.35, 0.32, 0.28],
+        alpha: false,
         texture: None,
+    },
+    Material {
+        name: "koshi",
+        kd: [0.40, 0.27, 0.17],
+        alpha: false,
+        texture: Some("koshi.png"),
+    },
+    Material {
+        name: "gate",
+        kd: [0.38, 0.25, 0.15],
+        alpha: false,
+        texture: Some("gate.png"),
+    },
+    Material {
+        name: "namako",
+        kd: [0.35, 0.36, 0.38],
+        alpha: false,
+        texture: Some("namako.png"),
+    },
+    Material {
+        name: "tree_01",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_01.png"),
+    },
+    Material {
+        name: "tree_02",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_02.png"),
+    },
+    Material {
+        name: "tree_03",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_03.png"),
+    },
+    Material {
+        name: "tree_04",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_04.png"),
+    },
+    Material {
+        name: "tree_05",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_05.png"),
+    },
+    Material {
+        name: "tree_06",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_06.png"),
+    },
+    Material {
+        name: "tree_07",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_07.png"),
+    },
+    Material {
+        name: "tree_08",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_08.png"),
+    },
+    Material {
+        name: "tree_09",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_09.png"),
+    },
+    Material {
+        name: "tree_10",
+        kd: [0.25, 0.40, 0.22],
+        alpha: true,
+        texture: Some("tree_10.png"),
+    },
+    Material {
+        name: "person_01",
+        kd: [0.25, 0.25, 0.35],
+        alpha: true,
+        texture: Some("person_01.png"),
+    },
+    Material {
+        name: "person_02",
+        kd: [0.25, 0.25, 0.35],
+        alpha: true,
+        texture: Some("person_02.png"),
+    },
+    Material {
+        name: "person_03",
+        kd: [0.25, 0.25, 0.35],
+        alpha: true,
+        texture: Some("person_03.png"),
+    },
+    Material {
+        name: "person_04",
+        kd: [0.25, 0.25, 0.35],
+        alpha: true,
+        texture: Some("person_04.png"),
+    },
+    Material {
+        name: "person_05",
+        kd: [0.25, 0.25, 0.35],
+        alpha: true,
+        texture: Some("person_05.png"),
+    },
+    Material {
+        name: "person_06",
+        kd: [0.25, 0.25, 0.35],
+        alpha: true,
+        texture: Some("person_06.png"),
+    },
+    Material {
+        name: "person_07",
+        kd: [0.25, 0.25, 0.35],
+        alpha: true,
+        texture: Some("person_07.png"),
+    },
+    Material {
+        name: "person_08",
+        kd: [0.25, 0.25, 0.35],
+        alpha: true,
+        texture: Some("person_08.png"),
     },
 ];
 
@@ -104,6 +243,51 @@ pub const TEXTURES: &[(&str, &[u8])] = &[
     (
         "tsuchikabe.png",
         include_bytes!("../../textures/tsuchikabe.png"),
+    ),
+    ("koshi.png", include_bytes!("../../textures/koshi.png")),
+    ("gate.png", include_bytes!("../../textures/gate.png")),
+    ("namako.png", include_bytes!("../../textures/namako.png")),
+    ("tree_01.png", include_bytes!("../../textures/tree_01.png")),
+    ("tree_02.png", include_bytes!("../../textures/tree_02.png")),
+    ("tree_03.png", include_bytes!("../../textures/tree_03.png")),
+    ("tree_04.png", include_bytes!("../../textures/tree_04.png")),
+    ("tree_05.png", include_bytes!("../../textures/tree_05.png")),
+    ("tree_06.png", include_bytes!("../../textures/tree_06.png")),
+    ("tree_07.png", include_bytes!("../../textures/tree_07.png")),
+    ("tree_08.png", include_bytes!("../../textures/tree_08.png")),
+    ("tree_09.png", include_bytes!("../../textures/tree_09.png")),
+    ("tree_10.png", include_bytes!("../../textures/tree_10.png")),
+    (
+        "person_01.png",
+        include_bytes!("../../textures/person_01.png"),
+    ),
+    (
+        "person_02.png",
+        include_bytes!("../../textures/person_02.png"),
+    ),
+    (
+        "person_03.png",
+        include_bytes!("../../textures/person_03.png"),
+    ),
+    (
+        "person_04.png",
+        include_bytes!("../../textures/person_04.png"),
+    ),
+    (
+        "person_05.png",
+        include_bytes!("../../textures/person_05.png"),
+    ),
+    (
+        "person_06.png",
+        include_bytes!("../../textures/person_06.png"),
+    ),
+    (
+        "person_07.png",
+        include_bytes!("../../textures/person_07.png"),
+    ),
+    (
+        "person_08.png",
+        include_bytes!("../../textures/person_08.png"),
     ),
 ];
 

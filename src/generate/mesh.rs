@@ -87,6 +87,42 @@ impl Mesh {
         }
     }
 
+    /// Adds every face of `other` (a mesh in the same frame), sharing equal positions.
+    pub fn append(&mut self, other: &Mesh) {
+        let pos: Vec<u32> = other
+            .positions
+            .iter()
+            .map(|&key| {
+                let next = self.positions.len() as u32;
+                *self.pos_index.entry(key).or_insert_with(|| {
+                    self.positions.push(key);
+                    next
+                })
+            })
+            .collect();
+        let uv: Vec<u32> = other
+            .uvs
+            .iter()
+            .map(|&key| {
+                let next = self.uvs.len() as u32;
+                *self.uv_index.entry(key).or_insert_with(|| {
+                    self.uvs.push(key);
+                    next
+                })
+            })
+            .collect();
+        for f in &other.faces {
+            self.faces.push(Face {
+                material: f.material,
+                corners: f
+                    .corners
+                    .iter()
+                    .map(|&(p, t)| (pos[p as usize], uv[t as usize]))
+                    .collect(),
+            });
+        }
+    }
+
     /// Releases the lookup tables once the mesh is complete.
     pub fn finish(mut self) -> Mesh {
         self.pos_index = HashMap::new();
@@ -100,8 +136,9 @@ pub fn mm(v: f64) -> i64 {
     (v * 1000.0).round() as i64
 }
 
-/// Directed edges that are not matched by exactly one opposite edge: empty for a closed,
-/// consistently oriented (watertight) mesh.
+/// Directed edges not matched by as many opposite edges: empty for a closed, consistently
+/// oriented (watertight) mesh. An edge used twice each way is allowed: a lot whose outline
+/// touches itself at a point (a pinch) gives a house whose shell meets itself there.
 pub fn open_edges(mesh: &Mesh) -> Vec<(u32, u32)> {
     let mut count: HashMap<(u32, u32), i32> = HashMap::new();
     for f in &mesh.faces {
@@ -113,7 +150,7 @@ pub fn open_edges(mesh: &Mesh) -> Vec<(u32, u32)> {
     }
     let mut bad: Vec<(u32, u32)> = count
         .iter()
-        .filter(|((a, b), n)| **n != 1 || count.get(&(*b, *a)) != Some(&1))
+        .filter(|((a, b), n)| count.get(&(*b, *a)) != Some(*n))
         .map(|(e, _)| *e)
         .collect();
     bad.sort();

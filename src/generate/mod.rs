@@ -4,6 +4,7 @@
 //! no randomness of its own. A lot whose house cannot be built is skipped with a reason.
 
 pub mod clip;
+pub mod instance;
 pub mod machiya;
 pub mod materials;
 pub mod mesh;
@@ -29,6 +30,12 @@ pub struct LayerFiles {
     pub footprints: String,
 }
 
+/// The `random` input of a feature's template: its own stream, apart from the type draw.
+fn template_random(seed: u64, layer: &str, id: &str) -> f64 {
+    use rand::RngExt;
+    crate::rng::feature_rng(seed, &format!("{layer}/template"), id).random::<f64>()
+}
+
 pub fn generate_tile(
     lots: &[PlannedMachiya],
     catalog: &Catalog,
@@ -39,9 +46,18 @@ pub fn generate_tile(
     let frame = Frame { origin };
     let mut out = TileMeshes::default();
     for m in lots {
-        let result = match catalog.get(&m.mtype) {
-            Some(t) => machiya::build(m, t, &params.machiya, frame),
-            None => Err(format!("machiya type `{}` has no type file", m.mtype)),
+        let layer = if m.height.is_some() {
+            "footprints"
+        } else {
+            "lots"
+        };
+        let result = match catalog.machiya(&m.mtype) {
+            Some(t) => {
+                let overrides = catalog.overrides(&m.mtype, m.district.as_deref());
+                let random = template_random(params.seed, layer, &m.id);
+                machiya::build(m, t, &overrides, &params.machiya, random, frame)
+            }
+            None => Err(format!("machiya type `{}` has no template", m.mtype)),
         };
         match result {
             Ok(mesh) => {

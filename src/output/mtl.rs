@@ -2,6 +2,9 @@
 //!
 //! Textured materials get a white `Kd`: three.js multiplies the texture by `Kd`, Blender and
 //! MeshLab ignore it when a texture is present, so white shows the texture right everywhere.
+//! Billboards (trees, people) are cut out by their texture's alpha: `map_d` names the same
+//! PNG, which Blender's importer turns into an alpha link and three.js's MTLLoader into
+//! `alphaMap`/transparency; viewers that read only `map_Kd` still get the RGBA texture.
 
 use std::fmt::Write;
 
@@ -27,6 +30,9 @@ pub fn mtl_text() -> String {
                     s,
                     "Ks 0.000 0.000 0.000\nd 1.0\nillum 1\nmap_Kd ../textures/{t}"
                 );
+                if m.alpha {
+                    let _ = writeln!(s, "map_d ../textures/{t}");
+                }
             }
             None => {
                 let _ = writeln!(

@@ -1,0 +1,530 @@
+//! Instantiating a template on one site: evaluating its parts into a mesh.
+//!
+//! A site is a lot (or any outline) in its frontage frame: u along the street, v into the
+//! lot, h up from the ground. Prism parts are cut from their outline and extruded, so a house
+//! fits whatever lot it is given; explicit parts place the template's own vertices. Every
+//! closed part is checked to be watertight, and every value to be a finite number, before
+//! anything is kept: a template that fails on one lot skips that lot with the reason.
+
+use std::cell::RefCell;
+
+use geo_types::Coord;
+
+use super::clip::{
+    area, clip_band, clip_band_u, dedup, extent_at, is_convex, LocalPoly, LocalRing,
+};
+use super::mesh::{open_edges, Frame, Mesh};
+use crate::templates::expr::{Expr, Lot};
+use crate::templates::template::{FaceSpec, Faces, Prism, Shape};
+use crate::templates::Template;
+
+/// Texture base of walls, floors and faces without a base of their own: one repeat per 2 m.
+const WORLD_TEXTURE_BASE: f64 = 2.0;
+/// Texture base of roofs: one repeat per metre along the street and up the slope.
+const ROOF_TEXTURE_BASE: f64 = 1.0;
+
+/// The frontage frame: u along the street, v into the lot, in map metres.
+#[derive(Debug, Clone, Copy)]
+pub struct Local {
+    pub a: Coord<f64>,
+    pub u: Coord<f64>,
+    pub v: Coord<f64>,
+}
+
+impl Local {
+    pub fn to_map(self, p: [f64; 2]) -> Coord<f64> {
+        Coord {
+            x: self.a.x + p[0] * self.u.x + p[1] * self.v.x,
+            y: self.a.y + p[0] * self.u.y + p[1] * self.v.y,
+        }
+    }
+    pub fn to_local(self, c: Coord<f64>) -> [f64; 2] {
+        let (dx, dy) = (c.x - self.a.x, c.y - self.a.y);
+        [dx * self.u.x + dy * self.u.y, dx * self.v.x + dy * self.v.y]
+    }
+}
+
+/// Where a template is built.
+#[derive(Debug, Clone)]
+pub struct Site {
+    /// The lot in the frontage frame (exterior counter-clockwise, holes clockwise).
+    pub lot: LocalPoly,
+    pub local: Local,
+    /// Ground elevation, metres: h = 0 of the template.
+    pub ground: f64,
+}
+
+impl Lot for Site {
+    fn extent_at(&self, v: f64) -> (f64, f64) {
+        extent_at(&self.lot.exterior, v)
+    }
+}
+
+impl Site {
+    /// A rectangle `width` x `depth` at the origin, facing a street along the x axis.
+    pub fn rectangle(width: f64, depth: f64) -> Site {
+        Site {
+            lot: LocalPoly::simple(vec![[0.0, 0.0], [width, 0.0], [width, depth], [0.0, depth]]),
+            local: Local {
+                a: Coord { x: 0.0, y: 0.0 },
+                u: Coord { x: 1.0, y: 0.0 },
+                v: Coord { x: 0.0, y: 1.0 },
+            },
+            ground: 0.0,
+        }
+    }
+
+    /// The lot's depth: its largest v.
+    pub fn depth(&self) -> f64 {
+        self.lot.exterior.iter().map(|p| p[1]).fold(0.0, f64::max)
+    }
+}
+
+/// Builds every part of `t` whose `when` holds into `mesh`. `slots` come from
+/// [`Template::evaluate`] for this site.
+pub fn instantiate(
+    t: &Template,
+    slots: &[f64],
+    site: &Site,
+    frame: Frame,
+    mesh: &mut Mesh,
+) -> Result<(), String> {
+    let cell = RefCell::new(slots.to_vec());
+    let scalar = |e: &Expr, what: &str, part: &str| -> Result<f64, String> {
+        let x = e.eval(&cell.borrow(), site);
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(format!("template {}: part `{part}`: {what} is {x}", t.name))
+        }
+    };
+    for part in &t.parts {
+        if let Some(w) = &part.when {
+            if scalar(w, "`when`", &part.name)? == 0.0 {
+                continue;
+            }
+        }
+        let mut piece = Mesh::new(String::new());
+        let closed = match &part.shape {
+            Shape::Prism(p) => {
+                prism(t, p, &part.name, site, frame, &cell, &scalar, &mut piece)?;
+                p.closed
+            }
+            Shape::Faces(f) => {
+                faces(f, &part.name, site, frame, &scalar, &mut piece)?;
+                f.closed
+            }
+        };
+        if closed && !open_edges(&piece).is_empty() {
+            return Err(format!(
+                "template {}: part `{}` ({}) is not a closed shell on this lot",
+                t.name, part.name, part.loc
+            ));
+        }
+        mesh.append(&piece);
+    }
+    Ok(())
+}
+
+type Scalar<'a> = dyn Fn(&Expr, &str, &str) -> Result<f64, String> + 'a;
+
+#[allow(clippy::too_many_arguments)]
+fn prism(
+    t: &Template,
+    p: &Prism,
+    name: &str,
+    site: &Site,
+    frame: Frame,
+    cell: &RefCell<Vec<f64>>,
+    scalar: &Scalar,
+    mesh: &mut Mesh,
+) -> Result<(), String> {
+    let bound = |e: &Option<Expr>, what: &str, inf: f64| -> Result<f64, String> {
+        e.as_ref().map_or(Ok(inf), |e| scalar(e, what, name))
+    };
+    let (v0, v1) = (
+        bound(&p.v0, "v0", f64::NEG_INFINITY)?,
+        bound(&p.v1, "v1", f64::INFINITY)?,
+    );
+    let (u0, u1) = (
+        bound(&p.u0, "u0", f64::NEG_INFINITY)?,
+        bound(&p.u1, "u1", f64::INFINITY)?,
+    );
+    let outline = match &p.outline {
+        None => site.lot.clone(),
+        Some(points) => {
+            let mut ring: LocalRing = points
+                .iter()
+                .map(|[u, v]| {
+                    Ok([
+                        scalar(u, "an outline u", name)?,
+                        scalar(v, "an outline v", name)?,
+                    ])
+                })
+                .collect::<Result<_, String>>()?;
+            if area(&ring) < 0.0 {
+                ring.reverse();
+            }
+            let ring = dedup(ring);
+            if ring.len() < 3 || area(&ring) <= 1e-9 {
+                return Err(format!(
+                    "template {}: part `{name}`: the outline has no area",
+                    t.name
+                ));
+            }
+            LocalPoly::simple(ring)
+        }
+    };
+    let mut pieces = Vec::new();
+    for b in clip_band(&outline, v0, v1) {
+        pieces.extend(clip_band_u(&b, u0, u1));
+    }
+    // Where the roof line bends: split there so that every top face is planar.
+    let splits_v: Vec<f64> = p
+        .split
+        .iter()
+        .map(|e| scalar(e, "a split", name))
+        .collect::<Result<_, _>>()?;
+    let splits_u: Vec<f64> = p
+        .split_u
+        .iter()
+        .map(|e| scalar(e, "a split_u", name))
+        .collect::<Result<_, _>>()?;
+    // A vertex within a millimetre of a split line is moved onto it: otherwise the two sides
+    // share a sliver that rounds to nothing and leaves the shell open.
+    let snap = |pieces: &mut Vec<LocalPoly>, axis: usize, s: f64| {
+        for q in pieces.iter_mut() {
+            for r in std::iter::once(&mut q.exterior).chain(q.holes.iter_mut()) {
+                for p in r.iter_mut() {
+                    if (p[axis] - s).abs() < 1e-3 {
+                        p[axis] = s;
+                    }
+                }
+            }
+        }
+    };
+    for &s in &splits_v {
+        snap(&mut pieces, 1, s);
+        pieces = pieces
+            .iter()
+            .flat_map(|q| {
+                let mut both = clip_band(q, f64::NEG_INFINITY, s);
+                both.extend(clip_band(q, s, f64::INFINITY));
+                both
+            })
+            .collect();
+    }
+    for &s in &splits_u {
+        snap(&mut pieces, 0, s);
+        pieces = pieces
+            .iter()
+            .flat_map(|q| {
+                let mut both = clip_band_u(q, f64::NEG_INFINITY, s);
+                both.extend(clip_band_u(q, s, f64::INFINITY));
+                both
+            })
+            .collect();
+    }
+    if pieces.is_empty() {
+        // Nothing of the outline lies in the band: the part is absent on this lot.
+        return Ok(());
+    }
+    let (us, vs) = (t.v_slot - 1, t.v_slot);
+    let at = |e: &Expr, q: [f64; 2]| -> f64 {
+        let mut s = cell.borrow_mut();
+        s[us] = q[0];
+        s[vs] = q[1];
+        e.eval(&s, site)
+    };
+    // Check every corner once: finite, and the top not below the bottom.
+    for q in pieces.iter().flat_map(|x| x.rings().flatten()) {
+        let (b, h) = (at(&p.bottom, *q), at(&p.top, *q));
+        if !(b.is_finite() && h.is_finite()) {
+            return Err(format!(
+                "template {}: part `{name}`: top or bottom is not a number at u={:.2}, v={:.2}",
+                t.name, q[0], q[1]
+            ));
+        }
+        if h < b - 1e-6 {
+            return Err(format!(
+                "template {}: part `{name}`: top {h:.2} m is below bottom {b:.2} m (a negative height) at u={:.2}, v={:.2}",
+                t.name, q[0], q[1]
+            ));
+        }
+    }
+    let front_v = if p.v0.is_some() {
+        v0
+    } else {
+        pieces
+            .iter()
+            .flat_map(|x| &x.exterior)
+            .map(|q| q[1])
+            .fold(f64::INFINITY, f64::min)
+    };
+    let facade = match p.front_material {
+        Some(material) => Some(Facade {
+            material,
+            front_v,
+            base: scalar(&p.front_base, "front_base", name)?,
+            height: scalar(&p.front_height, "front_height", name)?,
+        }),
+        None => None,
+    };
+    let dress = Dress {
+        top: p.top_material,
+        bottom: p.bottom_material,
+        wall: p.side_material,
+        facade,
+    };
+    let g = site.ground;
+    extrude(
+        mesh,
+        frame,
+        site.local,
+        &pieces,
+        &|q| g + at(&p.bottom, q),
+        &|q| g + at(&p.top, q),
+        &splits_v,
+        &splits_u,
+        &dress,
+        g,
+    );
+    Ok(())
+}
+
+fn faces(
+    f: &Faces,
+    name: &str,
+    site: &Site,
+    frame: Frame,
+    scalar: &Scalar,
+    mesh: &mut Mesh,
+) -> Result<(), String> {
+    let pts: Vec<[f64; 3]> = f
+        .vertices
+        .iter()
+        .enumerate()
+        .map(|(i, [u, v, h])| {
+            let what = format!("vertex {}", i + 1);
+            Ok([
+                scalar(u, &what, name)?,
+                scalar(v, &what, name)?,
+                scalar(h, &what, name)?,
+            ])
+        })
+        .collect::<Result<_, String>>()?;
+    for (k, face) in f.faces.iter().enumerate() {
+        let uvs = face_uvs(face, &pts, scalar, name, k)?;
+        let corners = face
+            .corners
+            .iter()
+            .zip(uvs)
+            .map(|(&i, [s, t])| {
+                let p = pts[i];
+                let pos = mesh.vertex(frame, site.local.to_map([p[0], p[1]]), site.ground + p[2]);
+                (pos, mesh.uv(s, t))
+            })
+            .collect();
+        mesh.face(face.material, corners);
+    }
+    Ok(())
+}
+
+/// A face's texture coordinates: as written, or projected onto the face with one repeat per
+/// `base` metres (walls: along the wall and up from the ground; flat faces: u and v).
+fn face_uvs(
+    face: &FaceSpec,
+    pts: &[[f64; 3]],
+    scalar: &Scalar,
+    name: &str,
+    k: usize,
+) -> Result<Vec<[f64; 2]>, String> {
+    if let Some(uv) = &face.uv {
+        let what = format!("a uv of face {}", k + 1);
+        return uv
+            .iter()
+            .map(|[s, t]| Ok([scalar(s, &what, name)?, scalar(t, &what, name)?]))
+            .collect();
+    }
+    let base = scalar(&face.base, "base", name)?;
+    if base <= 0.0 {
+        return Err(format!(
+            "part `{name}`: face {} has base {base} (must be > 0)",
+            k + 1
+        ));
+    }
+    let c: Vec<[f64; 3]> = face.corners.iter().map(|&i| pts[i]).collect();
+    // Newell's normal.
+    let mut n = [0.0; 3];
+    for i in 0..c.len() {
+        let (p, q) = (c[i], c[(i + 1) % c.len()]);
+        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    }
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if len > 0.0 && (n[2] / len).abs() < 0.7 {
+        // A wall: across along its horizontal direction, up with h.
+        let (hx, hy) = (-n[1], n[0]);
+        let hl = hx.hypot(hy);
+        Ok(c.iter()
+            .map(|p| [(p[0] * hx + p[1] * hy) / hl / base, p[2] / base])
+            .collect())
+    } else {
+        Ok(c.iter().map(|p| [p[0] / base, p[1] / base]).collect())
+    }
+}
+
+/// How the walls of an extruded part are dressed.
+struct Dress {
+    top: u16,
+    bottom: u16,
+    wall: u16,
+    /// Walls on the line `v = front_v` get this material with facade UVs.
+    facade: Option<Facade>,
+}
+
+struct Facade {
+    material: u16,
+    front_v: f64,
+    /// Width of one repeat along u.
+    base: f64,
+    /// Height the texture spans once, bottom to top, from the ground.
+    height: f64,
+}
+
+fn on_split(p: [f64; 2], q: [f64; 2], splits_v: &[f64], splits_u: &[f64]) -> bool {
+    splits_v
+        .iter()
+        .any(|s| (p[1] - s).abs() < 1e-6 && (q[1] - s).abs() < 1e-6)
+        || splits_u
+            .iter()
+            .any(|s| (p[0] - s).abs() < 1e-6 && (q[0] - s).abs() < 1e-6)
+}
+
+/// Extrudes planar pieces between a bottom and a top height, each a function of (u, v) that
+/// is linear on every piece. Walls on a split line are left out: there two pieces meet and
+/// the shell continues. The result is closed when the pieces tile a closed region.
+#[allow(clippy::too_many_arguments)]
+fn extrude(
+    mesh: &mut Mesh,
+    frame: Frame,
+    local: Local,
+    parts: &[LocalPoly],
+    bottom: &dyn Fn([f64; 2]) -> f64,
+    top: &dyn Fn([f64; 2]) -> f64,
+    splits_v: &[f64],
+    splits_u: &[f64],
+    dress: &Dress,
+    base: f64,
+) {
+    for part in parts {
+        let tris = triangles(part);
+        // Roof texture follows the slope, so tiles keep their size on steep roofs.
+        let stretch = |p: [f64; 2]| {
+            let gu = top([p[0] + 0.5, p[1]]) - top([p[0] - 0.5, p[1]]);
+            let gv = top([p[0], p[1] + 0.5]) - top([p[0], p[1] - 0.5]);
+            ((1.0 + gu * gu).sqrt(), (1.0 + gv * gv).sqrt())
+        };
+        for tri in &tris {
+            let corners = tri
+                .iter()
+                .map(|&p| {
+                    let pos = mesh.vertex(frame, local.to_map(p), top(p));
+                    let (su, sv) = stretch(p);
+                    let uv = mesh.uv(p[0] * su / ROOF_TEXTURE_BASE, p[1] * sv / ROOF_TEXTURE_BASE);
+                    (pos, uv)
+                })
+                .collect();
+            mesh.face(dress.top, corners);
+            let corners = tri
+                .iter()
+                .rev()
+                .map(|&p| {
+                    let pos = mesh.vertex(frame, local.to_map(p), bottom(p));
+                    let uv = mesh.uv(p[0] / WORLD_TEXTURE_BASE, p[1] / WORLD_TEXTURE_BASE);
+                    (pos, uv)
+                })
+                .collect();
+            mesh.face(dress.bottom, corners);
+        }
+        // Walls, outward: the polygon's inside is on the left of every edge of every ring
+        // (exterior counter-clockwise, holes clockwise), so outside is on the right.
+        for (p, q) in part
+            .rings()
+            .flat_map(|r| (0..r.len()).map(move |i| (r[i], r[(i + 1) % r.len()])))
+        {
+            if on_split(p, q, splits_v, splits_u) {
+                continue;
+            }
+            let (hp0, hq0, hp1, hq1) = (bottom(p), bottom(q), top(p), top(q));
+            let pm = local.to_map(p);
+            let qm = local.to_map(q);
+            let ids = [
+                mesh.vertex(frame, pm, hp0),
+                mesh.vertex(frame, qm, hq0),
+                mesh.vertex(frame, qm, hq1),
+                mesh.vertex(frame, pm, hp1),
+            ];
+            let facade = dress
+                .facade
+                .as_ref()
+                .filter(|fa| (p[1] - fa.front_v).abs() < 0.01 && (q[1] - fa.front_v).abs() < 0.01);
+            let (material, uvs) = match facade {
+                Some(fa) => {
+                    let (up, uq) = (p[0] / fa.base, q[0] / fa.base);
+                    // Facade UVs count from the ground, so the texture's storeys line up with
+                    // the house's whatever the ground elevation.
+                    let h = fa.height;
+                    (
+                        fa.material,
+                        [
+                            mesh.uv(up, (hp0 - base) / h),
+                            mesh.uv(uq, (hq0 - base) / h),
+                            mesh.uv(uq, (hq1 - base) / h),
+                            mesh.uv(up, (hp1 - base) / h),
+                        ],
+                    )
+                }
+                None => {
+                    let len = (q[0] - p[0]).hypot(q[1] - p[1]) / WORLD_TEXTURE_BASE;
+                    let b = WORLD_TEXTURE_BASE;
+                    (
+                        dress.wall,
+                        [
+                            mesh.uv(0.0, (hp0 - base) / b),
+                            mesh.uv(len, (hq0 - base) / b),
+                            mesh.uv(len, (hq1 - base) / b),
+                            mesh.uv(0.0, (hp1 - base) / b),
+                        ],
+                    )
+                }
+            };
+            mesh.face(material, ids.into_iter().zip(uvs).collect());
+        }
+    }
+}
+
+/// Triangles (counter-clockwise) covering a polygon: the polygon itself as one face when it
+/// is convex without holes, else earcut (which keeps the holes open).
+fn triangles(part: &LocalPoly) -> Vec<Vec<[f64; 2]>> {
+    if part.holes.is_empty() && is_convex(&part.exterior) {
+        return vec![part.exterior.clone()];
+    }
+    use geo::TriangulateEarcut;
+    use geo_types::{LineString, Polygon};
+    let ls = |r: &LocalRing| LineString(r.iter().map(|p| Coord { x: p[0], y: p[1] }).collect());
+    let poly = Polygon::new(ls(&part.exterior), part.holes.iter().map(ls).collect());
+    let raw = poly.earcut_triangles_raw();
+    raw.triangle_indices
+        .chunks_exact(3)
+        .map(|t| {
+            let mut tri: Vec<[f64; 2]> = t.iter().map(|&k| raw.vertices[k]).collect();
+            if area(&tri) < 0.0 {
+                tri.reverse();
+            }
+            tri
+        })
+        .filter(|tri| area(tri) > 1e-12)
+        .collect()
+}

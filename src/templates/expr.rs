@@ -1,0 +1,370 @@
+//! Template expressions: parsed by `evalexpr`, then compiled to a small tree over numbered
+//! slots and evaluated in `f64` only.
+//!
+//! evalexpr parses the text (operators, precedence, function calls, `if`), but evaluates with
+//! integer and float values kept apart (`7 / 2` is 3) and looks names up in a hash map. A
+//! template is evaluated tens of times per house for tens of thousands of houses, and its
+//! authors expect arithmetic, so the tree is compiled once: every name becomes a slot index,
+//! every number a float, and a comparison is 1 or 0.
+
+use evalexpr::{DefaultNumericTypes, Node, Operator, Value};
+
+/// A compiled expression.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Expr {
+    Const(f64),
+    Slot(usize),
+    Neg(Box<Expr>),
+    Not(Box<Expr>),
+    Bin(Bin, Box<Expr>, Box<Expr>),
+    Call(Func, Vec<Expr>),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Bin {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Rem,
+    Pow,
+    Eq,
+    Ne,
+    Gt,
+    Lt,
+    Ge,
+    Le,
+    And,
+    Or,
+}
+
+/// Functions a template may call. `lot_u0(v)` / `lot_u1(v)` give the lot's extent along the
+/// street at depth `v`, so a part can follow a lot whose sides are not square to the street.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Func {
+    Min,
+    Max,
+    Floor,
+    Ceil,
+    Round,
+    Abs,
+    Sqrt,
+    Sin,
+    Cos,
+    Tan,
+    Atan2,
+    If,
+    Clamp,
+    LotU0,
+    LotU1,
+}
+
+/// The names and argument counts of the functions (`None` = one or more).
+pub const FUNCTIONS: &[(&str, Func, Option<usize>)] = &[
+    ("min", Func::Min, None),
+    ("max", Func::Max, None),
+    ("floor", Func::Floor, Some(1)),
+    ("ceil", Func::Ceil, Some(1)),
+    ("round", Func::Round, Some(1)),
+    ("abs", Func::Abs, Some(1)),
+    ("sqrt", Func::Sqrt, Some(1)),
+    ("sin", Func::Sin, Some(1)),
+    ("cos", Func::Cos, Some(1)),
+    ("tan", Func::Tan, Some(1)),
+    ("atan2", Func::Atan2, Some(2)),
+    ("if", Func::If, Some(3)),
+    ("clamp", Func::Clamp, Some(3)),
+    ("lot_u0", Func::LotU0, Some(1)),
+    ("lot_u1", Func::LotU1, Some(1)),
+];
+
+/// What an expression may ask about the feature beyond its slots.
+pub trait Lot {
+    /// The lot's extent along u at depth v (v clamped to the lot).
+    fn extent_at(&self, v: f64) -> (f64, f64);
+}
+
+/// No lot: `lot_u0`/`lot_u1` give NaN (the caller reports it).
+pub struct NoLot;
+
+impl Lot for NoLot {
+    fn extent_at(&self, _v: f64) -> (f64, f64) {
+        (f64::NAN, f64::NAN)
+    }
+}
+
+/// Parses `text` and compiles it, resolving each name with `slot`.
+///
+/// ```
+/// use edo_city::templates::expr::{compile, NoLot};
+/// let names = ["width", "depth"];
+/// let e = compile("min(width, depth) / 2 + if(depth > 10, 1, 0)", &|n| {
+///     names.iter().position(|m| *m == n)
+/// })
+/// .unwrap();
+/// assert_eq!(e.eval(&[7.0, 12.0], &NoLot), 4.5);
+/// ```
+pub fn compile(text: &str, slot: &dyn Fn(&str) -> Option<usize>) -> Result<Expr, String> {
+    let tree = evalexpr::build_operator_tree::<DefaultNumericTypes>(text)
+        .map_err(|e| format!("cannot parse `{text}`: {e}"))?;
+    lower(&tree, slot).map_err(|e| format!("in `{text}`: {e}"))
+}
+
+fn lower(node: &Node, slot: &dyn Fn(&str) -> Option<usize>) -> Result<Expr, String> {
+    let kids = node.children();
+    let child = |i: usize| -> Result<Box<Expr>, String> {
+        kids.get(i)
+            .ok_or_else(|| "an operator lacks an operand".to_string())
+            .and_then(|k| lower(k, slot))
+            .map(Box::new)
+    };
+    let bin = |op: Bin| -> Result<Expr, String> { Ok(Expr::Bin(op, child(0)?, child(1)?)) };
+    Ok(match node.operator() {
+        Operator::RootNode => match kids {
+            [one] => lower(one, slot)?,
+            [] => return Err("empty expression".into()),
+            _ => return Err("a list of values is not a number".into()),
+        },
+        Operator::Add => bin(Bin::Add)?,
+        Operator::Sub => bin(Bin::Sub)?,
+        Operator::Mul => bin(Bin::Mul)?,
+        Operator::Div => bin(Bin::Div)?,
+        Operator::Mod => bin(Bin::Rem)?,
+        Operator::Exp => bin(Bin::Pow)?,
+        Operator::Eq => bin(Bin::Eq)?,
+        Operator::Neq => bin(Bin::Ne)?,
+        Operator::Gt => bin(Bin::Gt)?,
+        Operator::Lt => bin(Bin::Lt)?,
+        Operator::Geq => bin(Bin::Ge)?,
+        Operator::Leq => bin(Bin::Le)?,
+        Operator::And => bin(Bin::And)?,
+        Operator::Or => bin(Bin::Or)?,
+        Operator::Neg => Expr::Neg(child(0)?),
+        Operator::Not => Expr::Not(child(0)?),
+        Operator::Const { value } => Expr::Const(match value {
+            Value::Float(f) => *f,
+            Value::Int(i) => *i as f64,
+            Value::Boolean(b) => f64::from(u8::from(*b)),
+            other => return Err(format!("`{other}` is not a number")),
+        }),
+        Operator::VariableIdentifierRead { identifier } => match identifier.as_str() {
+            "pi" => Expr::Const(std::f64::consts::PI),
+            name => Expr::Slot(slot(name).ok_or_else(|| format!("unknown name `{name}`"))?),
+        },
+        Operator::FunctionIdentifier { identifier } => {
+            let name = identifier.strip_prefix("math::").unwrap_or(identifier);
+            let &(_, func, arity) =
+                FUNCTIONS
+                    .iter()
+                    .find(|(n, _, _)| *n == name)
+                    .ok_or_else(|| {
+                        format!(
+                            "unknown function `{identifier}` (known: {})",
+                            FUNCTIONS.iter().map(|f| f.0).collect::<Vec<_>>().join(", ")
+                        )
+                    })?;
+            let args = arguments(kids, slot)?;
+            let ok = match arity {
+                Some(n) => args.len() == n,
+                None => !args.is_empty(),
+            };
+            if !ok {
+                return Err(format!(
+                    "`{name}` takes {} argument(s), got {}",
+                    arity.map_or("one or more".to_string(), |n| n.to_string()),
+                    args.len()
+                ));
+            }
+            Expr::Call(func, args)
+        }
+        other => return Err(format!("`{other}` is not allowed in a template expression")),
+    })
+}
+
+/// A call's arguments: evalexpr gives one child, a tuple when there are several.
+fn arguments(kids: &[Node], slot: &dyn Fn(&str) -> Option<usize>) -> Result<Vec<Expr>, String> {
+    let mut node = match kids {
+        [one] => one,
+        [] => return Ok(Vec::new()),
+        _ => return Err("a function call with a malformed argument list".into()),
+    };
+    while matches!(node.operator(), Operator::RootNode) && node.children().len() == 1 {
+        node = &node.children()[0];
+    }
+    match node.operator() {
+        Operator::Tuple => node.children().iter().map(|k| lower(k, slot)).collect(),
+        Operator::RootNode if node.children().is_empty() => Ok(Vec::new()),
+        _ => Ok(vec![lower(node, slot)?]),
+    }
+}
+
+fn truth(x: f64) -> bool {
+    x != 0.0 && !x.is_nan()
+}
+
+impl Expr {
+    /// The value for the given slots. Arithmetic on NaN stays NaN for the caller to report.
+    pub fn eval(&self, slots: &[f64], lot: &dyn Lot) -> f64 {
+        match self {
+            Expr::Const(c) => *c,
+            Expr::Slot(i) => slots[*i],
+            Expr::Neg(e) => -e.eval(slots, lot),
+            Expr::Not(e) => f64::from(u8::from(!truth(e.eval(slots, lot)))),
+            Expr::Bin(op, a, b) => {
+                let x = a.eval(slots, lot);
+                // `and` / `or` evaluate their right side only when needed, like `if`.
+                match op {
+                    Bin::And => return f64::from(u8::from(truth(x) && truth(b.eval(slots, lot)))),
+                    Bin::Or => return f64::from(u8::from(truth(x) || truth(b.eval(slots, lot)))),
+                    _ => {}
+                }
+                let y = b.eval(slots, lot);
+                let t = |c: bool| f64::from(u8::from(c));
+                match op {
+                    Bin::Add => x + y,
+                    Bin::Sub => x - y,
+                    Bin::Mul => x * y,
+                    Bin::Div => x / y,
+                    Bin::Rem => x % y,
+                    Bin::Pow => x.powf(y),
+                    Bin::Eq => t(x == y),
+                    Bin::Ne => t(x != y),
+                    Bin::Gt => t(x > y),
+                    Bin::Lt => t(x < y),
+                    Bin::Ge => t(x >= y),
+                    Bin::Le => t(x <= y),
+                    Bin::And | Bin::Or => unreachable!("handled above"),
+                }
+            }
+            Expr::Call(f, args) => {
+                let arg = |i: usize| args[i].eval(slots, lot);
+                match f {
+                    Func::If => {
+                        if truth(arg(0)) {
+                            arg(1)
+                        } else {
+                            arg(2)
+                        }
+                    }
+                    Func::Min => args
+                        .iter()
+                        .map(|a| a.eval(slots, lot))
+                        .fold(f64::INFINITY, nan_min),
+                    Func::Max => args
+                        .iter()
+                        .map(|a| a.eval(slots, lot))
+                        .fold(f64::NEG_INFINITY, nan_max),
+                    Func::Floor => arg(0).floor(),
+                    Func::Ceil => arg(0).ceil(),
+                    Func::Round => arg(0).round(),
+                    Func::Abs => arg(0).abs(),
+                    Func::Sqrt => arg(0).sqrt(),
+                    Func::Sin => arg(0).sin(),
+                    Func::Cos => arg(0).cos(),
+                    Func::Tan => arg(0).tan(),
+                    Func::Atan2 => arg(0).atan2(arg(1)),
+                    Func::Clamp => {
+                        let (x, lo, hi) = (arg(0), arg(1), arg(2));
+                        nan_min(nan_max(x, lo), hi)
+                    }
+                    Func::LotU0 => lot.extent_at(arg(0)).0,
+                    Func::LotU1 => lot.extent_at(arg(0)).1,
+                }
+            }
+        }
+    }
+
+    /// The slots this expression reads.
+    pub fn slots(&self, out: &mut Vec<usize>) {
+        match self {
+            Expr::Const(_) => {}
+            Expr::Slot(i) => out.push(*i),
+            Expr::Neg(e) | Expr::Not(e) => e.slots(out),
+            Expr::Bin(_, a, b) => {
+                a.slots(out);
+                b.slots(out);
+            }
+            Expr::Call(_, args) => args.iter().for_each(|a| a.slots(out)),
+        }
+    }
+}
+
+/// `min` that lets NaN through (f64::min would hide it), so a broken template is reported.
+fn nan_min(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.min(b)
+    }
+}
+
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn eval(text: &str) -> f64 {
+        let names = ["a", "b"];
+        compile(text, &|n| names.iter().position(|m| *m == n))
+            .unwrap()
+            .eval(&[3.0, 4.0], &NoLot)
+    }
+
+    #[test]
+    fn arithmetic_is_in_floats() {
+        assert_eq!(eval("7 / 2"), 3.5);
+        assert_eq!(eval("a ^ 2 + b ^ 2"), 25.0);
+        assert_eq!(eval("-a + 1"), -2.0);
+        assert_eq!(eval("sqrt(a*a + b*b)"), 5.0);
+        assert_eq!(eval("math::sqrt(16)"), 4.0);
+        assert_eq!(eval("ceil(7.2 / 1.818)"), 4.0);
+        assert_eq!(eval("floor(2.7) + round(0.4)"), 2.0);
+        assert_eq!(eval("min(a, b, 1)"), 1.0);
+        assert_eq!(eval("max(a)"), 3.0);
+        assert_eq!(eval("clamp(10, 0, b)"), 4.0);
+        assert!((eval("atan2(1, 1) * 4") - std::f64::consts::PI).abs() < 1e-12);
+        assert!((eval("sin(pi / 2) + cos(0) + tan(0)") - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn conditions_are_one_or_zero() {
+        assert_eq!(eval("if(a > 2 && b < 5, 10, 20)"), 10.0);
+        assert_eq!(eval("if(a > 2 && b > 5, 10, 20)"), 20.0);
+        assert_eq!(eval("(a == 3) + (b != 4) + !(a < 1)"), 2.0);
+        assert_eq!(eval("if(0, 1/0, 7)"), 7.0);
+    }
+
+    #[test]
+    fn nan_is_not_hidden_by_min_or_max() {
+        assert!(eval("min(0/0, 1)").is_nan());
+        assert!(eval("max(1, 0/0)").is_nan());
+    }
+
+    #[test]
+    fn errors_name_what_is_wrong() {
+        let c = |t: &str| compile(t, &|n| (n == "a").then_some(0)).unwrap_err();
+        assert!(c("a +").contains("lacks an operand"), "{}", c("a +"));
+        assert!(c("(a").contains("cannot parse"), "{}", c("(a"));
+        assert!(c("depth * 2").contains("unknown name `depth`"));
+        assert!(c("cbrt(a)").contains("unknown function `cbrt`"));
+        assert!(c("atan2(a)").contains("takes 2"));
+        assert!(c("a = 2").contains("not allowed"));
+        assert!(c("\"text\"").contains("not a number"));
+    }
+
+    #[test]
+    fn slots_lists_every_name_read() {
+        let names = ["a", "b", "c"];
+        let e = compile("a + max(c, 2)", &|n| names.iter().position(|m| *m == n)).unwrap();
+        let mut s = Vec::new();
+        e.slots(&mut s);
+        assert_eq!(s, vec![0, 2]);
+    }
+}

@@ -1,0 +1,435 @@
+//! The text of a template file: a TOML schema whose every expression remembers where it was
+//! written, so that errors found after parsing still point at `file:line:column`.
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+use toml::Spanned;
+
+/// A number or an expression, as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+enum NumOrText {
+    Int(i64),
+    Float(f64),
+    Text(String),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTemplate {
+    name: Spanned<String>,
+    #[serde(default)]
+    kanji: String,
+    kind: Option<Spanned<String>>,
+    #[serde(default)]
+    description: String,
+    #[serde(default)]
+    aliases: Vec<String>,
+    extends: Option<Spanned<String>>,
+    #[serde(default, rename = "abstract")]
+    is_abstract: bool,
+    height: Option<Spanned<NumOrText>>,
+    #[serde(default)]
+    params: BTreeMap<String, Spanned<f64>>,
+    #[serde(default)]
+    attributes: BTreeMap<String, Spanned<f64>>,
+    #[serde(default)]
+    derived: BTreeMap<String, Spanned<NumOrText>>,
+    #[serde(default)]
+    materials: BTreeMap<String, Spanned<String>>,
+    #[serde(default)]
+    check: Vec<RawCheck>,
+    #[serde(default)]
+    part: Vec<RawPart>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCheck {
+    expr: Spanned<NumOrText>,
+    reason: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPart {
+    name: Spanned<String>,
+    when: Option<Spanned<NumOrText>>,
+    // A prism: an outline cut to a band and extruded.
+    outline: Option<Spanned<RawOutline>>,
+    v0: Option<Spanned<NumOrText>>,
+    v1: Option<Spanned<NumOrText>>,
+    u0: Option<Spanned<NumOrText>>,
+    u1: Option<Spanned<NumOrText>>,
+    bottom: Option<Spanned<NumOrText>>,
+    top: Option<Spanned<NumOrText>>,
+    #[serde(default)]
+    split: Vec<Spanned<NumOrText>>,
+    #[serde(default)]
+    split_u: Vec<Spanned<NumOrText>>,
+    top_material: Option<Spanned<String>>,
+    bottom_material: Option<Spanned<String>>,
+    side_material: Option<Spanned<String>>,
+    front_material: Option<Spanned<String>>,
+    front_base: Option<Spanned<NumOrText>>,
+    front_height: Option<Spanned<NumOrText>>,
+    // Explicit vertices and faces.
+    #[serde(default)]
+    vertices: Vec<Spanned<Vec<Spanned<NumOrText>>>>,
+    #[serde(default)]
+    faces: Vec<RawFace>,
+    closed: Option<bool>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+enum RawOutline {
+    Named(String),
+    // Spans do not survive an untagged enum: points are located at the outline.
+    Points(Vec<Vec<NumOrText>>),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFace {
+    corners: Spanned<Vec<Spanned<i64>>>,
+    material: Spanned<String>,
+    uv: Option<Spanned<Vec<Vec<Spanned<NumOrText>>>>>,
+    base: Option<Spanned<NumOrText>>,
+}
+
+/// Where something was written.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Loc(pub String);
+
+impl std::fmt::Display for Loc {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// A value as written, with its place.
+#[derive(Debug, Clone)]
+pub struct Src<T> {
+    pub value: T,
+    pub loc: Loc,
+}
+
+/// An expression's text (numbers become their decimal text).
+pub type Text = Src<String>;
+
+/// A template file, read but not yet compiled or merged with the template it extends.
+#[derive(Debug, Clone)]
+pub struct Source {
+    pub file: String,
+    pub name: Src<String>,
+    pub kanji: String,
+    pub kind: Option<Src<String>>,
+    pub description: String,
+    pub aliases: Vec<String>,
+    pub extends: Option<Src<String>>,
+    pub is_abstract: bool,
+    pub height: Option<Text>,
+    pub params: Vec<(String, Src<f64>)>,
+    pub attributes: Vec<(String, Src<f64>)>,
+    pub derived: Vec<(String, Text)>,
+    /// Material slots: a part's material may name a slot, which names a library material.
+    pub materials: Vec<(String, Src<String>)>,
+    pub checks: Vec<(Text, String)>,
+    pub parts: Vec<PartSource>,
+}
+
+#[derive(Debug, Clone)]
+pub struct PartSource {
+    pub name: Src<String>,
+    pub when: Option<Text>,
+    pub outline: Option<Src<OutlineSource>>,
+    pub v0: Option<Text>,
+    pub v1: Option<Text>,
+    pub u0: Option<Text>,
+    pub u1: Option<Text>,
+    pub bottom: Option<Text>,
+    pub top: Option<Text>,
+    pub split: Vec<Text>,
+    pub split_u: Vec<Text>,
+    pub top_material: Option<Src<String>>,
+    pub bottom_material: Option<Src<String>>,
+    pub side_material: Option<Src<String>>,
+    pub front_material: Option<Src<String>>,
+    pub front_base: Option<Text>,
+    pub front_height: Option<Text>,
+    pub vertices: Vec<Src<Vec<Text>>>,
+    pub faces: Vec<FaceSource>,
+    pub closed: Option<bool>,
+}
+
+#[derive(Debug, Clone)]
+pub enum OutlineSource {
+    Lot,
+    /// A name other than `lot` (reported when compiled).
+    Unknown(String),
+    Points(Vec<Vec<Text>>),
+}
+
+#[derive(Debug, Clone)]
+pub struct FaceSource {
+    pub corners: Src<Vec<Src<i64>>>,
+    pub material: Src<String>,
+    pub uv: Option<Src<Vec<Vec<Text>>>>,
+    pub base: Option<Text>,
+}
+
+/// 1-based line and column of a byte offset.
+pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+fn as_text(x: NumOrText) -> String {
+    match x {
+        NumOrText::Int(i) => i.to_string(),
+        // `{:?}` keeps a decimal point, so the expression reads as a float.
+        NumOrText::Float(f) => format!("{f:?}"),
+        NumOrText::Text(t) => t,
+    }
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+    text: &'a str,
+}
+
+impl Ctx<'_> {
+    fn loc(&self, span: std::ops::Range<usize>) -> Loc {
+        let (l, c) = line_col(self.text, span.start);
+        Loc(format!("{}:{l}:{c}", self.file))
+    }
+    fn src<T>(&self, s: Spanned<T>) -> Src<T> {
+        let loc = self.loc(s.span());
+        Src {
+            value: s.into_inner(),
+            loc,
+        }
+    }
+    fn text(&self, s: Spanned<NumOrText>) -> Text {
+        let loc = self.loc(s.span());
+        Src {
+            value: as_text(s.into_inner()),
+            loc,
+        }
+    }
+    fn plain(&self, x: NumOrText, loc: &Loc) -> Text {
+        Src {
+            value: as_text(x),
+            loc: loc.clone(),
+        }
+    }
+    fn opt(&self, s: Option<Spanned<NumOrText>>) -> Option<Text> {
+        s.map(|s| self.text(s))
+    }
+    fn list(&self, v: Vec<Spanned<NumOrText>>) -> Vec<Text> {
+        v.into_iter().map(|s| self.text(s)).collect()
+    }
+}
+
+/// Parses one template file. The error is `file:line:column: message`.
+pub fn parse(file: &str, text: &str) -> Result<Source, String> {
+    let raw: RawTemplate = toml::from_str(text).map_err(|e| {
+        let at = e.span().map(|s| line_col(text, s.start));
+        let msg = e.message().trim_end().to_string();
+        match at {
+            Some((l, c)) => format!("{file}:{l}:{c}: {msg}"),
+            None => format!("{file}: {msg}"),
+        }
+    })?;
+    let cx = Ctx { file, text };
+    let nums = |m: BTreeMap<String, Spanned<f64>>| -> Vec<(String, Src<f64>)> {
+        m.into_iter().map(|(k, v)| (k, cx.src(v))).collect()
+    };
+    let parts = raw
+        .part
+        .into_iter()
+        .map(|p| PartSource {
+            name: cx.src(p.name),
+            when: cx.opt(p.when),
+            outline: p.outline.map(|o| {
+                let loc = cx.loc(o.span());
+                let value = match o.into_inner() {
+                    RawOutline::Named(n) if n == "lot" => OutlineSource::Lot,
+                    RawOutline::Named(n) => OutlineSource::Unknown(n),
+                    RawOutline::Points(pts) => OutlineSource::Points(
+                        pts.into_iter()
+                            .map(|p| p.into_iter().map(|x| cx.plain(x, &loc)).collect())
+                            .collect(),
+                    ),
+                };
+                Src { value, loc }
+            }),
+            v0: cx.opt(p.v0),
+            v1: cx.opt(p.v1),
+            u0: cx.opt(p.u0),
+            u1: cx.opt(p.u1),
+            bottom: cx.opt(p.bottom),
+            top: cx.opt(p.top),
+            split: cx.list(p.split),
+            split_u: cx.list(p.split_u),
+            top_material: p.top_material.map(|s| cx.src(s)),
+            bottom_material: p.bottom_material.map(|s| cx.src(s)),
+            side_material: p.side_material.map(|s| cx.src(s)),
+            front_material: p.front_material.map(|s| cx.src(s)),
+            front_base: cx.opt(p.front_base),
+            front_height: cx.opt(p.front_height),
+            vertices: p
+                .vertices
+                .into_iter()
+                .map(|v| {
+                    let loc = cx.loc(v.span());
+                    Src {
+                        value: cx.list(v.into_inner()),
+                        loc,
+                    }
+                })
+                .collect(),
+            faces: p
+                .faces
+                .into_iter()
+                .map(|f| FaceSource {
+                    corners: {
+                        let loc = cx.loc(f.corners.span());
+                        Src {
+                            value: f
+                                .corners
+                                .into_inner()
+                                .into_iter()
+                                .map(|c| cx.src(c))
+                                .collect(),
+                            loc,
+                        }
+                    },
+                    material: cx.src(f.material),
+                    uv: f.uv.map(|uv| {
+                        let loc = cx.loc(uv.span());
+                        Src {
+                            value: uv.into_inner().into_iter().map(|p| cx.list(p)).collect(),
+                            loc,
+                        }
+                    }),
+                    base: cx.opt(f.base),
+                })
+                .collect(),
+            closed: p.closed,
+        })
+        .collect();
+    Ok(Source {
+        file: file.to_string(),
+        name: cx.src(raw.name),
+        kanji: raw.kanji,
+        kind: raw.kind.map(|k| cx.src(k)),
+        description: raw.description,
+        aliases: raw.aliases,
+        extends: raw.extends.map(|e| cx.src(e)),
+        is_abstract: raw.is_abstract,
+        height: cx.opt(raw.height),
+        params: nums(raw.params),
+        attributes: nums(raw.attributes),
+        derived: raw
+            .derived
+            .into_iter()
+            .map(|(k, v)| (k, cx.text(v)))
+            .collect(),
+        materials: raw
+            .materials
+            .into_iter()
+            .map(|(k, v)| (k, cx.src(v)))
+            .collect(),
+        checks: raw
+            .check
+            .into_iter()
+            .map(|c| (cx.text(c.expr), c.reason))
+            .collect(),
+        parts,
+    })
+}
+
+/// `child` on top of the template it extends: its params, attributes and derived values
+/// replace those of the same name, its parts replace parts of the same name and are added
+/// after the others, and whatever it leaves out comes from `base`.
+pub fn merge(base: &Source, child: &Source) -> Source {
+    fn over<T: Clone>(base: &[(String, T)], child: &[(String, T)]) -> Vec<(String, T)> {
+        let mut out: Vec<(String, T)> = base
+            .iter()
+            .filter(|(k, _)| !child.iter().any(|(c, _)| c == k))
+            .cloned()
+            .collect();
+        out.extend(child.iter().cloned());
+        out
+    }
+    let mut parts: Vec<PartSource> = base
+        .parts
+        .iter()
+        .map(|p| {
+            child
+                .parts
+                .iter()
+                .find(|c| c.name.value == p.name.value)
+                .unwrap_or(p)
+                .clone()
+        })
+        .collect();
+    parts.extend(
+        child
+            .parts
+            .iter()
+            .filter(|c| !base.parts.iter().any(|p| p.name.value == c.name.value))
+            .cloned(),
+    );
+    Source {
+        file: child.file.clone(),
+        name: child.name.clone(),
+        kanji: child.kanji.clone(),
+        kind: child.kind.clone().or_else(|| base.kind.clone()),
+        description: child.description.clone(),
+        aliases: child.aliases.clone(),
+        extends: None,
+        is_abstract: child.is_abstract,
+        height: child.height.clone().or_else(|| base.height.clone()),
+        params: over(&base.params, &child.params),
+        attributes: over(&base.attributes, &child.attributes),
+        derived: over(&base.derived, &child.derived),
+        materials: over(&base.materials, &child.materials),
+        checks: base.checks.iter().chain(&child.checks).cloned().collect(),
+        parts,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn locations_are_line_and_column() {
+        let text = "name = \"x\"\n[params]\nwidth2 = 3\n[derived]\nd = \"width2 * 2\"\n";
+        let s = parse("t.toml", text).unwrap();
+        assert_eq!(s.derived[0].1.loc.0, "t.toml:5:5");
+        assert_eq!(s.derived[0].1.value, "width2 * 2");
+        assert_eq!(s.params[0].1.value, 3.0);
+    }
+
+    #[test]
+    fn numbers_become_float_text() {
+        let s = parse("t.toml", "name = \"x\"\nheight = 7\n[derived]\na = 2.5\n").unwrap();
+        assert_eq!(s.height.unwrap().value, "7");
+        assert_eq!(s.derived[0].1.value, "2.5");
+    }
+
+    #[test]
+    fn toml_errors_point_at_the_line() {
+        let e = parse("t.toml", "name = \"x\"\nbogus = 1\n").unwrap_err();
+        assert!(e.starts_with("t.toml:2:1:"), "{e}");
+        let e = parse("t.toml", "name = \"x\"\n[[part]]\nname = \"p\"\ntop = [\n").unwrap_err();
+        assert!(e.starts_with("t.toml:4:"), "{e}");
+    }
+}

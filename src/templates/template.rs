@@ -1,0 +1,545 @@
+//! A compiled template: every expression resolved to slots, every material to its id, checked
+//! once when the catalog loads so that a build never starts with a broken template.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+use super::expr::{compile, Expr, Lot};
+use super::file::{Loc, OutlineSource, PartSource, Source, Src, Text};
+use crate::generate::materials;
+
+/// What a template models; `type_mix` may name only machiya.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Kind {
+    Machiya,
+    Kura,
+    Fence,
+    Gate,
+    Tree,
+    Person,
+}
+
+impl Kind {
+    pub const ALL: [(&'static str, Kind); 6] = [
+        ("machiya", Kind::Machiya),
+        ("kura", Kind::Kura),
+        ("fence", Kind::Fence),
+        ("gate", Kind::Gate),
+        ("tree", Kind::Tree),
+        ("person", Kind::Person),
+    ];
+    pub fn name(self) -> &'static str {
+        Kind::ALL.iter().find(|k| k.1 == self).map_or("", |k| k.0)
+    }
+}
+
+/// The values every template gets, in slot order. `u` runs along the frontage from its first
+/// vertex, `v` into the lot, `h` up from the ground; lengths are metres.
+pub const INPUTS: &[(&str, &str)] = &[
+    (
+        "width",
+        "frontage width: the frontage runs from u = 0 to u = width",
+    ),
+    (
+        "lot_depth",
+        "the lot's deepest point behind the frontage (largest v)",
+    ),
+    ("frontage_ax", "first frontage vertex, map x"),
+    ("frontage_ay", "first frontage vertex, map y"),
+    ("frontage_bx", "second frontage vertex, map x"),
+    ("frontage_by", "second frontage vertex, map y"),
+    ("centroid_x", "the lot's centroid, map x"),
+    ("centroid_y", "the lot's centroid, map y"),
+    ("ground", "ground elevation; h = 0 stands on it"),
+    (
+        "feature_id",
+        "the feature's id when it is a number, else -1",
+    ),
+    ("district", "the district's id when it is a number, else -1"),
+    (
+        "building_height",
+        "height of a footprint building from the data; 0 for a lot",
+    ),
+    ("machiya_depth", "machiya.depth of the parameter file"),
+    ("min_depth", "machiya.min_depth of the parameter file"),
+    (
+        "random",
+        "a number in [0, 1) fixed per feature by (seed, layer, feature id)",
+    ),
+];
+
+pub const N_INPUTS: usize = INPUTS.len();
+
+/// Slot of an input by name (for callers that fill inputs).
+pub fn input(name: &str) -> usize {
+    INPUTS
+        .iter()
+        .position(|i| i.0 == name)
+        .unwrap_or_else(|| panic!("no template input `{name}`"))
+}
+
+#[derive(Debug, Clone)]
+pub struct Template {
+    pub name: String,
+    pub kanji: String,
+    pub kind: Kind,
+    pub description: String,
+    pub aliases: Vec<String>,
+    /// The file the template was read from.
+    pub file: String,
+    pub is_abstract: bool,
+    /// Name of every slot: inputs, params, attributes, derived values, then `v`.
+    pub names: Vec<String>,
+    /// Default values of params and attributes (indexed by slot - N_INPUTS).
+    pub defaults: Vec<f64>,
+    pub params: Range<usize>,
+    pub attributes: Range<usize>,
+    /// Derived values in an order where each needs only earlier ones.
+    pub derived: Vec<(usize, Expr, Loc)>,
+    /// The slots of `u` and `v` (last two): the point a prism's `top` and `bottom` are
+    /// evaluated at.
+    pub v_slot: usize,
+    /// Conditions every feature must meet, with the reason given when one fails.
+    pub checks: Vec<(Expr, String)>,
+    /// The height the model declares (checked by tests against the mesh).
+    pub height: Option<(Expr, Loc)>,
+    pub parts: Vec<Part>,
+}
+
+#[derive(Debug, Clone)]
+pub struct Part {
+    pub name: String,
+    pub loc: Loc,
+    pub when: Option<Expr>,
+    pub shape: Shape,
+}
+
+#[derive(Debug, Clone)]
+pub enum Shape {
+    Prism(Box<Prism>),
+    Faces(Faces),
+}
+
+/// An outline (the lot, or a polygon of (u, v) points) cut to `v0 <= v <= v1` and
+/// `u0 <= u <= u1`, extruded from `bottom` to `top`, both functions of `v` that are linear
+/// between the `split` depths.
+#[derive(Debug, Clone)]
+pub struct Prism {
+    pub outline: Option<Vec<[Expr; 2]>>,
+    pub v0: Option<Expr>,
+    pub v1: Option<Expr>,
+    pub u0: Option<Expr>,
+    pub u1: Option<Expr>,
+    pub bottom: Expr,
+    pub top: Expr,
+    pub split: Vec<Expr>,
+    pub split_u: Vec<Expr>,
+    pub top_material: u16,
+    pub bottom_material: u16,
+    pub side_material: u16,
+    /// Walls on the front line `v = v0` with facade texture coordinates.
+    pub front_material: Option<u16>,
+    pub front_base: Expr,
+    pub front_height: Expr,
+    pub closed: bool,
+}
+
+/// Explicit vertices (u, v, h) and faces over them.
+#[derive(Debug, Clone)]
+pub struct Faces {
+    pub vertices: Vec<[Expr; 3]>,
+    pub faces: Vec<FaceSpec>,
+    pub closed: bool,
+}
+
+#[derive(Debug, Clone)]
+pub struct FaceSpec {
+    /// 0-based vertex indices (written 1-based in the file, like OBJ and the paper).
+    pub corners: Vec<usize>,
+    pub material: u16,
+    /// Texture coordinates per corner; `None` = projected onto the face, one repeat per `base`.
+    pub uv: Option<Vec<[Expr; 2]>>,
+    pub base: Expr,
+}
+
+fn err(loc: &Loc, msg: impl std::fmt::Display) -> String {
+    format!("{loc}: {msg}")
+}
+
+struct Names<'a> {
+    names: &'a [String],
+}
+
+impl Names<'_> {
+    fn compile(&self, t: &Text) -> Result<Expr, String> {
+        compile(&t.value, &|n| self.names.iter().position(|m| m == n)).map_err(|e| err(&t.loc, e))
+    }
+    fn opt(&self, t: &Option<Text>) -> Result<Option<Expr>, String> {
+        t.as_ref().map(|t| self.compile(t)).transpose()
+    }
+    fn or(&self, t: &Option<Text>, default: f64) -> Result<Expr, String> {
+        Ok(self.opt(t)?.unwrap_or(Expr::Const(default)))
+    }
+    fn pair(&self, p: &[Text], loc: &Loc) -> Result<[Expr; 2], String> {
+        match p {
+            [a, b] => Ok([self.compile(a)?, self.compile(b)?]),
+            _ => Err(err(loc, format!("a point needs 2 values, got {}", p.len()))),
+        }
+    }
+}
+
+/// Material slots of a template: slot name -> library material.
+type Slots<'a> = &'a [(String, Src<String>)];
+
+fn material(slots: Slots, m: &Option<Src<String>>, default: &str) -> Result<u16, String> {
+    match m {
+        None => Ok(materials::id(default)),
+        Some(m) => material_of(slots, m),
+    }
+}
+
+fn material_of(slots: Slots, m: &Src<String>) -> Result<u16, String> {
+    let m = slots
+        .iter()
+        .find(|(k, _)| *k == m.value)
+        .map_or(m, |(_, v)| v);
+    materials::find(&m.value).ok_or_else(|| {
+        err(
+            &m.loc,
+            format!(
+                "material `{}` is not in the texture library ({})",
+                m.value,
+                materials::names().join(", ")
+            ),
+        )
+    })
+}
+
+/// Compiles a template whose `extends` has been merged in.
+pub fn compile_template(s: &Source) -> Result<Template, String> {
+    let here = Loc(s.file.clone());
+    let kind = match &s.kind {
+        None => {
+            return Err(err(
+                &s.name.loc,
+                "`kind` is missing (machiya, kura, fence, gate, tree or person)",
+            ))
+        }
+        Some(k) => Kind::ALL
+            .iter()
+            .find(|(n, _)| *n == k.value)
+            .map(|x| x.1)
+            .ok_or_else(|| {
+                err(
+                    &k.loc,
+                    format!(
+                        "unknown kind `{}` (machiya, kura, fence, gate, tree or person)",
+                        k.value
+                    ),
+                )
+            })?,
+    };
+    // Slots: inputs, params, attributes, derived, v.
+    let mut names: Vec<String> = INPUTS.iter().map(|i| i.0.to_string()).collect();
+    let mut defaults = Vec::new();
+    let declare = |name: &str, loc: &Loc, names: &mut Vec<String>| -> Result<(), String> {
+        if name == "u" || name == "v" || name == "pi" || names.iter().any(|n| n == name) {
+            return Err(err(
+                loc,
+                format!(
+                    "`{name}` is already a name (an input, parameter, attribute or derived value)"
+                ),
+            ));
+        }
+        if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(err(
+                loc,
+                format!("`{name}`: names are letters, digits and `_`"),
+            ));
+        }
+        names.push(name.to_string());
+        Ok(())
+    };
+    let p0 = names.len();
+    for (k, v) in &s.params {
+        declare(k, &v.loc, &mut names)?;
+        defaults.push(v.value);
+    }
+    let a0 = names.len();
+    for (k, v) in &s.attributes {
+        declare(k, &v.loc, &mut names)?;
+        defaults.push(v.value);
+    }
+    let d0 = names.len();
+    for (k, v) in &s.derived {
+        declare(k, &v.loc, &mut names)?;
+    }
+    let u_slot = names.len();
+    names.push("u".into());
+    let v_slot = names.len();
+    names.push("v".into());
+    let scalar_names = Names {
+        names: &names[..u_slot],
+    };
+    let all = Names { names: &names };
+
+    // Derived values, ordered so each needs only earlier ones.
+    let mut pending: BTreeMap<usize, (Expr, Loc, Vec<usize>)> = BTreeMap::new();
+    for (i, (_, t)) in s.derived.iter().enumerate() {
+        let e = scalar_names.compile(t)?;
+        let mut deps = Vec::new();
+        e.slots(&mut deps);
+        deps.retain(|d| *d >= d0);
+        pending.insert(d0 + i, (e, t.loc.clone(), deps));
+    }
+    let mut derived = Vec::new();
+    let mut done = vec![false; names.len()];
+    while !pending.is_empty() {
+        let ready: Vec<usize> = pending
+            .iter()
+            .filter(|(_, (_, _, deps))| deps.iter().all(|d| done[*d]))
+            .map(|(k, _)| *k)
+            .collect();
+        if ready.is_empty() {
+            let cycle: Vec<&str> = pending.keys().map(|k| names[*k].as_str()).collect();
+            let loc = &pending.values().next().expect("not empty").1;
+            return Err(err(
+                loc,
+                format!(
+                    "derived values depend on each other in a cycle: {}",
+                    cycle.join(", ")
+                ),
+            ));
+        }
+        for k in ready {
+            let (e, loc, _) = pending.remove(&k).expect("listed");
+            done[k] = true;
+            derived.push((k, e, loc));
+        }
+    }
+
+    let height = match &s.height {
+        Some(t) => Some((scalar_names.compile(t)?, t.loc.clone())),
+        None => None,
+    };
+    for (k, m) in &s.materials {
+        material_of(&[], m).map_err(|e| format!("{e} (material slot `{k}`)"))?;
+    }
+    let checks = s
+        .checks
+        .iter()
+        .map(|(t, reason)| Ok((scalar_names.compile(t)?, reason.clone())))
+        .collect::<Result<Vec<_>, String>>()?;
+    let mut parts = Vec::new();
+    for p in &s.parts {
+        if parts.iter().any(|q: &Part| q.name == p.name.value) {
+            return Err(err(
+                &p.name.loc,
+                format!("a second part named `{}`", p.name.value),
+            ));
+        }
+        parts.push(compile_part(p, &scalar_names, &all, &s.materials)?);
+    }
+    if parts.is_empty() && !s.is_abstract {
+        return Err(err(&here, "the template has no `[[part]]`"));
+    }
+    Ok(Template {
+        name: s.name.value.clone(),
+        kanji: s.kanji.clone(),
+        kind,
+        description: s.description.clone(),
+        aliases: s.aliases.clone(),
+        file: s.file.clone(),
+        is_abstract: s.is_abstract,
+        defaults,
+        params: p0..a0,
+        attributes: a0..d0,
+        derived,
+        v_slot,
+        checks,
+        height,
+        parts,
+        names,
+    })
+}
+
+fn compile_part(p: &PartSource, scalar: &Names, all: &Names, slots: Slots) -> Result<Part, String> {
+    let loc = p.name.loc.clone();
+    let is_prism = p.top.is_some() || p.outline.is_some();
+    let is_faces = !p.vertices.is_empty() || !p.faces.is_empty();
+    let shape = match (is_prism, is_faces) {
+        (true, true) => return Err(err(&loc, "a part is either a prism (`top`, `outline`) or explicit `vertices` and `faces`, not both")),
+        (false, false) => return Err(err(&loc, "the part has neither `top` (a prism) nor `vertices` and `faces`")),
+        (true, false) => {
+            let top = p.top.as_ref().ok_or_else(|| err(&loc, "a prism needs `top`"))?;
+            let outline = match &p.outline {
+                None => None,
+                Some(Src { value: OutlineSource::Lot, .. }) => None,
+                Some(Src { value: OutlineSource::Unknown(n), loc }) => {
+                    return Err(err(loc, format!("outline `{n}`: give \"lot\" or a list of [u, v] points")))
+                }
+                Some(Src { value: OutlineSource::Points(pts), loc }) => {
+                    if pts.len() < 3 {
+                        return Err(err(loc, "an outline needs at least 3 points"));
+                    }
+                    Some(pts.iter().map(|pt| scalar.pair(pt, loc)).collect::<Result<_, _>>()?)
+                }
+            };
+            if p.front_material.is_some() && p.front_height.is_none() {
+                return Err(err(&loc, "`front_material` needs `front_height` (the height its texture spans)"));
+            }
+            Shape::Prism(Box::new(Prism {
+                outline,
+                v0: scalar.opt(&p.v0)?,
+                v1: scalar.opt(&p.v1)?,
+                u0: scalar.opt(&p.u0)?,
+                u1: scalar.opt(&p.u1)?,
+                bottom: all.or(&p.bottom, 0.0)?,
+                top: all.compile(top)?,
+                split: p.split.iter().map(|t| scalar.compile(t)).collect::<Result<_, _>>()?,
+                split_u: p.split_u.iter().map(|t| scalar.compile(t)).collect::<Result<_, _>>()?,
+                top_material: material(slots, &p.top_material, "kawara_roof")?,
+                bottom_material: material(slots, &p.bottom_material, "floor")?,
+                side_material: material(slots, &p.side_material, "shikkui_wall")?,
+                front_material: p.front_material.as_ref().map(|m| material_of(slots, m)).transpose()?,
+                front_base: scalar.or(&p.front_base, 1.818)?,
+                front_height: scalar.or(&p.front_height, 1.0)?,
+                closed: p.closed.unwrap_or(true),
+            }))
+        }
+        (false, true) => {
+            let vertices = p
+                .vertices
+                .iter()
+                .map(|v| match v.value.as_slice() {
+                    [a, b, c] => Ok([scalar.compile(a)?, scalar.compile(b)?, scalar.compile(c)?]),
+                    other => Err(err(&v.loc, format!("a vertex is [u, v, h], got {} values", other.len()))),
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            let mut faces = Vec::new();
+            for f in &p.faces {
+                if f.corners.value.len() < 3 {
+                    return Err(err(&f.corners.loc, "a face needs at least 3 corners"));
+                }
+                let mut corners = Vec::new();
+                for c in &f.corners.value {
+                    if c.value < 1 || c.value as usize > vertices.len() {
+                        return Err(err(&c.loc, format!("face corner {} is out of range: the part has vertices 1 to {}", c.value, vertices.len())));
+                    }
+                    corners.push(c.value as usize - 1);
+                }
+                let uv = match &f.uv {
+                    None => None,
+                    Some(uv) => {
+                        if uv.value.len() != corners.len() {
+                            return Err(err(&uv.loc, format!("{} texture coordinates for {} corners", uv.value.len(), corners.len())));
+                        }
+                        Some(uv.value.iter().map(|pt| scalar.pair(pt, &uv.loc)).collect::<Result<_, _>>()?)
+                    }
+                };
+                faces.push(FaceSpec {
+                    corners,
+                    material: material_of(slots, &f.material)?,
+                    uv,
+                    base: scalar.or(&f.base, 2.0)?,
+                });
+            }
+            Shape::Faces(Faces {
+                vertices,
+                faces,
+                closed: p.closed.unwrap_or(true),
+            })
+        }
+    };
+    Ok(Part {
+        name: p.name.value.clone(),
+        loc,
+        when: scalar.opt(&p.when)?,
+        shape,
+    })
+}
+
+impl Template {
+    /// Every scalar slot for one feature: the inputs, the params (defaults, then `overrides`),
+    /// the attributes (defaults, then the feature's own), then the derived values.
+    /// A derived value that is not a finite number is an error naming it.
+    pub fn evaluate(
+        &self,
+        inputs: &[f64; N_INPUTS],
+        overrides: &[(usize, f64)],
+        attributes: &[(String, f64)],
+        lot: &dyn Lot,
+    ) -> Result<Vec<f64>, String> {
+        let mut slots = vec![0.0; self.names.len()];
+        slots[..N_INPUTS].copy_from_slice(inputs);
+        slots[N_INPUTS..N_INPUTS + self.defaults.len()].copy_from_slice(&self.defaults);
+        for (k, v) in overrides {
+            slots[*k] = *v;
+        }
+        for (name, v) in attributes {
+            if let Some(k) = self
+                .attributes
+                .clone()
+                .find(|k| self.names[*k].eq_ignore_ascii_case(name))
+            {
+                slots[k] = *v;
+            }
+        }
+        for (k, e, loc) in &self.derived {
+            let x = e.eval(&slots, lot);
+            if !x.is_finite() {
+                return Err(format!(
+                    "template {}: `{}` ({loc}) is {x} for this feature",
+                    self.name, self.names[*k]
+                ));
+            }
+            slots[*k] = x;
+        }
+        for (e, reason) in &self.checks {
+            if e.eval(&slots, lot) == 0.0 {
+                return Err(self.fill(reason, &slots));
+            }
+        }
+        Ok(slots)
+    }
+
+    /// `reason` with every `{name}` replaced by that slot's value (2 decimals).
+    fn fill(&self, reason: &str, slots: &[f64]) -> String {
+        let mut out = String::new();
+        let mut rest = reason;
+        while let Some(i) = rest.find('{') {
+            out.push_str(&rest[..i]);
+            let after = &rest[i + 1..];
+            match after.find('}') {
+                Some(j) if self.slot(&after[..j]).is_some() => {
+                    let k = self.slot(&after[..j]).expect("checked");
+                    out.push_str(&format!("{:.2}", slots[k]));
+                    rest = &after[j + 1..];
+                }
+                _ => {
+                    out.push('{');
+                    rest = after;
+                }
+            }
+        }
+        out.push_str(rest);
+        out
+    }
+
+    /// The slot of a param or attribute name.
+    pub fn slot(&self, name: &str) -> Option<usize> {
+        self.names[..self.v_slot - 1].iter().position(|n| n == name)
+    }
+
+    /// Names of the params (what `[template.<name>]` may set).
+    pub fn param_names(&self) -> impl Iterator<Item = &str> {
+        self.names[self.params.clone()].iter().map(String::as_str)
+    }
+
+    /// Names of the attributes a feature may give.
+    pub fn attribute_names(&self) -> impl Iterator<Item = &str> {
+        self.names[self.attributes.clone()]
+            .iter()
+            .map(String::as_str)
+    }
+}
