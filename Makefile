@@ -2,7 +2,7 @@
 
 CARGO ?= cargo
 
-.PHONY: run test lint bench real textures fixtures clean
+.PHONY: run test lint bench real textures fixtures clean pictures
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
@@ -36,6 +36,10 @@ bench:
 ## Redraw the texture library (the PNGs are committed).
 textures:
 	$(CARGO) run --release --example make_textures
+
+## Render every template alone into docs/templates/ (needs f3d and xvfb-run).
+pictures:
+	scripts/render_templates.sh
 
 ## Regenerate the example data (lots.csv is written by hand on top of it).
 fixtures:

@@ -159,11 +159,12 @@ pub fn read_and_analyse(
 pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcome, BuildError> {
     let t0 = Instant::now();
     let catalog = load_catalog(&opts.params, opts.templates.as_deref())?;
+    let textures = output::texture_library(&opts.params.textures).map_err(BuildError::Config)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .build()
         .map_err(|e| BuildError::Config(format!("cannot start worker threads: {e}")))?;
-    pool.install(|| run(opts, &catalog, progress, t0))
+    pool.install(|| run(opts, &catalog, &textures, progress, t0))
 }
 
 fn write_err(path: &Path, source: std::io::Error) -> BuildError {
@@ -176,6 +177,7 @@ fn write_err(path: &Path, source: std::io::Error) -> BuildError {
 fn run(
     opts: &BuildOptions,
     catalog: &Catalog,
+    texture_set: &[output::Texture],
     progress: &dyn Progress,
     t0: Instant,
 ) -> Result<BuildOutcome, BuildError> {
@@ -199,7 +201,8 @@ fn run(
     for dir in [&opts.out, &tiles_dir, &opts.out.join("textures")] {
         output::atomic::remove_leftover_temporaries(dir);
     }
-    let textures = output::write_textures(&opts.out).map_err(|e| write_err(&opts.out, e))?;
+    let textures =
+        output::write_textures(&opts.out, texture_set).map_err(|e| write_err(&opts.out, e))?;
 
     let files = generate::LayerFiles {
         lots: opts

@@ -6,6 +6,7 @@
 //! See ARCHITECTURE.md for the codemap and the rules each stage keeps.
 
 pub mod analyse;
+pub mod author;
 pub mod build;
 pub mod compare;
 pub mod generate;

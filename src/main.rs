@@ -2,7 +2,7 @@
 //! Everything the user sees (progress bars, the summary, error context) lives here.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -129,6 +129,30 @@ enum Command {
     },
     /// Print the default parameter file (documented key by key).
     Params,
+    /// Build one template alone on a rectangular lot and write it as OBJ + MTL + textures,
+    /// for authoring templates; without a name, list the templates.
+    Template {
+        /// Template name (machiya type, kura, fence, tsuiji, gate, tree, person or your own).
+        name: Option<String>,
+        /// Frontage width of the site, metres (the u axis).
+        #[arg(long, default_value_t = 5.454)]
+        width: f64,
+        /// Depth of the site, metres (the v axis).
+        #[arg(long, default_value_t = 20.0)]
+        depth: f64,
+        /// The OBJ to write; its MTL and a textures/ directory go beside it.
+        #[arg(short, long, default_value = "template.obj")]
+        output: PathBuf,
+        /// Parameter file: its `[template.<name>]` values and texture set apply.
+        #[arg(short, long)]
+        params: Option<PathBuf>,
+        /// Directory of your own template files (added to the shipped ones).
+        #[arg(long)]
+        templates: Option<PathBuf>,
+        /// Set a template parameter, e.g. `--set eave_height=6.1` (repeatable).
+        #[arg(long = "set", value_name = "PARAM=VALUE")]
+        set: Vec<String>,
+    },
     /// Inspect a directory of shapefiles and write a starting parameter file with guesses.
     Init {
         /// The data directory.
@@ -427,6 +451,15 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", edo_city::params::DEFAULT_TOML);
             Ok(())
         }
+        Command::Template {
+            name,
+            width,
+            depth,
+            output,
+            params,
+            templates,
+            set,
+        } => template_command(name, width, depth, &output, params, templates, &set),
     }
 }
 
@@ -559,4 +592,96 @@ impl Progress for Bars {
         self.bar.disable_steady_tick();
         self.bar.finish_and_clear();
     }
+}
+
+/// `edo-city template`: list the templates, or build one alone.
+fn template_command(
+    name: Option<String>,
+    width: f64,
+    depth: f64,
+    output: &Path,
+    params: Option<PathBuf>,
+    templates: Option<PathBuf>,
+    set: &[String],
+) -> anyhow::Result<()> {
+    let params = match &params {
+        Some(p) => Params::from_path(p)?,
+        None => Params::default(),
+    };
+    let catalog = edo_city::build::load_catalog(&params, templates.as_deref())?;
+    let Some(name) = name else {
+        println!("template\tkind\tkanji\tfile\tparameters");
+        for t in catalog.templates.values() {
+            let kind = if t.is_abstract {
+                format!("{} (abstract)", t.kind.name())
+            } else {
+                t.kind.name().to_string()
+            };
+            println!(
+                "{}\t{kind}\t{}\t{}\t{}",
+                t.name,
+                t.kanji,
+                t.file,
+                t.param_names().join(" ")
+            );
+        }
+        return Ok(());
+    };
+    let t = match catalog
+        .get(&name)
+        .or_else(|| catalog.resolve(&name).and_then(|n| catalog.get(n)))
+    {
+        Some(t) => t,
+        None => anyhow::bail!(
+            "no template `{name}` (templates: {})",
+            catalog
+                .templates
+                .keys()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    let mut sets = Vec::new();
+    for s in set {
+        let (k, v) = s
+            .split_once('=')
+            .ok_or_else(|| anyhow::anyhow!("--set {s}: write PARAM=VALUE"))?;
+        let v: f64 = v
+            .trim()
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--set {s}: `{v}` is not a number"))?;
+        sets.push((k.trim().to_string(), v));
+    }
+    let alone = edo_city::author::build_alone(&catalog, t, width, depth, &params, &sets)
+        .map_err(anyhow::Error::msg)?;
+    let n =
+        edo_city::author::write(&alone, output, &params.textures).map_err(anyhow::Error::msg)?;
+    println!(
+        "{} ({}) on a {width} x {depth} m lot: {} vertices, {} faces, parts {}",
+        t.name,
+        t.kind.name(),
+        alone.mesh.positions.len(),
+        alone.mesh.faces.len(),
+        alone.parts.join(", ")
+    );
+    match alone.declared_height {
+        Some(h) => println!("height {:.3} m (declared {h:.3} m)", alone.top),
+        None => println!("height {:.3} m", alone.top),
+    }
+    println!(
+        "{}; wrote {} with its .mtl and {n} textures in {}",
+        if edo_city::author::is_closed(&alone.mesh) {
+            "closed shell"
+        } else {
+            "open surfaces (billboards or a fence panel)"
+        },
+        output.display(),
+        output
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join("textures")
+            .display()
+    );
+    Ok(())
 }

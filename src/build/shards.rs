@@ -286,11 +286,7 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     let mut merged = first.clone();
     merged.shard = None;
     merged.tiles = tiles.into_values().collect();
-    if dirs.len() > 1 {
-        let dir = target.join("textures");
-        std::fs::create_dir_all(&dir).map_err(|e| write_err(&dir, e))?;
-        crate::output::write_textures(target).map_err(|e| write_err(target, e))?;
-    }
+    // The first shard wrote the texture set its parameters chose into `target/textures`.
     let rep = write_manifest_and_report(target, &merged)?;
     // The whole city's plan, as a full build draws it (shards leave it to the merge).
     if draw_plan {

@@ -431,8 +431,14 @@ fn extrude(
                 .iter()
                 .map(|&p| {
                     let pos = mesh.vertex(frame, local.to_map(p), top(p));
+                    // Tile courses run along the eaves: texture x across the slope.
                     let (su, sv) = stretch(p);
-                    let uv = mesh.uv(p[0] * su / ROOF_TEXTURE_BASE, p[1] * sv / ROOF_TEXTURE_BASE);
+                    let (s, t) = if su > sv {
+                        (p[1], p[0] * su)
+                    } else {
+                        (p[0], p[1] * sv)
+                    };
+                    let uv = mesh.uv(s / ROOF_TEXTURE_BASE, t / ROOF_TEXTURE_BASE);
                     (pos, uv)
                 })
                 .collect();

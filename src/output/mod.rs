@@ -10,6 +10,7 @@ pub mod plan;
 pub mod report;
 pub mod text;
 
+use std::borrow::Cow;
 use std::path::Path;
 
 use sha2::{Digest, Sha256};
@@ -50,13 +51,58 @@ pub fn write_tile(
     ))
 }
 
-/// Copies the texture library to `<out>/textures/`.
-pub fn write_textures(out: &Path) -> std::io::Result<Vec<ManifestFile>> {
+/// One texture file: its name in `textures/` and its PNG bytes.
+pub type Texture = (&'static str, Cow<'static, [u8]>);
+
+/// The texture library: the shipped PNGs, each replaced by the file of the same name in the
+/// directory `set` when it has one (a scan of a painting, say). "" = the shipped set.
+/// Every replacement must be a readable PNG, and every PNG in `set` must replace one.
+pub fn texture_library(set: &str) -> Result<Vec<Texture>, String> {
+    let mut lib: Vec<Texture> = TEXTURES
+        .iter()
+        .map(|(n, b)| (*n, Cow::Borrowed(*b)))
+        .collect();
+    if set.is_empty() {
+        return Ok(lib);
+    }
+    let dir = Path::new(set);
+    let entries = std::fs::read_dir(dir).map_err(|e| {
+        format!(
+            "texture set {}: cannot read the directory: {e}",
+            dir.display()
+        )
+    })?;
+    let mut names: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.to_lowercase().ends_with(".png"))
+        .collect();
+    names.sort();
+    for name in names {
+        let path = dir.join(&name);
+        let Some(slot) = lib.iter_mut().find(|(n, _)| *n == name) else {
+            return Err(format!(
+                "texture set {}: {name} replaces no texture of the library (its files: {})",
+                dir.display(),
+                TEXTURES.iter().map(|t| t.0).collect::<Vec<_>>().join(", ")
+            ));
+        };
+        let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+            .map_err(|e| format!("{}: not a readable PNG: {e}", path.display()))?;
+        slot.1 = Cow::Owned(bytes);
+    }
+    Ok(lib)
+}
+
+/// Writes the texture library to `<out>/textures/`.
+pub fn write_textures(out: &Path, library: &[Texture]) -> std::io::Result<Vec<ManifestFile>> {
     let dir = out.join("textures");
     std::fs::create_dir_all(&dir)?;
-    TEXTURES
+    library
         .iter()
         .map(|(name, bytes)| {
+            let bytes: &[u8] = bytes;
             atomic::write_atomic(&dir.join(name), bytes)?;
             Ok(ManifestFile {
                 path: format!("textures/{name}"),

@@ -12,8 +12,13 @@ use crate::generate::materials::MATERIALS;
 
 /// MTL text listing every material; textures are referenced as `../textures/<file>`.
 pub fn mtl_text() -> String {
+    mtl_text_at("../textures/")
+}
+
+/// MTL text with textures referenced as `<prefix><file>`.
+pub fn mtl_text_at(prefix: &str) -> String {
     let mut s = format!(
-        "# edo-city {} materials; textures in ../textures/\n",
+        "# edo-city {} materials; textures in {prefix}\n",
         env!("CARGO_PKG_VERSION")
     );
     for m in MATERIALS {
@@ -28,10 +33,10 @@ pub fn mtl_text() -> String {
                 s.push_str("Ka 1.000 1.000 1.000\nKd 1.000 1.000 1.000\n");
                 let _ = writeln!(
                     s,
-                    "Ks 0.000 0.000 0.000\nd 1.0\nillum 1\nmap_Kd ../textures/{t}"
+                    "Ks 0.000 0.000 0.000\nd 1.0\nillum 1\nmap_Kd {prefix}{t}"
                 );
                 if m.alpha {
-                    let _ = writeln!(s, "map_d ../textures/{t}");
+                    let _ = writeln!(s, "map_d {prefix}{t}");
                 }
             }
             None => {

@@ -230,7 +230,7 @@ impl Catalog {
                             "parameter file: [{where_}template.{name}] sets `{k}`, which is not \
                              a parameter of {} (its parameters: {})",
                             t.file,
-                            t.param_names().collect::<Vec<_>>().join(", ")
+                            t.param_names().join(", ")
                         ))
                         })?;
                     if !v.is_finite() {

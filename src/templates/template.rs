@@ -531,9 +531,14 @@ impl Template {
         self.names[..self.v_slot - 1].iter().position(|n| n == name)
     }
 
-    /// Names of the params (what `[template.<name>]` may set).
-    pub fn param_names(&self) -> impl Iterator<Item = &str> {
-        self.names[self.params.clone()].iter().map(String::as_str)
+    /// Names of the params (what `[template.<name>]` may set), sorted.
+    pub fn param_names(&self) -> Vec<&str> {
+        let mut v: Vec<&str> = self.names[self.params.clone()]
+            .iter()
+            .map(String::as_str)
+            .collect();
+        v.sort_unstable();
+        v
     }
 
     /// Names of the attributes a feature may give.

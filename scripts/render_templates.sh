@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Renders every shipped template alone into docs/templates/<name>.png (run `make pictures`).
+# Needs f3d and xvfb-run (Debian: apt install f3d xvfb); the pictures are committed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=target/release/edo-city
+cargo build --release --quiet
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+render() { # name width depth camera-position focal-point
+    local name=$1 w=$2 d=$3 cam=$4 focus=$5
+    "$bin" template "$name" --width "$w" --depth "$d" -o "$work/$name.obj" >/dev/null
+    xvfb-run -a f3d "$work/$name.obj" --output "docs/templates/$name.png" \
+        --resolution 480,360 --camera-position="$cam" --camera-focal-point="$focus" \
+        --camera-view-up=0,1,0 --grid=0 --bg-color=0.85,0.87,0.9 >/dev/null 2>&1
+    echo "docs/templates/$name.png"
+}
+for t in hiraya naka-nikai-small naka-nikai-large sou-nikai sangai shimoutaya heitsuki kanban-gatera; do
+    render "$t" 5.454 20 -13,11,19 2.7,4,-5
+done
+render kura 4.5 6.5 -7,7,10 2.2,2.8,-3.2
+render fence 5.454 1 -3,3,7 2.7,0.9,0
+render tsuiji 5.454 1 -3,4,8 2.7,1.3,0
+render gate 3.03 1 -3,4,7 1.5,2,0
+render tree 1 1 -8,4,15 0,3.4,0
+render person 1 1 -1.5,1.5,3 0,0.8,0

@@ -1,0 +1,135 @@
+//! `edo-city template`: one template built alone on a rectangular site, for authoring.
+//!
+//! A historian editing a template wants to see it without building a city: this builds it
+//! on a `width` x `depth` lot facing a street along x, and writes an OBJ with its MTL and
+//! textures beside it, ready for Blender or a web viewer.
+
+use std::path::Path;
+
+use crate::generate::instance::{instantiate, Site};
+use crate::generate::mesh::{open_edges, Frame, Mesh};
+use crate::output::{atomic::write_atomic, mtl, obj, texture_library};
+use crate::params::Params;
+use crate::templates::template::{input, N_INPUTS};
+use crate::templates::{Catalog, Template};
+
+/// A template built alone.
+#[derive(Debug)]
+pub struct Alone {
+    pub mesh: Mesh,
+    /// The height the template declares, metres (None when it declares none).
+    pub declared_height: Option<f64>,
+    /// The highest point of the mesh, metres.
+    pub top: f64,
+    /// Names of the parts whose `when` held.
+    pub parts: Vec<String>,
+}
+
+/// The inputs of a rectangle `width` x `depth` at the origin, frontage along x.
+pub fn rectangle_inputs(width: f64, depth: f64, params: &Params) -> [f64; N_INPUTS] {
+    let mut x = [0.0; N_INPUTS];
+    for (name, value) in [
+        ("width", width),
+        ("lot_depth", depth),
+        ("frontage_bx", width),
+        ("centroid_x", width / 2.0),
+        ("centroid_y", depth / 2.0),
+        ("feature_id", -1.0),
+        ("district", -1.0),
+        ("machiya_depth", params.machiya.depth),
+        ("min_depth", params.machiya.min_depth),
+        ("random", 0.5),
+    ] {
+        x[input(name)] = value;
+    }
+    x
+}
+
+/// Builds template `t` on a `width` x `depth` rectangle with the parameter file's values for
+/// it, then `sets` (param name, value) on top.
+pub fn build_alone(
+    catalog: &Catalog,
+    t: &Template,
+    width: f64,
+    depth: f64,
+    params: &Params,
+    sets: &[(String, f64)],
+) -> Result<Alone, String> {
+    if !(width > 0.0 && depth > 0.0 && width.is_finite() && depth.is_finite()) {
+        return Err(format!(
+            "the site must be positive, got {width} x {depth} m"
+        ));
+    }
+    let mut overrides = catalog.overrides(&t.name, None);
+    for (k, v) in sets {
+        let slot = t
+            .params
+            .clone()
+            .find(|s| t.names[*s] == *k)
+            .ok_or_else(|| {
+                format!(
+                    "--set {k}: {} has no parameter `{k}` (its parameters: {})",
+                    t.name,
+                    t.param_names().join(", ")
+                )
+            })?;
+        overrides.push((slot, *v));
+    }
+    let site = Site::rectangle(width, depth);
+    let slots = t.evaluate(
+        &rectangle_inputs(width, depth, params),
+        &overrides,
+        &[],
+        &site,
+    )?;
+    let mut mesh = Mesh::new(t.name.clone());
+    instantiate(t, &slots, &site, Frame { origin: [0.0, 0.0] }, &mut mesh)?;
+    let parts = t
+        .parts
+        .iter()
+        .filter(|p| p.when.as_ref().is_none_or(|w| w.eval(&slots, &site) != 0.0))
+        .map(|p| p.name.clone())
+        .collect();
+    let top = mesh.positions.iter().map(|p| p[1]).max().unwrap_or(0) as f64 / 1000.0;
+    Ok(Alone {
+        declared_height: t.height.as_ref().map(|(e, _)| e.eval(&slots, &site)),
+        mesh: mesh.finish(),
+        top,
+        parts,
+    })
+}
+
+/// Writes `<stem>.obj`, `<stem>.mtl` and `textures/` into the OBJ's directory.
+pub fn write(alone: &Alone, obj_path: &Path, texture_set: &str) -> Result<usize, String> {
+    let stem = obj_path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| !s.is_empty())
+        .ok_or_else(|| format!("{}: give a file name ending in .obj", obj_path.display()))?;
+    let dir = obj_path.parent().unwrap_or(Path::new(""));
+    let io = |p: &Path, e: std::io::Error| format!("cannot write {}: {e}", p.display());
+    let textures = texture_library(texture_set)?;
+    let tex_dir = dir.join("textures");
+    std::fs::create_dir_all(&tex_dir).map_err(|e| io(&tex_dir, e))?;
+    for (name, bytes) in &textures {
+        let p = tex_dir.join(name);
+        write_atomic(&p, bytes).map_err(|e| io(&p, e))?;
+    }
+    let mut buf = Vec::new();
+    obj::write_tile(
+        &mut buf,
+        stem,
+        [0.0, 0.0],
+        std::slice::from_ref(&alone.mesh),
+    );
+    write_atomic(obj_path, &buf).map_err(|e| io(obj_path, e))?;
+    let mtl_path = dir.join(format!("{stem}.mtl"));
+    write_atomic(&mtl_path, mtl::mtl_text_at("textures/").as_bytes())
+        .map_err(|e| io(&mtl_path, e))?;
+    Ok(textures.len())
+}
+
+/// True when every edge of the mesh is shared by two faces (for the summary line).
+pub fn is_closed(mesh: &Mesh) -> bool {
+    open_edges(mesh).is_empty()
+}
