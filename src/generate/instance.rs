@@ -13,7 +13,7 @@ use geo_types::Coord;
 use super::clip::{
     area, clip_band, clip_band_u, dedup, extent_at, is_convex, LocalPoly, LocalRing,
 };
-use super::mesh::{open_edges, Frame, Mesh};
+use super::mesh::{open_edges_of, Frame, Mesh};
 use crate::templates::expr::{Expr, Lot};
 use crate::templates::template::{FaceSpec, Faces, Prism, Shape};
 use crate::templates::Template;
@@ -104,24 +104,24 @@ pub fn instantiate(
                 continue;
             }
         }
-        let mut piece = Mesh::new(String::new());
+        // Parts share the mesh's vertices; each part's own faces must close on themselves.
+        let first_face = mesh.faces.len();
         let closed = match &part.shape {
             Shape::Prism(p) => {
-                prism(t, p, &part.name, site, frame, &cell, &scalar, &mut piece)?;
+                prism(t, p, &part.name, site, frame, &cell, &scalar, mesh)?;
                 p.closed
             }
             Shape::Faces(f) => {
-                faces(f, &part.name, site, frame, &scalar, &mut piece)?;
+                faces(f, &part.name, site, frame, &scalar, mesh)?;
                 f.closed
             }
         };
-        if closed && !open_edges(&piece).is_empty() {
+        if closed && !open_edges_of(&mesh.faces[first_face..]).is_empty() {
             return Err(format!(
                 "template {}: part `{}` ({}) is not a closed shell on this lot",
                 t.name, part.name, part.loc
             ));
         }
-        mesh.append(&piece);
     }
     Ok(())
 }

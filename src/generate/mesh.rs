@@ -87,42 +87,6 @@ impl Mesh {
         }
     }
 
-    /// Adds every face of `other` (a mesh in the same frame), sharing equal positions.
-    pub fn append(&mut self, other: &Mesh) {
-        let pos: Vec<u32> = other
-            .positions
-            .iter()
-            .map(|&key| {
-                let next = self.positions.len() as u32;
-                *self.pos_index.entry(key).or_insert_with(|| {
-                    self.positions.push(key);
-                    next
-                })
-            })
-            .collect();
-        let uv: Vec<u32> = other
-            .uvs
-            .iter()
-            .map(|&key| {
-                let next = self.uvs.len() as u32;
-                *self.uv_index.entry(key).or_insert_with(|| {
-                    self.uvs.push(key);
-                    next
-                })
-            })
-            .collect();
-        for f in &other.faces {
-            self.faces.push(Face {
-                material: f.material,
-                corners: f
-                    .corners
-                    .iter()
-                    .map(|&(p, t)| (pos[p as usize], uv[t as usize]))
-                    .collect(),
-            });
-        }
-    }
-
     /// Releases the lookup tables once the mesh is complete.
     pub fn finish(mut self) -> Mesh {
         self.pos_index = HashMap::new();
@@ -140,8 +104,13 @@ pub fn mm(v: f64) -> i64 {
 /// oriented (watertight) mesh. An edge used twice each way is allowed: a lot whose outline
 /// touches itself at a point (a pinch) gives a house whose shell meets itself there.
 pub fn open_edges(mesh: &Mesh) -> Vec<(u32, u32)> {
+    open_edges_of(&mesh.faces)
+}
+
+/// [`open_edges`] of some of a mesh's faces (one part of a model).
+pub fn open_edges_of(faces: &[Face]) -> Vec<(u32, u32)> {
     let mut count: HashMap<(u32, u32), i32> = HashMap::new();
-    for f in &mesh.faces {
+    for f in faces {
         let n = f.corners.len();
         for i in 0..n {
             let (a, b) = (f.corners[i].0, f.corners[(i + 1) % n].0);
