@@ -333,3 +333,59 @@ fn a_texture_set_replaces_textures_by_name() {
     assert!(String::from_utf8_lossy(&run.stderr).contains("not a readable PNG"));
     assert!(!out2.exists());
 }
+
+#[test]
+fn the_worked_example_of_docs_templates_md_builds() {
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/templates.md"))
+            .unwrap();
+    let at = doc
+        .find("Save as `mydir/udatsu-ya.toml`")
+        .expect("the example is in the doc");
+    let start = doc[at..].find("```toml\n").unwrap() + at + "```toml\n".len();
+    let end = doc[start..].find("```").unwrap() + start;
+    let dir = tempfile::tempdir().unwrap();
+    let mydir = dir.path().join("mydir");
+    std::fs::create_dir(&mydir).unwrap();
+    std::fs::write(mydir.join("udatsu-ya.toml"), &doc[start..end]).unwrap();
+    let obj = dir.path().join("udatsu.obj");
+    let out = edo_city()
+        .args(["template", "udatsu-ya", "--templates"])
+        .arg(&mydir)
+        .arg("-o")
+        .arg(&obj)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("udatsu_left, udatsu_right") && text.contains("closed shell"),
+        "{text}"
+    );
+    assert!(text.contains("height 8.900 m (declared 8.900 m)"), "{text}");
+    // And in a city: the parameter file names it in the mix.
+    let params = dir.path().join("p.toml");
+    std::fs::write(&params, "[type_mix]\nudatsu-ya = 1.0\n").unwrap();
+    let city = dir.path().join("city");
+    let r = build_ok(
+        &fixture("kyoto-small"),
+        &city,
+        &[
+            "--quiet",
+            "--no-plan",
+            "--templates",
+            mydir.to_str().unwrap(),
+            "--params",
+            params.to_str().unwrap(),
+        ],
+    );
+    assert!(
+        r["counts"]["by_type"]["udatsu-ya"].as_u64().unwrap() > 200,
+        "{}",
+        r["counts"]["by_type"]
+    );
+}
