@@ -389,3 +389,70 @@ fn the_worked_example_of_docs_templates_md_builds() {
         r["counts"]["by_type"]
     );
 }
+
+#[test]
+fn a_template_that_fails_on_a_lot_skips_that_lot_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let mydir = dir.path().join("t");
+    std::fs::create_dir(&mydir).unwrap();
+    // NaN on narrow lots only (sqrt of a negative number), an upside-down part on wide ones.
+    std::fs::write(
+        mydir.join("odd.toml"),
+        "name = \"odd\"\nextends = \"machiya\"\n[derived]\nodd_w = \"sqrt(width - 5.0)\"\n\
+         [[part]]\nname = \"upside_down\"\nwhen = \"odd_w > 1\"\nv0 = \"1\"\nv1 = \"2\"\n\
+         bottom = \"3\"\ntop = \"2\"\n",
+    )
+    .unwrap();
+    let params = dir.path().join("p.toml");
+    std::fs::write(&params, "[type_mix]\nodd = 1.0\n").unwrap();
+    let input = dir.path().join("in");
+    copy_fixture("kyoto-small", &input);
+    std::fs::remove_file(input.join("lots.csv")).unwrap();
+    // The fixture's DBF names types for some lots; those are built as named.
+    let out = dir.path().join("out");
+    let r = build_ok(
+        &input,
+        &out,
+        &[
+            "--quiet",
+            "--no-plan",
+            "--templates",
+            mydir.to_str().unwrap(),
+            "--params",
+            params.to_str().unwrap(),
+        ],
+    );
+    let skipped = r["skipped"].as_array().unwrap();
+    let nan = skipped
+        .iter()
+        .filter(|s| {
+            s["reason"].as_str().unwrap().contains("`odd_w` (")
+                && s["reason"].as_str().unwrap().contains("is NaN")
+        })
+        .count();
+    let upside = skipped
+        .iter()
+        .filter(|s| {
+            s["reason"]
+                .as_str()
+                .unwrap()
+                .contains("part `upside_down`: top 2.00 m is below bottom 3.00 m")
+        })
+        .count();
+    assert!(
+        nan > 0 && upside > 0,
+        "{nan} NaN, {upside} upside down: {}",
+        r["skipped_by_reason"]
+    );
+    let odd_built = r["counts"]["by_type"]["odd"].as_u64().unwrap_or(0);
+    assert!(odd_built > 0, "lots of 5-6 m frontage are built");
+    assert_eq!(
+        r["counts"]["lots"].as_u64().unwrap(),
+        r["counts"]["machiya"].as_u64().unwrap() + skipped.len() as u64 + 2,
+        "every lot is built or skipped (the 2 are the buke and jisha lots)"
+    );
+    for s in skipped {
+        assert_eq!(s["layer"], "lots");
+        assert!(s["file"].as_str().unwrap().ends_with("lots.shp"));
+    }
+}
