@@ -93,6 +93,8 @@ pub struct BuildOptions {
 pub struct Timings {
     pub read: Duration,
     pub analyse: Duration,
+    /// Of `analyse`: kura placement, the R-tree of provisional plots and its queries.
+    pub kura: Duration,
     pub generate_and_write: Duration,
     /// Drawing plan.png.
     pub plan: Duration,
@@ -118,6 +120,18 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
     });
     let mut catalog = Catalog::load(dir.as_deref())?;
     catalog.configure(&params.template, &params.district_templates())?;
+    if params.kura.enabled {
+        let k = &params.kura.template;
+        if catalog
+            .get(k)
+            .is_none_or(|t| t.kind != Kind::Kura || t.is_abstract)
+        {
+            return Err(BuildError::Config(format!(
+                "kura.template names `{k}`, which is not a kura template (kura templates: {})",
+                catalog.names_of(Kind::Kura).join(", ")
+            )));
+        }
+    }
     for name in params.type_mix.keys() {
         if catalog.machiya(name).is_none() {
             return Err(BuildError::Config(format!(
@@ -186,6 +200,7 @@ fn run(
     let (data, plan, read, analysed) = read_and_analyse(&opts.input, params, catalog, progress)?;
     timings.read = read;
     timings.analyse = analysed;
+    timings.kura = plan.kura_time;
     // After reading (a mistyped input is reported as that), before writing anything.
     shards::check_out_dir(opts)?;
 

@@ -305,9 +305,10 @@ fn run(cli: Cli) -> Result<()> {
             if timings {
                 let t = &outcome.timings;
                 eprintln!(
-                    "timings: read {:.3} s, analyse {:.3} s, generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, total {:.3} s",
+                    "timings: read {:.3} s, analyse {:.3} s (kura plots and R-tree {:.3} s), generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, total {:.3} s",
                     t.read.as_secs_f64(),
                     t.analyse.as_secs_f64(),
+                    t.kura.as_secs_f64(),
                     t.generate_and_write.as_secs_f64(),
                     t.generate_cpu.as_secs_f64(),
                     t.write_cpu.as_secs_f64(),
@@ -523,6 +524,7 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
         "  frontage fallback {:>3}  (no vertex pair passed the Fig.4 test)",
         c.frontage_fallback
     );
+    print_table2(r, opts.params.kura.enabled, opts.params.kura.collision);
     println!(
         "  tiles      {:>7}  ({} written now, {:.1} MB)",
         c.tiles,
@@ -551,6 +553,47 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
         );
     }
     println!("  in {:.2} s", o.timings.total.as_secs_f64());
+}
+
+/// The paper's Table 2 beside this build's figures.
+fn print_table2(r: &edo_city::output::report::Report, enabled: bool, avoid: bool) {
+    let (t, p) = (&r.table2.all, &r.table2.paper);
+    if !enabled {
+        println!("  kura             0  (kura.enabled = false)");
+        return;
+    }
+    println!(
+        "  kura       {:>7}  built ({} avoidance); Table 2:",
+        r.counts.kura,
+        if avoid { "with" } else { "without" }
+    );
+    println!("                          this build          paper (all Kyoto)");
+    println!(
+        "    machiya              {:>7}             {:>7}",
+        t.machiya, p.machiya
+    );
+    println!(
+        "    kura candidates      {:>7}  {:5.1} %",
+        t.kura_candidates,
+        100.0 * t.kura_candidates as f64 / t.machiya.max(1) as f64
+    );
+    println!(
+        "    without avoidance    {:>7}  {:5.1} %    {:>7}  {:5.1} %",
+        t.kura_without_avoidance,
+        100.0 * t.ratio_without,
+        p.kura_without_avoidance,
+        100.0 * p.ratio_without
+    );
+    println!(
+        "    with avoidance       {:>7}  {:5.1} %    {:>7}  {:5.1} %   (painting: {} / {} = {:.1} %)",
+        t.kura_with_avoidance,
+        100.0 * t.ratio_with,
+        p.kura_with_avoidance,
+        100.0 * p.ratio_with,
+        p.painting_kura,
+        p.painting_machiya,
+        100.0 * p.painting_ratio
+    );
 }
 
 /// indicatif bars, one per stage, drawn on stderr only when it is a terminal.

@@ -198,6 +198,68 @@ pub struct PlannedMachiya {
     pub height: Option<f64>,
     /// The feature's numeric attributes that its template declares (`[attributes]`).
     pub attrs: Vec<(String, f64)>,
+    /// Its kura, as section 4.2 decided.
+    pub kura: KuraDecision,
+}
+
+/// What section 4.2 decided for a machiya's kura (蔵). A rectangle is `[u0, v0, u1, v1]` in
+/// the machiya's frontage frame (u along the street, v into the lot).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum KuraDecision {
+    /// Frontage narrower than `kura.min_frontage` or lot shallower than `kura.depth_ratio`
+    /// times it (or a footprint building).
+    #[default]
+    NotCandidate,
+    /// A candidate with no room for a kura behind its house.
+    NoRoom,
+    /// The kura fits, but its provisional plot overlaps another machiya's: built only with
+    /// `kura.collision = false`.
+    Collides([f64; 4]),
+    /// The kura fits and its plot overlaps no other.
+    Clear([f64; 4]),
+}
+
+impl KuraDecision {
+    pub fn is_candidate(&self) -> bool {
+        !matches!(self, KuraDecision::NotCandidate)
+    }
+    /// The kura's rectangle when it fits (whether or not it collides).
+    pub fn rect(&self) -> Option<[f64; 4]> {
+        match self {
+            KuraDecision::Collides(r) | KuraDecision::Clear(r) => Some(*r),
+            _ => None,
+        }
+    }
+    /// The rectangle of the kura to build, given whether collisions are avoided.
+    pub fn to_build(&self, avoid: bool) -> Option<[f64; 4]> {
+        match self {
+            KuraDecision::Clear(r) => Some(*r),
+            KuraDecision::Collides(r) if !avoid => Some(*r),
+            _ => None,
+        }
+    }
+}
+
+/// The paper's Table 2 counts for a set of machiya.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct KuraCounts {
+    /// Machiya built.
+    pub machiya: usize,
+    /// Of them, candidates for a kura (frontage and depth rule).
+    pub candidates: usize,
+    /// Kura that fit: what is built without collision avoidance.
+    pub without_avoidance: usize,
+    /// Kura that fit and whose plots collide with no other: built with avoidance.
+    pub with_avoidance: usize,
+}
+
+impl KuraCounts {
+    pub fn add(&mut self, o: &KuraCounts) {
+        self.machiya += o.machiya;
+        self.candidates += o.candidates;
+        self.without_avoidance += o.without_avoidance;
+        self.with_avoidance += o.with_avoidance;
+    }
 }
 
 impl PlannedMachiya {
@@ -222,6 +284,8 @@ pub struct Plan {
     pub footprints: usize,
     pub skipped: Vec<Skipped>,
     pub warnings: Vec<String>,
+    /// Time spent placing kura and testing their provisional plots (for `--timings`).
+    pub kura_time: std::time::Duration,
 }
 
 /// What generation found in one tile.
@@ -233,5 +297,11 @@ pub struct TileStats {
     pub footprints_by_type: BTreeMap<String, usize>,
     pub by_district: BTreeMap<String, usize>,
     pub type_given: usize,
+    /// Kura built.
+    #[serde(default)]
+    pub kura: usize,
+    /// Table 2 counts per district ("" = none).
+    #[serde(default)]
+    pub kura_counts: BTreeMap<String, KuraCounts>,
     pub skipped: Vec<Skipped>,
 }

@@ -47,11 +47,12 @@ pub struct Params {
     pub layers: Layers,
     pub frontage: FrontageParams,
     pub machiya: MachiyaParams,
+    pub kura: KuraParams,
     /// Relative weights of the machiya types drawn for lots of unknown type.
     pub type_mix: BTreeMap<String, f64>,
     /// Directory of textures that replace the shipped ones by file name (a texture set, as
-    /// the paper compared texture libraries); "" = the shipped set. Relative to the
-    /// parameter file's directory when read from a file.
+    /// the paper compared texture libraries); "" = the shipped set. Relative to the working
+    /// directory.
     #[serde(default)]
     pub textures: String,
     /// Template parameter values: `[template.<name>] <param> = <number>`.
@@ -230,6 +231,36 @@ pub struct MachiyaParams {
     pub templates: String,
 }
 
+/// Kura (蔵) storehouses behind wide, deep machiya, section 4.2 of the paper.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KuraParams {
+    /// Build kura at all.
+    pub enabled: bool,
+    /// Template of the kura.
+    pub template: String,
+    /// Candidates: frontage at least this (3 ken = 5.454 m: the paper's sign of wealth) ...
+    pub min_frontage: f64,
+    /// ... and a lot at least this many times as deep as its frontage is wide.
+    pub depth_ratio: f64,
+    /// Size of a kura: along the street, and into the lot.
+    pub width: f64,
+    pub depth: f64,
+    /// A narrow or short lot shrinks its kura down to these; below them it gets none.
+    pub min_width: f64,
+    pub min_depth: f64,
+    /// Open ground between the back of the house and the kura (a courtyard).
+    pub gap: f64,
+    /// Distance of the kura from the back and the sides of the lot.
+    pub back_margin: f64,
+    pub side_margin: f64,
+    /// Collision avoidance of Fig.7: a kura whose provisional plot overlaps another plot is
+    /// not built. false = the paper's "without avoidance" column.
+    pub collision: bool,
+    /// Plots overlapping by less than this area (m2) do not collide (touching plots never do).
+    pub overlap_tolerance: f64,
+}
+
 impl Default for Params {
     fn default() -> Self {
         // The shipped file is the single source of the defaults; a unit test parses it.
@@ -279,7 +310,12 @@ impl Params {
             path: path.to_string(),
             message,
         };
+        let k = &self.kura;
         let positive = [
+            ("kura.width", k.width),
+            ("kura.depth", k.depth),
+            ("kura.min_width", k.min_width),
+            ("kura.min_depth", k.min_depth),
             ("tile_size", self.tile_size),
             ("frontage.min_length", self.frontage.min_length),
             ("machiya.depth", self.machiya.depth),
@@ -294,6 +330,24 @@ impl Params {
                     "`{key}` must be a positive number, got {value}"
                 )));
             }
+        }
+        for (key, value) in [
+            ("kura.min_frontage", k.min_frontage),
+            ("kura.depth_ratio", k.depth_ratio),
+            ("kura.gap", k.gap),
+            ("kura.back_margin", k.back_margin),
+            ("kura.side_margin", k.side_margin),
+            ("kura.overlap_tolerance", k.overlap_tolerance),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(bad(format!("`{key}` must be 0 or more, got {value}")));
+            }
+        }
+        if k.min_width > k.width || k.min_depth > k.depth {
+            return Err(bad(
+                "`kura.min_width` / `kura.min_depth` must not exceed `kura.width` / `kura.depth`"
+                    .into(),
+            ));
         }
         if !(self.machiya.min_depth.is_finite() && self.machiya.min_depth >= 0.0) {
             return Err(bad("`machiya.min_depth` must be 0 or more".into()));
@@ -447,6 +501,7 @@ mod partial {
         layers: Option<Layers>,
         frontage: Option<Frontage>,
         machiya: Option<Machiya>,
+        kura: Option<Kura>,
         type_mix: Option<BTreeMap<String, f64>>,
         textures: Option<String>,
         template: Option<BTreeMap<String, BTreeMap<String, f64>>>,
@@ -562,6 +617,24 @@ mod partial {
         depth: Option<f64>,
         min_depth: Option<f64>,
         templates: Option<String>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Kura {
+        enabled: Option<bool>,
+        template: Option<String>,
+        min_frontage: Option<f64>,
+        depth_ratio: Option<f64>,
+        width: Option<f64>,
+        depth: Option<f64>,
+        min_width: Option<f64>,
+        min_depth: Option<f64>,
+        gap: Option<f64>,
+        back_margin: Option<f64>,
+        side_margin: Option<f64>,
+        collision: Option<bool>,
+        overlap_tolerance: Option<f64>,
     }
 }
 

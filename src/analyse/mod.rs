@@ -2,6 +2,7 @@
 //! frontage, type and tile. No I/O; every random choice through [`crate::rng`].
 
 pub mod frontage;
+pub mod kura;
 pub mod street;
 pub mod tiling;
 
@@ -59,8 +60,21 @@ pub fn analyse(
         .par_iter()
         .map(|f| plan_footprint(f, &edges, rule, params, catalog))
         .collect();
+    let mut outcomes = outcomes;
+    let mut fp_outcomes = fp_outcomes;
+    let t = std::time::Instant::now();
+    let mut planned: Vec<&mut PlannedMachiya> = outcomes
+        .iter_mut()
+        .chain(fp_outcomes.iter_mut())
+        .filter_map(|o| match o {
+            Outcome::Planned(m, _) => Some(&mut **m),
+            Outcome::Skipped(_) => None,
+        })
+        .collect();
+    kura::decide(&mut planned, catalog, params);
     let mut plan = Plan {
         origin,
+        kura_time: t.elapsed(),
         ..Plan::default()
     };
     plan.footprints = fp_outcomes
@@ -158,6 +172,7 @@ fn plan_lot(
             ground: lot.ground,
             height: None,
             attrs,
+            kura: Default::default(),
         }),
         warnings,
     )
@@ -243,6 +258,7 @@ fn plan_footprint(
             ground: f.ground,
             height: Some(f.height),
             attrs: Vec::new(),
+            kura: Default::default(),
         }),
         warnings,
     )

@@ -364,6 +364,7 @@ mod tests {
             ground: 0.0,
             height: None,
             attrs: Vec::new(),
+            kura: Default::default(),
         };
         let mut plan = Plan::default();
         for (id, n) in counts {

@@ -191,6 +191,7 @@ mod tests {
             ground: 0.0,
             height: None,
             attrs: Vec::new(),
+            kura: Default::default(),
         }
     }
 

@@ -5,11 +5,12 @@
 
 pub mod clip;
 pub mod instance;
+pub mod kura;
 pub mod machiya;
 pub mod materials;
 pub mod mesh;
 
-use crate::model::{PlannedMachiya, Skipped, TileStats};
+use crate::model::{KuraDecision, PlannedMachiya, Skipped, TileStats};
 use crate::params::Params;
 use crate::templates::Catalog;
 use mesh::{Frame, Mesh};
@@ -45,6 +46,11 @@ pub fn generate_tile(
 ) -> TileMeshes {
     let frame = Frame { origin };
     let mut out = TileMeshes::default();
+    let kura_template = params
+        .kura
+        .enabled
+        .then(|| catalog.get(&params.kura.template))
+        .flatten();
     for m in lots {
         let layer = if m.height.is_some() {
             "footprints"
@@ -59,35 +65,53 @@ pub fn generate_tile(
             }
             None => Err(format!("machiya type `{}` has no template", m.mtype)),
         };
-        match result {
+        let (file, skipped) = match m.height {
+            None => (&files.lots, "lots"),
+            Some(_) => (&files.footprints, "footprints"),
+        };
+        let skip = |reason: String| Skipped {
+            layer: skipped.into(),
+            file: file.clone(),
+            id: m.id.clone(),
+            reason,
+        };
+        let mesh = match result {
+            Ok(mesh) => mesh,
+            Err(reason) => {
+                out.stats.skipped.push(skip(reason));
+                continue;
+            }
+        };
+        out.meshes.push(mesh);
+        let st = &mut out.stats;
+        let district = m.district.clone().unwrap_or_default();
+        let by_type = if m.height.is_some() {
+            st.footprints += 1;
+            &mut st.footprints_by_type
+        } else {
+            st.machiya += 1;
+            st.type_given += m.type_given as usize;
+            let k = st.kura_counts.entry(district.clone()).or_default();
+            k.machiya += 1;
+            k.candidates += m.kura.is_candidate() as usize;
+            k.without_avoidance += m.kura.rect().is_some() as usize;
+            k.with_avoidance += matches!(m.kura, KuraDecision::Clear(_)) as usize;
+            &mut st.by_type
+        };
+        *by_type.entry(m.mtype.clone()).or_default() += 1;
+        *st.by_district.entry(district).or_default() += 1;
+        // Its kura, in the same tile: the plan decided it for the whole city at once.
+        let (Some(rect), Some(t)) = (m.kura.to_build(params.kura.collision), kura_template) else {
+            continue;
+        };
+        let overrides = catalog.overrides(&t.name, m.district.as_deref());
+        let random = template_random(params.seed, "kura", &m.id);
+        match kura::build(m, rect, t, &overrides, &params.machiya, random, frame) {
             Ok(mesh) => {
                 out.meshes.push(mesh);
-                let st = &mut out.stats;
-                let by_type = if m.height.is_some() {
-                    st.footprints += 1;
-                    &mut st.footprints_by_type
-                } else {
-                    st.machiya += 1;
-                    st.type_given += m.type_given as usize;
-                    &mut st.by_type
-                };
-                *by_type.entry(m.mtype.clone()).or_default() += 1;
-                *st.by_district
-                    .entry(m.district.clone().unwrap_or_default())
-                    .or_default() += 1;
+                out.stats.kura += 1;
             }
-            Err(reason) => {
-                let (layer, file) = match m.height {
-                    None => ("lots", &files.lots),
-                    Some(_) => ("footprints", &files.footprints),
-                };
-                out.stats.skipped.push(Skipped {
-                    layer: layer.into(),
-                    file: file.clone(),
-                    id: m.id.clone(),
-                    reason,
-                })
-            }
+            Err(reason) => out.stats.skipped.push(skip(format!("its kura: {reason}"))),
         }
     }
     out

@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 pub use crate::model::TileStats;
-use crate::model::{LayerInfo, Skipped, TableJoin};
+use crate::model::{KuraCounts, LayerInfo, Skipped, TableJoin};
 use crate::params::Params;
 
 #[derive(Debug, Clone, Default, Serialize)]
@@ -35,7 +35,80 @@ pub struct Counts {
     /// Lots where no pair passed the Fig.4 test and the nearest edge was taken.
     pub frontage_fallback: usize,
     pub tiles: usize,
+    /// Kura (storehouses) built.
+    pub kura: usize,
     pub skipped: usize,
+}
+
+/// The paper's Table 2: kura per machiya, without and with collision avoidance.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Table2 {
+    pub machiya: usize,
+    pub kura_candidates: usize,
+    pub kura_without_avoidance: usize,
+    pub kura_with_avoidance: usize,
+    /// kura / machiya.
+    pub ratio_without: f64,
+    pub ratio_with: f64,
+}
+
+impl Table2 {
+    fn of(c: &KuraCounts) -> Table2 {
+        let ratio = |k: usize| {
+            if c.machiya == 0 {
+                0.0
+            } else {
+                // Four decimals keep report.json stable and readable.
+                (k as f64 / c.machiya as f64 * 10_000.0).round() / 10_000.0
+            }
+        };
+        Table2 {
+            machiya: c.machiya,
+            kura_candidates: c.candidates,
+            kura_without_avoidance: c.without_avoidance,
+            kura_with_avoidance: c.with_avoidance,
+            ratio_without: ratio(c.without_avoidance),
+            ratio_with: ratio(c.with_avoidance),
+        }
+    }
+}
+
+/// Table 2 for the whole city and per district ("" = lots without a district).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Table2Report {
+    #[serde(flatten)]
+    pub all: Table2,
+    pub by_district: BTreeMap<String, Table2>,
+    /// The paper's figures, for comparison.
+    pub paper: PaperTable2,
+}
+
+/// Table 2 of Kosaka et al. 2008: all of Kyoto, and the Rakuchu-rakugai-zu screen.
+#[derive(Debug, Clone, Serialize)]
+pub struct PaperTable2 {
+    pub machiya: usize,
+    pub kura_without_avoidance: usize,
+    pub kura_with_avoidance: usize,
+    pub ratio_without: f64,
+    pub ratio_with: f64,
+    pub painting_machiya: usize,
+    pub painting_kura: usize,
+    pub painting_ratio: f64,
+}
+
+impl Default for PaperTable2 {
+    fn default() -> Self {
+        PaperTable2 {
+            machiya: 30_052,
+            kura_without_avoidance: 16_664,
+            kura_with_avoidance: 2_824,
+            ratio_without: 0.554,
+            ratio_with: 0.094,
+            painting_machiya: 236,
+            painting_kura: 33,
+            painting_ratio: 0.140,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Default, Serialize)]
@@ -47,6 +120,7 @@ pub struct Report {
     pub crs: String,
     pub layers: Vec<LayerInfo>,
     pub counts: Counts,
+    pub table2: Table2Report,
     /// Every feature left out, with file, id and reason.
     pub skipped: Vec<Skipped>,
     pub skipped_by_reason: BTreeMap<String, usize>,
@@ -138,8 +212,15 @@ pub fn assemble_report(m: &Manifest) -> Report {
             *to.entry(k.clone()).or_default() += v;
         }
     };
+    let mut kura_all = KuraCounts::default();
+    let mut kura_by_district: BTreeMap<String, KuraCounts> = BTreeMap::new();
     for t in &m.tiles {
         let s = &t.stats;
+        c.kura += s.kura;
+        for (d, k) in &s.kura_counts {
+            kura_all.add(k);
+            kura_by_district.entry(d.clone()).or_default().add(k);
+        }
         c.machiya += s.machiya;
         c.footprints += s.footprints;
         c.type_given += s.type_given;
@@ -154,6 +235,15 @@ pub fn assemble_report(m: &Manifest) -> Report {
             obj_bytes: t.obj.bytes,
         });
     }
+    r.table2 = Table2Report {
+        all: Table2::of(&kura_all),
+        by_district: kura_by_district
+            .iter()
+            .map(|(d, k)| (d.clone(), Table2::of(k)))
+            .collect(),
+        paper: PaperTable2::default(),
+    };
+    let c = &mut r.counts;
     c.type_drawn = c.machiya.saturating_sub(c.type_given);
     c.tiles = m.tiles.len();
     c.skipped = r.skipped.len();

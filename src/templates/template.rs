@@ -526,6 +526,18 @@ impl Template {
         out
     }
 
+    /// A param's value with the parameter file's `overrides` (the last one wins).
+    pub fn param(&self, overrides: &[(usize, f64)], name: &str) -> Option<f64> {
+        let slot = self.params.clone().find(|s| self.names[*s] == name)?;
+        Some(
+            overrides
+                .iter()
+                .rev()
+                .find(|(k, _)| *k == slot)
+                .map_or(self.defaults[slot - N_INPUTS], |(_, v)| *v),
+        )
+    }
+
     /// The slot of a param or attribute name.
     pub fn slot(&self, name: &str) -> Option<usize> {
         self.names[..self.v_slot - 1].iter().position(|n| n == name)
