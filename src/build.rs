@@ -308,7 +308,7 @@ fn run(
     if opts.plan_image {
         let grid = (params.tile_size, params.tile_origin);
         let image = output::plan::View::fit(&data, None)
-            .and_then(|view| output::plan::draw_plan(&data, &plan, &view, grid));
+            .and_then(|view| output::plan::draw_plan(&data, &plan, &view, grid, kura_view(params)));
         if let Some(png) = image {
             let path = opts.out.join("plan.png");
             output::atomic::write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
@@ -402,8 +402,14 @@ pub fn draw_plan_of(out: &Path, tile: Option<&str>) -> Result<Vec<u8>, BuildErro
     };
     let grid = (params.tile_size, params.tile_origin);
     output::plan::View::fit(&data, bounds)
-        .and_then(|view| output::plan::draw_plan(&data, &plan, &view, grid))
+        .and_then(|view| output::plan::draw_plan(&data, &plan, &view, grid, kura_view(params)))
         .ok_or_else(|| BuildError::Config("nothing to draw: no lots or footprints".into()))
+}
+
+/// How plan.png shows kura: not at all, or built ones filled and (with avoidance) refused
+/// ones outlined.
+fn kura_view(params: &Params) -> Option<bool> {
+    params.kura.enabled.then_some(params.kura.collision)
 }
 
 /// The input-wide part of the report.

@@ -46,6 +46,8 @@ pub struct Comparison {
     pub totals: Vec<Row>,
     pub by_type: Vec<Row>,
     pub by_district: Vec<Row>,
+    /// The paper's Table 2 for both builds.
+    pub table2: Vec<Row>,
     pub tiles: TileDiff,
 }
 
@@ -126,6 +128,7 @@ pub fn compare(dir_a: &Path, dir_b: &Path) -> Result<Comparison, BuildError> {
             ca.frontage_fallback,
             cb.frontage_fallback,
         ),
+        ("kura", ca.kura, cb.kura),
         ("skipped", ca.skipped, cb.skipped),
         ("tiles", ca.tiles, cb.tiles),
     ]
@@ -163,6 +166,30 @@ pub fn compare(dir_a: &Path, dir_b: &Path) -> Result<Comparison, BuildError> {
         totals,
         by_type: rows(&ca.by_type, &cb.by_type),
         by_district: rows(&ca.by_district, &cb.by_district),
+        table2: {
+            let (ta, tb) = (&ra.table2.all, &rb.table2.all);
+            [
+                ("machiya", ta.machiya, tb.machiya),
+                ("kura candidates", ta.kura_candidates, tb.kura_candidates),
+                (
+                    "without avoidance",
+                    ta.kura_without_avoidance,
+                    tb.kura_without_avoidance,
+                ),
+                (
+                    "with avoidance",
+                    ta.kura_with_avoidance,
+                    tb.kura_with_avoidance,
+                ),
+            ]
+            .into_iter()
+            .map(|(n, a, b)| Row {
+                name: n.into(),
+                a,
+                b,
+            })
+            .collect()
+        },
         tiles,
     })
 }
@@ -189,6 +216,7 @@ pub fn render(c: &Comparison) -> String {
     table(&mut s, "counts", &c.totals);
     table(&mut s, "machiya by type", &c.by_type);
     table(&mut s, "houses by district", &c.by_district);
+    table(&mut s, "kura (Table 2)", &c.table2);
     let t = &c.tiles;
     let list = |v: &[String]| {
         if v.is_empty() {

@@ -94,3 +94,50 @@ fn merchant_and_craftsman_towns_differ_where_their_parameters_do() {
         "{text}"
     );
 }
+
+#[test]
+fn kura_with_and_without_avoidance_compare_as_the_papers_table_2() {
+    let work = tempfile::tempdir().unwrap();
+    let (a, b) = (work.path().join("with"), work.path().join("without"));
+    let off = work.path().join("off.toml");
+    std::fs::write(&off, "[kura]\ncollision = false\n").unwrap();
+    build_ok(&fixture("kyoto-small"), &a, &["--quiet", "--no-plan"]);
+    build_ok(
+        &fixture("kyoto-small"),
+        &b,
+        &["--quiet", "--no-plan", "--params", off.to_str().unwrap()],
+    );
+    let out = edo_city().arg("compare").arg(&a).arg(&b).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("kura.collision"), "{text}");
+    assert!(text.contains("kura (Table 2)"), "{text}");
+    let out = edo_city()
+        .args(["compare", "--json"])
+        .arg(&a)
+        .arg(&b)
+        .output()
+        .unwrap();
+    let c: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let row = |table: &str, name: &str| {
+        let r = c[table]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["name"] == name)
+            .unwrap_or_else(|| panic!("{table}/{name}"))
+            .clone();
+        (r["a"].as_u64().unwrap(), r["b"].as_u64().unwrap())
+    };
+    let (with_a, with_b) = row("table2", "with avoidance");
+    let (without_a, without_b) = row("table2", "without avoidance");
+    assert_eq!(
+        (with_a, without_a),
+        (with_b, without_b),
+        "the table is the same"
+    );
+    let (kura_a, kura_b) = row("totals", "kura");
+    assert_eq!(kura_a, with_a, "A built the avoided set");
+    assert_eq!(kura_b, without_b, "B built every kura that fits");
+    assert!(kura_b > kura_a, "the fixture has colliding plots");
+}

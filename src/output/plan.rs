@@ -32,6 +32,8 @@ pub const FOOTPRINT: [u8; 3] = [140, 155, 175];
 pub const SKIPPED: [u8; 3] = [220, 90, 80];
 pub const OTHER_USE: [u8; 3] = [200, 215, 190];
 pub const FRONTAGE: [u8; 3] = [200, 30, 30];
+pub const KURA: [u8; 3] = [70, 70, 78];
+pub const KURA_REFUSED: [u8; 3] = [235, 120, 30];
 
 /// What the image shows and how metres map to pixels.
 #[derive(Debug, Clone, Copy)]
@@ -141,11 +143,14 @@ fn polygon_path(view: &View, poly: &Polygon<f64>) -> Option<tiny_skia::Path> {
 }
 
 /// Draws the plan; `None` when there is nothing to draw. `tile_grid` = (size, origin).
+/// `kura`: `None` when kura are off, else whether collisions are avoided (then the refused
+/// kura are outlined in red).
 pub fn draw_plan(
     data: &Dataset,
     plan: &Plan,
     view: &View,
     tile_grid: (f64, [f64; 2]),
+    kura: Option<bool>,
 ) -> Option<Vec<u8>> {
     let (w, h) = view.size();
     let mut pm = Pixmap::new(w, h)?;
@@ -203,6 +208,37 @@ pub fn draw_plan(
             pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin, id, None);
         }
     }
+    let mut refused_any = false;
+    if let Some(avoid) = kura {
+        let refused = Stroke {
+            width: 1.5,
+            ..Stroke::default()
+        };
+        for m in plan.tiles.values().flatten() {
+            let Some(r) = m.kura.rect() else { continue };
+            let (u, v, a) = (m.frontage.u_axis(), m.frontage.v_axis(), m.frontage.a);
+            let at = |p: [f64; 2]| Coord {
+                x: a.x + p[0] * u.x + p[1] * v.x,
+                y: a.y + p[0] * u.y + p[1] * v.y,
+            };
+            let ring = [
+                at([r[0], r[1]]),
+                at([r[2], r[1]]),
+                at([r[2], r[3]]),
+                at([r[0], r[3]]),
+                at([r[0], r[1]]),
+            ];
+            let Some(path) = line_path(view, &ring) else {
+                continue;
+            };
+            if m.kura.to_build(avoid).is_some() {
+                pm.fill_path(&path, &paint(KURA, 255), FillRule::EvenOdd, id, None);
+            } else {
+                refused_any = true;
+                pm.stroke_path(&path, &paint(KURA_REFUSED, 255), &refused, id, None);
+            }
+        }
+    }
     // Centrelines on top: in cadastral data the roads are parcels too and hide the bands.
     for street in &data.streets {
         if let Some(path) = line_path(view, &street.line.0) {
@@ -220,7 +256,11 @@ pub fn draw_plan(
     }
     draw_tile_grid(&mut pm, view, plan, tile_grid);
     draw_scale_bar(&mut pm, view);
-    draw_legend(&mut pm, &colours, !data.footprints.is_empty());
+    let kura_rows = match kura {
+        Some(_) => 1 + usize::from(refused_any),
+        None => 0,
+    };
+    draw_legend(&mut pm, &colours, !data.footprints.is_empty(), kura_rows);
     encode_png(&pm)
 }
 
@@ -323,10 +363,24 @@ fn draw_scale_bar(pm: &mut Pixmap, view: &View) {
     draw_text(pm, x, y - 20.0, &format!("{metres} m"), 2, [30, 30, 30]);
 }
 
-fn draw_legend(pm: &mut Pixmap, colours: &BTreeMap<String, [u8; 3]>, footprints: bool) {
+fn draw_legend(
+    pm: &mut Pixmap,
+    colours: &BTreeMap<String, [u8; 3]>,
+    footprints: bool,
+    kura_rows: usize,
+) {
     let mut rows: Vec<(String, [u8; 3])> = colours.iter().map(|(t, c)| (t.clone(), *c)).collect();
     if footprints {
         rows.push(("footprint".into(), FOOTPRINT));
+    }
+    for (name, colour) in [
+        ("kura", KURA),
+        ("kura refused (plots collide)", KURA_REFUSED),
+    ]
+    .into_iter()
+    .take(kura_rows)
+    {
+        rows.push((name.into(), colour));
     }
     rows.push(("other use".into(), OTHER_USE));
     rows.push(("skipped".into(), SKIPPED));
