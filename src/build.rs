@@ -132,10 +132,16 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
             )));
         }
     }
-    for name in params.type_mix.keys() {
+    let mixes = std::iter::once(("type_mix".to_string(), &params.type_mix)).chain(
+        params
+            .district
+            .iter()
+            .filter_map(|(id, d)| Some((format!("district.{id}.type_mix"), d.type_mix.as_ref()?))),
+    );
+    for (key, name) in mixes.flat_map(|(key, mix)| mix.keys().map(move |n| (key.clone(), n))) {
         if catalog.machiya(name).is_none() {
             return Err(BuildError::Config(format!(
-                "type_mix names `{name}`, which has no machiya template (known types: {})",
+                "{key} names `{name}`, which has no machiya template (known types: {})",
                 catalog.names_of(Kind::Machiya).join(", ")
             )));
         }

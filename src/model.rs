@@ -95,6 +95,11 @@ pub struct LayerInfo {
     /// The layer's CRS as a proj string, or how it was assumed.
     pub crs: String,
     pub reprojected: bool,
+    /// Vertices read and left after generalisation (`simplify.tolerance`).
+    #[serde(default)]
+    pub vertices_before: usize,
+    #[serde(default)]
+    pub vertices_after: usize,
 }
 
 /// A street centreline with its full width in metres.
@@ -297,6 +302,10 @@ pub struct TileStats {
     pub footprints_by_type: BTreeMap<String, usize>,
     pub by_district: BTreeMap<String, usize>,
     pub type_given: usize,
+    /// Types drawn from a type mix (not given by the data), per district: to check a
+    /// district's mix against its parameter.
+    #[serde(default)]
+    pub drawn_by_district: BTreeMap<String, BTreeMap<String, usize>>,
     /// Kura built.
     #[serde(default)]
     pub kura: usize,

@@ -48,6 +48,7 @@ pub struct Params {
     pub frontage: FrontageParams,
     pub machiya: MachiyaParams,
     pub kura: KuraParams,
+    pub simplify: SimplifyParams,
     /// Relative weights of the machiya types drawn for lots of unknown type.
     pub type_mix: BTreeMap<String, f64>,
     /// Directory of textures that replace the shipped ones by file name (a texture set, as
@@ -67,12 +68,24 @@ pub struct Params {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DistrictParams {
+    /// The type mix drawn from for this district's lots of unknown type, replacing
+    /// `type_mix` there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub type_mix: Option<BTreeMap<String, f64>>,
     /// Template parameter values in this district, on top of `[template.<name>]`.
     #[serde(default)]
     pub template: BTreeMap<String, BTreeMap<String, f64>>,
 }
 
 impl Params {
+    /// The type mix of a district: its own, else `type_mix`.
+    pub fn type_mix_of(&self, district: Option<&str>) -> &BTreeMap<String, f64> {
+        district
+            .and_then(|d| self.district.get(d))
+            .and_then(|d| d.type_mix.as_ref())
+            .unwrap_or(&self.type_mix)
+    }
+
     /// `[district.<id>.template...]` of every district, as the catalog takes them.
     pub fn district_templates(&self) -> BTreeMap<String, BTreeMap<String, BTreeMap<String, f64>>> {
         self.district
@@ -231,6 +244,15 @@ pub struct MachiyaParams {
     pub templates: String,
 }
 
+/// Vertex generalisation before analysis (section 2.2 of the paper).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimplifyParams {
+    /// A vertex within this distance (metres) of the line through its neighbours is removed
+    /// from outlines and lines; 0 = keep every vertex.
+    pub tolerance: f64,
+}
+
 /// Kura (蔵) storehouses behind wide, deep machiya, section 4.2 of the paper.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -338,6 +360,7 @@ impl Params {
             ("kura.back_margin", k.back_margin),
             ("kura.side_margin", k.side_margin),
             ("kura.overlap_tolerance", k.overlap_tolerance),
+            ("simplify.tolerance", self.simplify.tolerance),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(bad(format!("`{key}` must be 0 or more, got {value}")));
@@ -386,16 +409,25 @@ impl Params {
                 )));
             }
         }
-        if self.type_mix.is_empty() {
-            return Err(bad("`type_mix` lists no machiya type".into()));
-        }
-        for (name, w) in &self.type_mix {
-            if !(w.is_finite() && *w >= 0.0) {
-                return Err(bad(format!("`type_mix.{name}` must be 0 or more, got {w}")));
+        let check_mix = |key: &str, mix: &BTreeMap<String, f64>| {
+            if mix.is_empty() {
+                return Err(bad(format!("`{key}` lists no machiya type")));
             }
-        }
-        if self.type_mix.values().sum::<f64>() <= 0.0 {
-            return Err(bad("`type_mix` weights add up to 0".into()));
+            for (name, w) in mix {
+                if !(w.is_finite() && *w >= 0.0) {
+                    return Err(bad(format!("`{key}.{name}` must be 0 or more, got {w}")));
+                }
+            }
+            if mix.values().sum::<f64>() <= 0.0 {
+                return Err(bad(format!("`{key}` weights add up to 0")));
+            }
+            Ok(())
+        };
+        check_mix("type_mix", &self.type_mix)?;
+        for (id, d) in &self.district {
+            if let Some(mix) = &d.type_mix {
+                check_mix(&format!("district.{id}.type_mix"), mix)?;
+            }
         }
         Ok(())
     }
@@ -502,6 +534,7 @@ mod partial {
         frontage: Option<Frontage>,
         machiya: Option<Machiya>,
         kura: Option<Kura>,
+        simplify: Option<Simplify>,
         type_mix: Option<BTreeMap<String, f64>>,
         textures: Option<String>,
         template: Option<BTreeMap<String, BTreeMap<String, f64>>>,
@@ -511,6 +544,7 @@ mod partial {
     #[serde(deny_unknown_fields)]
     #[allow(dead_code)]
     struct District {
+        type_mix: Option<BTreeMap<String, f64>>,
         template: Option<BTreeMap<String, BTreeMap<String, f64>>>,
     }
     #[derive(Deserialize)]
@@ -617,6 +651,12 @@ mod partial {
         depth: Option<f64>,
         min_depth: Option<f64>,
         templates: Option<String>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Simplify {
+        tolerance: Option<f64>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]

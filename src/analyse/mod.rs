@@ -143,7 +143,7 @@ fn plan_lot(
     });
     let (mtype, type_given) = match given {
         Some(t) => (t.to_string(), true),
-        None => (draw_type(params, &lot.id), false),
+        None => (draw_type(params, &lot.id, lot.district.as_deref()), false),
     };
     let computed = || tiling::tile_id(centroid, params.tile_size, params.tile_origin);
     let tile = match lot.tile.as_deref() {
@@ -266,19 +266,18 @@ fn plan_footprint(
 
 /// Draws a type from `type_mix` with the lot's own RNG (the paper: "when a lot's type is
 /// unknown, one of the types is drawn at random").
-pub fn draw_type(params: &Params, id: &str) -> String {
-    let total: f64 = params.type_mix.values().sum();
+pub fn draw_type(params: &Params, id: &str, district: Option<&str>) -> String {
+    let mix = params.type_mix_of(district);
+    let total: f64 = mix.values().sum();
     let mut r = feature_rng(params.seed, "lots/mtype", id).random::<f64>() * total;
-    for (name, w) in &params.type_mix {
+    for (name, w) in mix {
         if r < *w {
             return name.clone();
         }
         r -= w;
     }
     // Rounding left r at the very top: the last type with a weight.
-    params
-        .type_mix
-        .iter()
+    mix.iter()
         .rev()
         .find(|(_, w)| **w > 0.0)
         .map(|(n, _)| n.clone())
@@ -310,7 +309,7 @@ mod tests {
         let p = Params::default();
         let n = 20_000;
         let hiraya = (0..n)
-            .filter(|i| draw_type(&p, &i.to_string()) == "hiraya")
+            .filter(|i| draw_type(&p, &i.to_string(), None) == "hiraya")
             .count();
         let share = hiraya as f64 / n as f64;
         // Table 1: 86 / 236 = 36.4 %.
@@ -320,6 +319,6 @@ mod tests {
     #[test]
     fn a_draw_depends_only_on_seed_and_id() {
         let p = Params::default();
-        assert_eq!(draw_type(&p, "17"), draw_type(&p, "17"));
+        assert_eq!(draw_type(&p, "17", None), draw_type(&p, "17", None));
     }
 }

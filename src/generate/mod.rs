@@ -91,6 +91,13 @@ pub fn generate_tile(
         } else {
             st.machiya += 1;
             st.type_given += m.type_given as usize;
+            if !m.type_given {
+                *st.drawn_by_district
+                    .entry(district.clone())
+                    .or_default()
+                    .entry(m.mtype.clone())
+                    .or_default() += 1;
+            }
             let k = st.kura_counts.entry(district.clone()).or_default();
             k.machiya += 1;
             k.candidates += m.kura.is_candidate() as usize;

@@ -10,6 +10,7 @@ pub mod crs;
 pub mod fields;
 pub mod geometry;
 pub mod shp;
+pub mod simplify;
 pub mod table;
 pub mod widths;
 
@@ -292,6 +293,8 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
                 .map(|c| c.definition.clone())
                 .unwrap_or_else(|| "unknown (no .prj)".into()),
             reprojected: o.reproject,
+            vertices_before: 0,
+            vertices_after: 0,
         });
     }
 
@@ -346,6 +349,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             dir.join(&l.streets.file).display()
         )));
     }
+    simplify::generalise(&mut data, params.simplify.tolerance);
     Ok(data)
 }
 

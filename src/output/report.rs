@@ -32,6 +32,8 @@ pub struct Counts {
     pub type_drawn: usize,
     /// Houses (machiya and footprints) per district; "" = no district.
     pub by_district: BTreeMap<String, usize>,
+    /// Machiya types drawn from the type mix (not given by the data), per district.
+    pub drawn_by_district: BTreeMap<String, BTreeMap<String, usize>>,
     /// Lots where no pair passed the Fig.4 test and the nearest edge was taken.
     pub frontage_fallback: usize,
     pub tiles: usize,
@@ -227,6 +229,9 @@ pub fn assemble_report(m: &Manifest) -> Report {
         add(&mut c.by_type, &s.by_type);
         add(&mut c.footprints_by_type, &s.footprints_by_type);
         add(&mut c.by_district, &s.by_district);
+        for (d, types) in &s.drawn_by_district {
+            add(c.drawn_by_district.entry(d.clone()).or_default(), types);
+        }
         r.skipped.extend(s.skipped.iter().cloned());
         r.tiles.push(TileReport {
             id: t.id.clone(),
