@@ -40,18 +40,23 @@ const MAX_RUN: usize = 256;
 /// `tol` of the segment from the last kept vertex to the next. So a gently curved boundary
 /// digitised in short segments keeps its curve. The ends are kept. Linear in the points.
 fn reduce_open(pts: &[Coord<f64>], tol: f64) -> Vec<Coord<f64>> {
-    let Some((&first, rest)) = pts.split_first() else {
+    kept_indices(pts, tol).into_iter().map(|i| pts[i]).collect()
+}
+
+/// The indices of the vertices [`reduce_open`] keeps.
+fn kept_indices(pts: &[Coord<f64>], tol: f64) -> Vec<usize> {
+    if pts.is_empty() {
         return Vec::new();
-    };
-    let mut kept = vec![first];
-    let mut run: Vec<Coord<f64>> = Vec::new();
-    let mut cand: Option<Coord<f64>> = None;
-    for &p in rest {
+    }
+    let mut kept = vec![0];
+    let mut run: Vec<usize> = Vec::new();
+    let mut cand: Option<usize> = None;
+    for p in 1..pts.len() {
         if let Some(c) = cand {
-            let a = *kept.last().expect("starts with the first point");
+            let a = pts[*kept.last().expect("starts with the first point")];
             let droppable = run.len() < MAX_RUN
-                && deviation(a, c, p) <= tol
-                && run.iter().all(|&q| deviation(a, q, p) <= tol);
+                && deviation(a, pts[c], pts[p]) <= tol
+                && run.iter().all(|&q| deviation(a, pts[q], pts[p]) <= tol);
             if droppable {
                 run.push(c);
             } else {
@@ -79,11 +84,20 @@ fn reduce_ring(r: &LineString<f64>, tol: f64) -> LineString<f64> {
         })
         .unwrap_or(0);
     let rotated: Vec<Coord<f64>> = (0..=n).map(|k| pts[(start + k) % n]).collect();
-    let out = reduce_open(&rotated, tol);
-    if out.len() < 4 {
+    let mut kept: Vec<usize> = kept_indices(&rotated, tol)
+        .into_iter()
+        .map(|k| (start + k) % n)
+        .collect();
+    kept.pop(); // the start again, closing the ring
+    if kept.len() < 3 {
         // Fewer than 3 corners left: the ring was (nearly) a line; keep it as it was.
         return r.clone();
     }
+    // Back in the input's order from its first kept vertex, so that the same outline with
+    // other floating-point noise (a reprojected copy) keeps the same vertex order.
+    kept.sort_unstable();
+    let mut out: Vec<Coord<f64>> = kept.iter().map(|&i| pts[i]).collect();
+    out.push(out[0]);
     LineString(out)
 }
 
