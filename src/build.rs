@@ -120,6 +120,32 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
     });
     let mut catalog = Catalog::load(dir.as_deref())?;
     catalog.configure(&params.template, &params.district_templates())?;
+    if params.fence.enabled {
+        let f = &params.fence;
+        let named = f.types.values().chain([&f.default_type]);
+        for name in named {
+            if catalog
+                .get(name)
+                .is_none_or(|t| t.kind != Kind::Fence || t.is_abstract)
+            {
+                return Err(BuildError::Config(format!(
+                    "fence.types / fence.default_type name `{name}`, which is not a fence template \
+                     (fence templates: {})",
+                    catalog.names_of(Kind::Fence).join(", ")
+                )));
+            }
+        }
+        let g = &f.gate_template;
+        if catalog
+            .get(g)
+            .is_none_or(|t| t.kind != Kind::Gate || t.is_abstract)
+        {
+            return Err(BuildError::Config(format!(
+                "fence.gate_template names `{g}`, which is not a gate template (gate templates: {})",
+                catalog.names_of(Kind::Gate).join(", ")
+            )));
+        }
+    }
     if params.kura.enabled {
         let k = &params.kura.template;
         if catalog
@@ -249,7 +275,9 @@ fn run(
         .par_iter()
         .map(|(id, lots)| {
             let t = Instant::now();
-            let meshes = generate::generate_tile(lots, catalog, params, plan.origin, &files);
+            let fences = plan.fences.get(*id).map_or(&[][..], Vec::as_slice);
+            let meshes =
+                generate::generate_tile(lots, fences, catalog, params, plan.origin, &files);
             gen_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
             let t = Instant::now();
             let written = output::write_tile(&opts.out, id, plan.origin, &meshes.meshes)
@@ -354,7 +382,9 @@ pub fn check(
         .tiles
         .par_iter()
         .map(|(id, lots)| {
-            let meshes = generate::generate_tile(lots, &catalog, params, plan.origin, &files);
+            let fences = plan.fences.get(id).map_or(&[][..], Vec::as_slice);
+            let meshes =
+                generate::generate_tile(lots, fences, &catalog, params, plan.origin, &files);
             let none = report::ManifestFile {
                 path: String::new(),
                 bytes: 0,

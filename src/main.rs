@@ -525,6 +525,18 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
         c.frontage_fallback
     );
     print_table2(r, opts.params.kura.enabled, opts.params.kura.collision);
+    if c.fence_segments + c.gates > 0 {
+        println!(
+            "  fences     {:>7}  segments, {} gates; walls: {}",
+            c.fence_segments,
+            c.gates,
+            c.wall_metres
+                .iter()
+                .map(|(t, m)| format!("{t} {m:.0} m"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     println!(
         "  tiles      {:>7}  ({} written now, {:.1} MB)",
         c.tiles,

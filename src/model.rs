@@ -207,6 +207,38 @@ pub struct PlannedMachiya {
     pub kura: KuraDecision,
 }
 
+/// A wall segment or a gate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum FenceKind {
+    Wall,
+    Gate,
+}
+
+/// One fence segment or gate (section 4.3): the site of a fence or gate template, from `a` to
+/// `b` with the enclosed side on the left.
+#[derive(Debug, Clone)]
+pub struct PlannedFence {
+    /// The lot's (or fence line's) id.
+    pub id: String,
+    pub record: usize,
+    /// "lots" or "fences": the layer it came from.
+    pub layer: String,
+    pub template: String,
+    pub kind: FenceKind,
+    /// The edge of the outline (from 0) it stands on.
+    pub edge: usize,
+    pub a: Coord<f64>,
+    pub b: Coord<f64>,
+    /// Mitres at the two ends (cot of half the interior angle; 0 = a square end).
+    pub start_mitre: f64,
+    pub end_mitre: f64,
+    pub ground: f64,
+    pub district: Option<String>,
+    pub tile: TileId,
+    /// Numeric attributes for the template (`height`).
+    pub attrs: Vec<(String, f64)>,
+}
+
 /// What section 4.2 decided for a machiya's kura (蔵). A rectangle is `[u0, v0, u1, v1]` in
 /// the machiya's frontage frame (u along the street, v into the lot).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -291,6 +323,9 @@ pub struct Plan {
     pub warnings: Vec<String>,
     /// Time spent placing kura and testing their provisional plots (for `--timings`).
     pub kura_time: std::time::Duration,
+    /// Fence segments and gates per tile, in input order (a tile here always has an entry,
+    /// maybe empty, in `tiles`).
+    pub fences: BTreeMap<TileId, Vec<PlannedFence>>,
 }
 
 /// What generation found in one tile.
@@ -309,6 +344,14 @@ pub struct TileStats {
     /// Kura built.
     #[serde(default)]
     pub kura: usize,
+    /// Fence segments and gates built, and wall length per fence template in whole
+    /// millimetres (integers, so a manifest read back and written again is byte-identical).
+    #[serde(default)]
+    pub fence_segments: usize,
+    #[serde(default)]
+    pub gates: usize,
+    #[serde(default)]
+    pub wall_mm: BTreeMap<String, u64>,
     /// Table 2 counts per district ("" = none).
     #[serde(default)]
     pub kura_counts: BTreeMap<String, KuraCounts>,

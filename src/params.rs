@@ -49,6 +49,7 @@ pub struct Params {
     pub machiya: MachiyaParams,
     pub kura: KuraParams,
     pub simplify: SimplifyParams,
+    pub fence: FenceParams,
     /// Relative weights of the machiya types drawn for lots of unknown type.
     pub type_mix: BTreeMap<String, f64>,
     /// Directory of textures that replace the shipped ones by file name (a texture set, as
@@ -244,6 +245,27 @@ pub struct MachiyaParams {
     pub templates: String,
 }
 
+/// Fences and gates, section 4.3 of the paper.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FenceParams {
+    pub enabled: bool,
+    /// Lot uses walled along their whole outline.
+    pub uses: Vec<String>,
+    /// Fence template per lot use.
+    pub types: BTreeMap<String, String>,
+    /// Fence template of a walled lot whose use is not in `types`.
+    pub default_type: String,
+    pub gate_template: String,
+    /// Width of a gate, whatever the edge's length: 1 jo.
+    pub gate_width: f64,
+    /// Lot attributes: the fence template, the gate (1 = the edge facing the street, eN =
+    /// edge N, 0 = none) and the wall height (metres, given to the template as `height`).
+    pub type_field: String,
+    pub gate_field: String,
+    pub height_field: String,
+}
+
 /// Vertex generalisation before analysis (section 2.2 of the paper).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -334,6 +356,7 @@ impl Params {
         };
         let k = &self.kura;
         let positive = [
+            ("fence.gate_width", self.fence.gate_width),
             ("kura.width", k.width),
             ("kura.depth", k.depth),
             ("kura.min_width", k.min_width),
@@ -535,6 +558,7 @@ mod partial {
         machiya: Option<Machiya>,
         kura: Option<Kura>,
         simplify: Option<Simplify>,
+        fence: Option<Fence>,
         type_mix: Option<BTreeMap<String, f64>>,
         textures: Option<String>,
         template: Option<BTreeMap<String, BTreeMap<String, f64>>>,
@@ -651,6 +675,20 @@ mod partial {
         depth: Option<f64>,
         min_depth: Option<f64>,
         templates: Option<String>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Fence {
+        enabled: Option<bool>,
+        uses: Option<Vec<String>>,
+        types: Option<BTreeMap<String, String>>,
+        default_type: Option<String>,
+        gate_template: Option<String>,
+        gate_width: Option<f64>,
+        type_field: Option<String>,
+        gate_field: Option<String>,
+        height_field: Option<String>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]

@@ -29,23 +29,23 @@ fn kyoto_small_builds_and_every_tile_rereads_cleanly() {
     assert_eq!(report["counts"]["tiles"], tiles.len());
     assert!(tiles.len() >= 2, "the fixture spans several tiles");
     let mut names = BTreeSet::new();
-    let mut kura = 0;
+    let (mut kura, mut fences) = (0, 0);
     for tile in tiles {
         let obj = out.path().join(tile["obj"]["path"].as_str().unwrap());
         for o in load_tile(&obj, origin) {
-            // A kura (storehouse) stands wholly inside its machiya's lot, roof included.
-            let (id, is_kura) = match o.name.strip_prefix("kura_") {
-                Some(id) => (id, true),
-                None => (
-                    o.name
-                        .strip_prefix("machiya_")
-                        .expect("objects are machiya_<id> or kura_<id>"),
-                    false,
-                ),
-            };
+            // A kura (storehouse) stands wholly inside its machiya's lot, roof included; the
+            // walls of the samurai and temple lots stand on them, copings reaching out above
+            // 2 m like eaves.
+            let (kind, id) = o.name.split_once('_').expect("objects are <kind>_<id>");
+            let is_kura = kind == "kura";
             kura += is_kura as usize;
+            fences += (kind == "fence") as usize;
             let (lot_use, _, poly) = lots.get(id).unwrap_or_else(|| panic!("no lot {id}"));
-            assert_eq!(lot_use, "machiya");
+            match kind {
+                "machiya" | "kura" => assert_eq!(lot_use, "machiya"),
+                "fence" => assert!(["buke", "jisha"].contains(&lot_use.as_str()), "{lot_use}"),
+                other => panic!("unexpected object {other}_{id}"),
+            }
             for v in &o.vertices {
                 let d = distance_to_lot(poly, v[0], v[1]);
                 if v[2] < 0.001 || is_kura {
@@ -71,8 +71,9 @@ fn kyoto_small_builds_and_every_tile_rereads_cleanly() {
             );
         }
     }
+    assert_eq!(fences, 2, "the samurai and the temple lot are walled");
     assert_eq!(
-        names.len() - kura,
+        names.len() - kura - fences,
         machiya_lots,
         "one machiya_* object per machiya lot"
     );

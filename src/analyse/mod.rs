@@ -1,6 +1,7 @@
 //! Stage 2: analysis. Turns the [`Dataset`] into a [`Plan`]: for every machiya lot its
 //! frontage, type and tile. No I/O; every random choice through [`crate::rng`].
 
+pub mod fences;
 pub mod frontage;
 pub mod kura;
 pub mod street;
@@ -91,6 +92,21 @@ pub fn analyse(
                 plan.tiles.entry(m.tile.clone()).or_default().push(*m);
             }
             Outcome::Skipped(s) => plan.skipped.push(s),
+        }
+    }
+    if params.fence.enabled {
+        let walled: Vec<(Vec<crate::model::PlannedFence>, Vec<String>)> = data
+            .lots
+            .par_iter()
+            .filter(|l| params.fence.uses.iter().any(|u| u == l.lot_use.name()))
+            .map(|l| fences::plan_lot_fences(l, &edges, params, lots_file))
+            .collect();
+        for (segments, warnings) in walled {
+            plan.warnings.extend(warnings);
+            for f in segments {
+                plan.tiles.entry(f.tile.clone()).or_default();
+                plan.fences.entry(f.tile.clone()).or_default().push(f);
+            }
         }
     }
     plan

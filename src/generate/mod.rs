@@ -4,13 +4,14 @@
 //! no randomness of its own. A lot whose house cannot be built is skipped with a reason.
 
 pub mod clip;
+pub mod fences;
 pub mod instance;
 pub mod kura;
 pub mod machiya;
 pub mod materials;
 pub mod mesh;
 
-use crate::model::{KuraDecision, PlannedMachiya, Skipped, TileStats};
+use crate::model::{FenceKind, KuraDecision, PlannedFence, PlannedMachiya, Skipped, TileStats};
 use crate::params::Params;
 use crate::templates::Catalog;
 use mesh::{Frame, Mesh};
@@ -39,6 +40,7 @@ fn template_random(seed: u64, layer: &str, id: &str) -> f64 {
 
 pub fn generate_tile(
     lots: &[PlannedMachiya],
+    fences: &[PlannedFence],
     catalog: &Catalog,
     params: &Params,
     origin: [f64; 2],
@@ -121,5 +123,64 @@ pub fn generate_tile(
             Err(reason) => out.stats.skipped.push(skip(format!("its kura: {reason}"))),
         }
     }
+    build_fences(fences, catalog, params, frame, files, &mut out);
     out
+}
+
+/// The fences and gates of a tile: a lot's walls in one object, each gate in its own. A
+/// segment whose template fails skips that lot's fence with the reason.
+fn build_fences(
+    fences: &[PlannedFence],
+    catalog: &Catalog,
+    params: &Params,
+    frame: Frame,
+    files: &LayerFiles,
+    out: &mut TileMeshes,
+) {
+    // One object per name (a lot's walls, one gate), in the order they first appear: a gate
+    // splits its edge, but the walls on both sides stay one object.
+    let mut groups: Vec<(String, Vec<&PlannedFence>)> = Vec::new();
+    let mut index: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    for f in fences {
+        let name = fences::object_name(f);
+        let k = *index.entry(name.clone()).or_insert_with(|| {
+            groups.push((name, Vec::new()));
+            groups.len() - 1
+        });
+        groups[k].1.push(f);
+    }
+    for (name, segments) in groups {
+        let mut mesh = Mesh::new(name);
+        let mut built: Result<Vec<(String, f64)>, String> = Ok(Vec::new());
+        for f in &segments {
+            let random = template_random(params.seed, "fences", &format!("{}/{}", f.id, f.edge));
+            built = built.and_then(|mut lens| {
+                let len = fences::build_segment(f, catalog, params, random, frame, &mut mesh)?;
+                lens.push((f.template.clone(), len));
+                Ok(lens)
+            });
+        }
+        let first = segments[0];
+        match built {
+            Ok(lens) => {
+                let st = &mut out.stats;
+                match first.kind {
+                    FenceKind::Gate => st.gates += 1,
+                    FenceKind::Wall => {
+                        st.fence_segments += lens.len();
+                        for (t, l) in lens {
+                            *st.wall_mm.entry(t).or_default() += (l * 1000.0).round() as u64;
+                        }
+                    }
+                }
+                out.meshes.push(mesh.finish());
+            }
+            Err(reason) => out.stats.skipped.push(Skipped {
+                layer: first.layer.clone(),
+                file: files.lots.clone(),
+                id: first.id.clone(),
+                reason: format!("its fence: {reason}"),
+            }),
+        }
+    }
 }

@@ -39,6 +39,10 @@ pub struct Counts {
     pub tiles: usize,
     /// Kura (storehouses) built.
     pub kura: usize,
+    /// Fence segments and gates built, and metres of wall per fence template (to the mm).
+    pub fence_segments: usize,
+    pub gates: usize,
+    pub wall_metres: BTreeMap<String, f64>,
     pub skipped: usize,
 }
 
@@ -219,6 +223,11 @@ pub fn assemble_report(m: &Manifest) -> Report {
     for t in &m.tiles {
         let s = &t.stats;
         c.kura += s.kura;
+        c.fence_segments += s.fence_segments;
+        c.gates += s.gates;
+        for (t, mm) in &s.wall_mm {
+            *c.wall_metres.entry(t.clone()).or_default() += *mm as f64 / 1000.0;
+        }
         for (d, k) in &s.kura_counts {
             kura_all.add(k);
             kura_by_district.entry(d.clone()).or_default().add(k);
@@ -249,6 +258,9 @@ pub fn assemble_report(m: &Manifest) -> Report {
         paper: PaperTable2::default(),
     };
     let c = &mut r.counts;
+    for m in c.wall_metres.values_mut() {
+        *m = (*m * 1000.0).round() / 1000.0;
+    }
     c.type_drawn = c.machiya.saturating_sub(c.type_given);
     c.tiles = m.tiles.len();
     c.skipped = r.skipped.len();

@@ -66,6 +66,11 @@ pub const INPUTS: &[(&str, &str)] = &[
         "random",
         "a number in [0, 1) fixed per feature by (seed, layer, feature id)",
     ),
+    (
+        "start_mitre",
+        "fences: cot of half the interior angle at the segment's start (1 at a right angle, 0 at a free or straight end, < 0 at a reflex corner)",
+    ),
+    ("end_mitre", "fences: the same at the segment's end"),
 ];
 
 pub const N_INPUTS: usize = INPUTS.len();

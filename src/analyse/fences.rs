@@ -1,0 +1,226 @@
+//! Fences and gates along lot outlines, section 4.3 of the paper.
+//!
+//! Every lot whose use is in `fence.uses` (samurai, noble and temple lots by default) is
+//! walled along every edge of its outline. Each edge becomes one fence segment: the site of a
+//! fence template, running from the edge's first vertex to its second with the lot on its
+//! left. The gate (`gate` attribute: 1 = the edge facing the street, `eN` = edge N) is a gate
+//! of `fence.gate_width` centred on its edge, with the wall split into the two side parts of
+//! Fig.11; an edge shorter than the gate is filled by the gate, with a warning.
+
+use geo::Centroid;
+use geo_types::Coord;
+
+use super::street::StreetEdges;
+use super::tiling;
+use crate::model::{FenceKind, Lot, PlannedFence};
+use crate::params::Params;
+
+/// cot of half the interior angle at `p` (neighbours `q` before, `r` after, ring
+/// counter-clockwise): how far, per metre of wall thickness, a wall's inner edge runs past
+/// the corner so that two walls meet on the angle's bisector. 1 at a right angle, 0 for a
+/// straight continuation, negative at a reflex corner.
+pub fn mitre(q: Coord<f64>, p: Coord<f64>, r: Coord<f64>) -> f64 {
+    let (a, b) = ((p.x - q.x, p.y - q.y), (r.x - p.x, r.y - p.y));
+    // Turn to the left, (-pi, pi]; the interior angle is pi - turn.
+    let turn = (a.0 * b.1 - a.1 * b.0).atan2(a.0 * b.0 + a.1 * b.1);
+    let half = (std::f64::consts::PI - turn) / 2.0;
+    let cot = half.cos() / half.sin();
+    // A hairpin (interior angle near 0) would run the wall to infinity: cap it at 20 x.
+    cot.clamp(-20.0, 20.0)
+}
+
+/// Which edge holds the gate, from the `gate` attribute: `1`/`street` = the edge whose middle
+/// is nearest a street edge, `eN`/`edge N` = edge N (from 1), `0`/empty = none.
+pub fn gate_edge(
+    raw: &str,
+    ring: &[Coord<f64>],
+    edges: &StreetEdges,
+) -> Result<Option<usize>, String> {
+    let t = raw.trim().to_lowercase();
+    let n = ring.len();
+    match t.as_str() {
+        "" | "0" | "no" | "none" => Ok(None),
+        "1" | "street" | "yes" | "true" => Ok((0..n)
+            .map(|i| {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                let mid = Coord {
+                    x: (a.x + b.x) / 2.0,
+                    y: (a.y + b.y) / 2.0,
+                };
+                (edges.distance(mid), i)
+            })
+            .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
+            .map(|(_, i)| i)),
+        other => {
+            let num = other
+                .strip_prefix("edge")
+                .or_else(|| other.strip_prefix('e'))
+                .map(str::trim)
+                .and_then(|s| s.parse::<usize>().ok());
+            match num {
+                Some(k) if (1..=n).contains(&k) => Ok(Some(k - 1)),
+                _ => Err(format!(
+                    "gate `{raw}` is not 0, 1 (the edge facing the street) or eN with N from 1 to {n}"
+                )),
+            }
+        }
+    }
+}
+
+/// The fence template of a lot: its `fence` attribute, else the one for its use.
+fn template_of(lot: &Lot, params: &Params) -> String {
+    let f = &params.fence;
+    lot.attrs
+        .iter()
+        .find(|(k, _)| k.eq_ignore_ascii_case(&f.type_field))
+        .map(|(_, v)| v.trim().to_string())
+        .filter(|v| !v.is_empty())
+        .or_else(|| f.types.get(lot.lot_use.name()).cloned())
+        .unwrap_or_else(|| f.default_type.clone())
+}
+
+/// The fence segments and gate of one walled lot, and any warnings.
+pub fn plan_lot_fences(
+    lot: &Lot,
+    edges: &StreetEdges,
+    params: &Params,
+    lots_file: &str,
+) -> (Vec<PlannedFence>, Vec<String>) {
+    let mut warnings = Vec::new();
+    let r = &lot.outline.exterior().0;
+    let ring: Vec<Coord<f64>> = r[..r.len().saturating_sub(1)].to_vec();
+    let n = ring.len();
+    if n < 3 {
+        return (Vec::new(), warnings);
+    }
+    let centroid = lot.outline.centroid().map_or(ring[0], |c| c.0);
+    let tile = tiling::tile_id(centroid, params.tile_size, params.tile_origin);
+    let template = template_of(lot, params);
+    let gate_raw = lot
+        .attrs
+        .iter()
+        .find(|(k, _)| k.eq_ignore_ascii_case(&params.fence.gate_field))
+        .map(|(_, v)| v.as_str())
+        .unwrap_or("");
+    let gate = match gate_edge(gate_raw, &ring, edges) {
+        Ok(g) => g,
+        Err(e) => {
+            warnings.push(format!("{lots_file}: lot {}: {e}; no gate built", lot.id));
+            None
+        }
+    };
+    let height = lot
+        .attrs
+        .iter()
+        .find(|(k, _)| k.eq_ignore_ascii_case(&params.fence.height_field))
+        .and_then(|(_, v)| v.trim().parse::<f64>().ok())
+        .filter(|h| h.is_finite() && *h > 0.0);
+    let attrs: Vec<(String, f64)> = height
+        .map(|h| ("height".to_string(), h))
+        .into_iter()
+        .collect();
+    let seg = |a: Coord<f64>, b: Coord<f64>, c0: f64, c1: f64, kind: FenceKind, edge: usize| {
+        PlannedFence {
+            id: lot.id.clone(),
+            record: lot.record,
+            layer: "lots".into(),
+            template: match kind {
+                FenceKind::Wall => template.clone(),
+                FenceKind::Gate => params.fence.gate_template.clone(),
+            },
+            kind,
+            edge,
+            a,
+            b,
+            start_mitre: c0,
+            end_mitre: c1,
+            ground: lot.ground,
+            district: lot.district.clone(),
+            tile: tile.clone(),
+            attrs: attrs.clone(),
+        }
+    };
+    let mut out = Vec::new();
+    for i in 0..n {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        let c0 = mitre(ring[(i + n - 1) % n], a, b);
+        let c1 = mitre(a, b, ring[(i + 2) % n]);
+        let len = (b.x - a.x).hypot(b.y - a.y);
+        if len < 1e-6 {
+            continue;
+        }
+        if gate != Some(i) {
+            out.push(seg(a, b, c0, c1, FenceKind::Wall, i));
+            continue;
+        }
+        let gw = params.fence.gate_width;
+        if len <= gw {
+            warnings.push(format!(
+                "{lots_file}: lot {}: edge {} is {len:.2} m, shorter than the gate ({gw} m): the \
+                 gate fills the edge",
+                lot.id,
+                i + 1
+            ));
+            out.push(seg(a, b, 0.0, 0.0, FenceKind::Gate, i));
+            continue;
+        }
+        // Fig.11: the wall's two side parts, the gate between them, centred on the edge.
+        let at = |t: f64| Coord {
+            x: a.x + (b.x - a.x) * t,
+            y: a.y + (b.y - a.y) * t,
+        };
+        let (t0, t1) = (0.5 - gw / 2.0 / len, 0.5 + gw / 2.0 / len);
+        out.push(seg(a, at(t0), c0, 0.0, FenceKind::Wall, i));
+        out.push(seg(at(t0), at(t1), 0.0, 0.0, FenceKind::Gate, i));
+        out.push(seg(at(t1), b, 0.0, c1, FenceKind::Wall, i));
+    }
+    (out, warnings)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn c(x: f64, y: f64) -> Coord<f64> {
+        Coord { x, y }
+    }
+
+    #[test]
+    fn the_gate_attribute_names_an_edge() {
+        use geo_types::{LineString, Polygon};
+        let ring = vec![c(0.0, 0.0), c(40.0, 0.0), c(40.0, 30.0), c(0.0, 30.0)];
+        // The street runs along the top (y = 30..36).
+        let block = Polygon::new(
+            LineString::from(vec![
+                (-50.0, -50.0),
+                (90.0, -50.0),
+                (90.0, 30.0),
+                (-50.0, 30.0),
+                (-50.0, -50.0),
+            ]),
+            vec![],
+        );
+        let edges = StreetEdges::new(&[block], &[]);
+        assert_eq!(gate_edge("1", &ring, &edges), Ok(Some(2)));
+        assert_eq!(gate_edge("street", &ring, &edges), Ok(Some(2)));
+        assert_eq!(gate_edge("e2", &ring, &edges), Ok(Some(1)));
+        assert_eq!(gate_edge("edge 4", &ring, &edges), Ok(Some(3)));
+        assert_eq!(gate_edge("0", &ring, &edges), Ok(None));
+        assert_eq!(gate_edge("", &ring, &edges), Ok(None));
+        let err = gate_edge("e9", &ring, &edges).unwrap_err();
+        assert!(err.contains("N from 1 to 4"), "{err}");
+    }
+
+    #[test]
+    fn mitres_of_right_straight_reflex_and_acute_corners() {
+        let right = mitre(c(0.0, 0.0), c(10.0, 0.0), c(10.0, 10.0));
+        assert!((right - 1.0).abs() < 1e-12);
+        let straight = mitre(c(0.0, 0.0), c(5.0, 0.0), c(10.0, 0.0));
+        assert!(straight.abs() < 1e-12);
+        let reflex = mitre(c(0.0, 0.0), c(10.0, 0.0), c(10.0, -10.0));
+        assert!((reflex + 1.0).abs() < 1e-12);
+        // 60 degrees inside: cot(30) = 1.732.
+        let acute = mitre(c(0.0, 0.0), c(10.0, 0.0), c(5.0, 8.660254));
+        assert!((acute - 3f64.sqrt()).abs() < 1e-5, "{acute}");
+    }
+}

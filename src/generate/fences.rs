@@ -1,0 +1,92 @@
+//! Fence and gate meshes (section 4.3): each planned segment is its template built on the
+//! segment, the walls of one lot in one object `fence_<id>`, each gate an object
+//! `gate_<id>_<edge>`.
+
+use geo_types::Coord;
+
+use super::clip::LocalPoly;
+use super::instance::{instantiate, Local, Site};
+use super::mesh::{Frame, Mesh};
+use crate::model::{FenceKind, PlannedFence};
+use crate::params::Params;
+use crate::templates::expr::Lot;
+use crate::templates::template::{input, N_INPUTS};
+use crate::templates::Catalog;
+
+/// The site of a segment: u from `a` to `b`, the enclosed side (v > 0) on the left.
+fn site(f: &PlannedFence) -> Option<(Site, f64)> {
+    let (dx, dy) = (f.b.x - f.a.x, f.b.y - f.a.y);
+    let len = dx.hypot(dy);
+    if len.is_nan() || len <= 1e-6 {
+        return None;
+    }
+    let u = Coord {
+        x: dx / len,
+        y: dy / len,
+    };
+    let site = Site {
+        lot: LocalPoly::simple(vec![[0.0, 0.0], [len, 0.0], [len, 1.0], [0.0, 1.0]]),
+        local: Local {
+            a: f.a,
+            u,
+            v: Coord { x: -u.y, y: u.x },
+        },
+        ground: f.ground,
+    };
+    Some((site, len))
+}
+
+/// Builds one segment into `mesh`; returns its length.
+pub fn build_segment(
+    f: &PlannedFence,
+    catalog: &Catalog,
+    params: &Params,
+    random: f64,
+    frame: Frame,
+    mesh: &mut Mesh,
+) -> Result<f64, String> {
+    let t = catalog
+        .get(&f.template)
+        .ok_or_else(|| format!("fence template `{}` does not exist", f.template))?;
+    let (site, len) = site(f).ok_or("the segment has no length")?;
+    let mid = Coord {
+        x: (f.a.x + f.b.x) / 2.0,
+        y: (f.a.y + f.b.y) / 2.0,
+    };
+    let mut x = [0.0; N_INPUTS];
+    for (name, value) in [
+        ("width", len),
+        ("lot_depth", 1.0),
+        ("frontage_ax", f.a.x),
+        ("frontage_ay", f.a.y),
+        ("frontage_bx", f.b.x),
+        ("frontage_by", f.b.y),
+        ("centroid_x", mid.x),
+        ("centroid_y", mid.y),
+        ("ground", f.ground),
+        ("feature_id", super::machiya::numeric_id(Some(&f.id))),
+        (
+            "district",
+            super::machiya::numeric_id(f.district.as_deref()),
+        ),
+        ("machiya_depth", params.machiya.depth),
+        ("min_depth", params.machiya.min_depth),
+        ("random", random),
+        ("start_mitre", f.start_mitre),
+        ("end_mitre", f.end_mitre),
+    ] {
+        x[input(name)] = value;
+    }
+    let overrides = catalog.overrides(&t.name, f.district.as_deref());
+    let slots = t.evaluate(&x, &overrides, &f.attrs, &site as &dyn Lot)?;
+    instantiate(t, &slots, &site, frame, mesh)?;
+    Ok(len)
+}
+
+/// The object a segment goes into.
+pub fn object_name(f: &PlannedFence) -> String {
+    match f.kind {
+        FenceKind::Wall => format!("fence_{}", f.id),
+        FenceKind::Gate => format!("gate_{}_{}", f.id, f.edge + 1),
+    }
+}
