@@ -262,6 +262,11 @@ fn run(
             .join(&params.layers.footprints.file)
             .display()
             .to_string(),
+        fences: opts
+            .input
+            .join(&params.layers.fences.file)
+            .display()
+            .to_string(),
     };
     let tiles: Vec<_> = plan
         .tiles
@@ -376,6 +381,7 @@ pub fn check(
             .join(&params.layers.footprints.file)
             .display()
             .to_string(),
+        fences: input.join(&params.layers.fences.file).display().to_string(),
     };
     // Generate every tile (to find the houses that cannot be built), write nothing.
     let tiles: Vec<report::ManifestTile> = plan

@@ -72,6 +72,16 @@ pub struct Lot {
     pub ground: f64,
 }
 
+/// A free-standing fence or wall from a line layer.
+#[derive(Debug, Clone)]
+pub struct FenceLine {
+    pub id: String,
+    pub record: usize,
+    pub line: LineString<f64>,
+    /// Every attribute of the feature.
+    pub attrs: BTreeMap<String, String>,
+}
+
 /// A building footprint from the data, built as a house of its own height.
 #[derive(Debug, Clone)]
 pub struct Footprint {
@@ -123,6 +133,8 @@ pub struct Skipped {
 #[derive(Debug, Clone, Default)]
 pub struct Dataset {
     pub lots: Vec<Lot>,
+    /// Free-standing fence lines.
+    pub fence_lines: Vec<FenceLine>,
     /// City blocks (machi 町 / gaiku 街区): their boundaries are street edges.
     pub blocks: Vec<Polygon<f64>>,
     pub streets: Vec<Street>,

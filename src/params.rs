@@ -105,6 +105,18 @@ pub struct Layers {
     pub street_widths: StreetWidthsLayer,
     pub footprints: FootprintsLayer,
     pub districts: DistrictsLayer,
+    pub fences: FencesLayer,
+}
+
+/// Free-standing fences (a PolyLine layer), walled like lot outlines: a closed line encloses
+/// its inside, an open one has its wall on its left. Attributes as `[fence]` names them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FencesLayer {
+    pub file: String,
+    #[serde(default)]
+    pub encoding: String,
+    pub id_field: String,
 }
 
 /// District polygons (chiku 地区): a lot or footprint without a district attribute gets the
@@ -581,6 +593,15 @@ mod partial {
         street_widths: Option<Widths>,
         footprints: Option<Footprints>,
         districts: Option<Districts>,
+        fences: Option<FencesLayer>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct FencesLayer {
+        file: Option<String>,
+        encoding: Option<String>,
+        id_field: Option<String>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]

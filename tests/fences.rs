@@ -270,3 +270,135 @@ fn walls_gates_and_corners() {
     );
     assert!(ground.iter().all(|p| (0.0..=1.0).contains(&p[1])));
 }
+
+/// One line of `fences.shp`: id, points, fence type, gate, height.
+type FenceRow<'a> = (u32, Vec<[f64; 2]>, &'a str, &'a str, f64);
+
+fn write_fence_lines(path: &Path, lines: &[FenceRow]) {
+    use dbase::{FieldName, FieldValue, Record, TableWriterBuilder};
+    let name = |s: &str| FieldName::try_from(s).unwrap();
+    let table = TableWriterBuilder::new()
+        .add_numeric_field(name("id"), 10, 0)
+        .add_character_field(name("fence"), 20)
+        .add_character_field(name("gate"), 10)
+        .add_numeric_field(name("height"), 8, 2);
+    let mut w = shapefile::Writer::from_path(path, table).unwrap();
+    for (id, pts, fence, gate, height) in lines {
+        let mut rec = Record::default();
+        rec.insert("id".into(), FieldValue::Numeric(Some(*id as f64)));
+        rec.insert(
+            "fence".into(),
+            FieldValue::Character(Some(fence.to_string())),
+        );
+        rec.insert("gate".into(), FieldValue::Character(Some(gate.to_string())));
+        rec.insert("height".into(), FieldValue::Numeric(Some(*height)));
+        let pts: Vec<shapefile::Point> = pts
+            .iter()
+            .map(|p| shapefile::Point::new(p[0], p[1]))
+            .collect();
+        w.write_shape_and_record(&shapefile::Polyline::new(pts), &rec)
+            .unwrap();
+    }
+}
+
+#[test]
+fn free_standing_fence_lines_from_a_line_layer() {
+    let dir = tempfile::tempdir().unwrap();
+    // One town lot, so there is something on the street; the fences stand on open ground.
+    write_lots(
+        &dir.path().join("lots.shp"),
+        &[SynthLot {
+            id: 1,
+            ring: vec![[0.0, 0.0], [6.0, 0.0], [6.0, 20.0], [0.0, 20.0]],
+            lot_use: "machiya",
+            mtype: "平屋",
+            district: "",
+        }],
+    )
+    .unwrap();
+    write_blocks(
+        &dir.path().join("blocks.shp"),
+        &[vec![[0.0, 0.0], [100.0, 0.0], [100.0, 60.0], [0.0, 60.0]]],
+    )
+    .unwrap();
+    write_fence_lines(
+        &dir.path().join("fences.shp"),
+        &[
+            // A closed square drawn clockwise: still walled on its inside.
+            (
+                7,
+                vec![
+                    [20.0, 10.0],
+                    [20.0, 30.0],
+                    [40.0, 30.0],
+                    [40.0, 10.0],
+                    [20.0, 10.0],
+                ],
+                "tsuiji",
+                "0",
+                3.0,
+            ),
+            // An open line of two segments, gate on the second, wall on its left.
+            (
+                8,
+                vec![[50.0, 10.0], [70.0, 10.0], [70.0, 30.0]],
+                "fence",
+                "e2",
+                0.0,
+            ),
+        ],
+    );
+    // Small numbers without a .prj would read as degrees: give the lots' CRS.
+    std::fs::copy(dir.path().join("lots.prj"), dir.path().join("fences.prj")).unwrap();
+    let out = dir.path().join("out");
+    let r = build_ok(dir.path(), &out, &["--quiet", "--no-plan"]);
+    let c = &r["counts"];
+    assert_eq!(c["gates"], 1, "{c}");
+    assert_eq!(c["fence_segments"], 4 + 1 + 2, "{c}");
+    assert!(
+        (c["wall_metres"]["tsuiji"].as_f64().unwrap() - 80.0).abs() < 0.01,
+        "{c}"
+    );
+    assert!((c["wall_metres"]["fence"].as_f64().unwrap() - (40.0 - 3.03)).abs() < 0.01);
+    let layers = r["layers"].as_array().unwrap();
+    assert!(layers
+        .iter()
+        .any(|l| l["role"] == "fences" && l["features"] == 2));
+
+    let objs = objects(&out);
+    let square: Vec<[f64; 3]> = objs
+        .iter()
+        .filter(|o| o.name == "fenceline_7")
+        .flat_map(|o| o.tris.iter().flat_map(|t| t.0))
+        .collect();
+    assert!(!square.is_empty());
+    // The tsuiji of the square stands inside it (its coping reaches out above 3 m), 3 m high.
+    for p in square.iter().filter(|p| p[2] < 2.0) {
+        assert!(
+            (20.0 - 1e-3..=40.0 + 1e-3).contains(&p[0])
+                && (10.0 - 1e-3..=30.0 + 1e-3).contains(&p[1]),
+            "{p:?} outside the square"
+        );
+    }
+    // Its earthen wall reaches the `height` of the line (3 m), under the coping.
+    assert!(square.iter().any(|p| (p[2] - 3.0).abs() < 1e-3));
+    assert!(!square.iter().any(|p| p[2] > 1.0 && p[2] < 2.9));
+    // The open line's wall is on its left: north of its first segment, west of its second.
+    let open: Vec<[f64; 3]> = objs
+        .iter()
+        .filter(|o| o.name == "fenceline_8")
+        .flat_map(|o| o.tris.iter().flat_map(|t| t.0))
+        .collect();
+    assert!(!open.is_empty());
+    assert!(objs.iter().any(|o| o.name == "gateline_8_2"));
+    let gate: Vec<[f64; 3]> = objs
+        .iter()
+        .filter(|o| o.name == "gateline_8_2")
+        .flat_map(|o| o.tris.iter().flat_map(|t| t.0))
+        .filter(|p| p[2] < 0.001)
+        .collect();
+    assert!(
+        gate.iter().all(|p| p[0] <= 70.0 + 1e-3 && p[0] >= 69.0),
+        "west of x = 70: {gate:?}"
+    );
+}

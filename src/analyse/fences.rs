@@ -12,7 +12,7 @@ use geo_types::Coord;
 
 use super::street::StreetEdges;
 use super::tiling;
-use crate::model::{FenceKind, Lot, PlannedFence};
+use crate::model::{FenceKind, FenceLine, Lot, PlannedFence};
 use crate::params::Params;
 
 /// cot of half the interior angle at `p` (neighbours `q` before, `r` after, ring
@@ -79,53 +79,47 @@ fn template_of(lot: &Lot, params: &Params) -> String {
         .unwrap_or_else(|| f.default_type.clone())
 }
 
-/// The fence segments and gate of one walled lot, and any warnings.
-pub fn plan_lot_fences(
-    lot: &Lot,
-    edges: &StreetEdges,
+/// A line's value of the attribute `field` (case ignored), trimmed.
+fn attr<'a>(attrs: &'a std::collections::BTreeMap<String, String>, field: &str) -> Option<&'a str> {
+    attrs
+        .iter()
+        .find(|(k, _)| k.eq_ignore_ascii_case(field))
+        .map(|(_, v)| v.trim())
+        .filter(|v| !v.is_empty())
+}
+
+/// What every segment of one outline or line shares.
+struct Walled<'a> {
+    id: &'a str,
+    record: usize,
+    layer: &'static str,
+    file: &'a str,
+    template: String,
+    ground: f64,
+    district: Option<String>,
+    tile: String,
+    attrs: Vec<(String, f64)>,
+}
+
+/// The segments of a closed ring (`closed`, points not repeated) or an open line, with the
+/// wall on the left of each segment and the gate on segment `gate`.
+fn segments(
+    w: &Walled,
+    pts: &[Coord<f64>],
+    closed: bool,
+    gate: Option<usize>,
     params: &Params,
-    lots_file: &str,
-) -> (Vec<PlannedFence>, Vec<String>) {
-    let mut warnings = Vec::new();
-    let r = &lot.outline.exterior().0;
-    let ring: Vec<Coord<f64>> = r[..r.len().saturating_sub(1)].to_vec();
-    let n = ring.len();
-    if n < 3 {
-        return (Vec::new(), warnings);
-    }
-    let centroid = lot.outline.centroid().map_or(ring[0], |c| c.0);
-    let tile = tiling::tile_id(centroid, params.tile_size, params.tile_origin);
-    let template = template_of(lot, params);
-    let gate_raw = lot
-        .attrs
-        .iter()
-        .find(|(k, _)| k.eq_ignore_ascii_case(&params.fence.gate_field))
-        .map(|(_, v)| v.as_str())
-        .unwrap_or("");
-    let gate = match gate_edge(gate_raw, &ring, edges) {
-        Ok(g) => g,
-        Err(e) => {
-            warnings.push(format!("{lots_file}: lot {}: {e}; no gate built", lot.id));
-            None
-        }
-    };
-    let height = lot
-        .attrs
-        .iter()
-        .find(|(k, _)| k.eq_ignore_ascii_case(&params.fence.height_field))
-        .and_then(|(_, v)| v.trim().parse::<f64>().ok())
-        .filter(|h| h.is_finite() && *h > 0.0);
-    let attrs: Vec<(String, f64)> = height
-        .map(|h| ("height".to_string(), h))
-        .into_iter()
-        .collect();
+    warnings: &mut Vec<String>,
+) -> Vec<PlannedFence> {
+    let n = pts.len();
+    let count = if closed { n } else { n - 1 };
     let seg = |a: Coord<f64>, b: Coord<f64>, c0: f64, c1: f64, kind: FenceKind, edge: usize| {
         PlannedFence {
-            id: lot.id.clone(),
-            record: lot.record,
-            layer: "lots".into(),
+            id: w.id.to_string(),
+            record: w.record,
+            layer: w.layer.into(),
             template: match kind {
-                FenceKind::Wall => template.clone(),
+                FenceKind::Wall => w.template.clone(),
                 FenceKind::Gate => params.fence.gate_template.clone(),
             },
             kind,
@@ -134,17 +128,26 @@ pub fn plan_lot_fences(
             b,
             start_mitre: c0,
             end_mitre: c1,
-            ground: lot.ground,
-            district: lot.district.clone(),
-            tile: tile.clone(),
-            attrs: attrs.clone(),
+            ground: w.ground,
+            district: w.district.clone(),
+            tile: w.tile.clone(),
+            attrs: w.attrs.clone(),
         }
     };
     let mut out = Vec::new();
-    for i in 0..n {
-        let (a, b) = (ring[i], ring[(i + 1) % n]);
-        let c0 = mitre(ring[(i + n - 1) % n], a, b);
-        let c1 = mitre(a, b, ring[(i + 2) % n]);
+    for i in 0..count {
+        let (a, b) = (pts[i], pts[(i + 1) % n]);
+        // A free end of an open line is square; every other end is mitred.
+        let c0 = if closed || i > 0 {
+            mitre(pts[(i + n - 1) % n], a, b)
+        } else {
+            0.0
+        };
+        let c1 = if closed || i + 2 < n {
+            mitre(a, b, pts[(i + 2) % n])
+        } else {
+            0.0
+        };
         let len = (b.x - a.x).hypot(b.y - a.y);
         if len < 1e-6 {
             continue;
@@ -156,9 +159,11 @@ pub fn plan_lot_fences(
         let gw = params.fence.gate_width;
         if len <= gw {
             warnings.push(format!(
-                "{lots_file}: lot {}: edge {} is {len:.2} m, shorter than the gate ({gw} m): the \
-                 gate fills the edge",
-                lot.id,
+                "{}: {} {}: edge {} is {len:.2} m, shorter than the gate ({gw} m): the gate \
+                 fills the edge",
+                w.file,
+                if w.layer == "lots" { "lot" } else { "fence" },
+                w.id,
                 i + 1
             ));
             out.push(seg(a, b, 0.0, 0.0, FenceKind::Gate, i));
@@ -174,6 +179,130 @@ pub fn plan_lot_fences(
         out.push(seg(at(t0), at(t1), 0.0, 0.0, FenceKind::Gate, i));
         out.push(seg(at(t1), b, 0.0, c1, FenceKind::Wall, i));
     }
+    out
+}
+
+/// The height attribute, for the template's `height`.
+fn height_attr(
+    attrs: &std::collections::BTreeMap<String, String>,
+    params: &Params,
+) -> Vec<(String, f64)> {
+    attr(attrs, &params.fence.height_field)
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|h| h.is_finite() && *h > 0.0)
+        .map(|h| ("height".to_string(), h))
+        .into_iter()
+        .collect()
+}
+
+/// The gate of a walled outline or line, or a warning.
+fn gate_of(
+    attrs: &std::collections::BTreeMap<String, String>,
+    pts: &[Coord<f64>],
+    edges: &StreetEdges,
+    params: &Params,
+    what: &str,
+    warnings: &mut Vec<String>,
+) -> Option<usize> {
+    let raw = attr(attrs, &params.fence.gate_field).unwrap_or("");
+    gate_edge(raw, pts, edges).unwrap_or_else(|e| {
+        warnings.push(format!("{what}: {e}; no gate built"));
+        None
+    })
+}
+
+/// The fence segments and gate of one walled lot, and any warnings.
+pub fn plan_lot_fences(
+    lot: &Lot,
+    edges: &StreetEdges,
+    params: &Params,
+    lots_file: &str,
+) -> (Vec<PlannedFence>, Vec<String>) {
+    let mut warnings = Vec::new();
+    let r = &lot.outline.exterior().0;
+    let ring: Vec<Coord<f64>> = r[..r.len().saturating_sub(1)].to_vec();
+    if ring.len() < 3 {
+        return (Vec::new(), warnings);
+    }
+    let centroid = lot.outline.centroid().map_or(ring[0], |c| c.0);
+    let what = format!("{lots_file}: lot {}", lot.id);
+    let gate = gate_of(&lot.attrs, &ring, edges, params, &what, &mut warnings);
+    let w = Walled {
+        id: &lot.id,
+        record: lot.record,
+        layer: "lots",
+        file: lots_file,
+        template: template_of(lot, params),
+        ground: lot.ground,
+        district: lot.district.clone(),
+        tile: tiling::tile_id(centroid, params.tile_size, params.tile_origin),
+        attrs: height_attr(&lot.attrs, params),
+    };
+    let out = segments(&w, &ring, true, gate, params, &mut warnings);
+    (out, warnings)
+}
+
+/// The segments of a free-standing fence line: a closed line (first point = last) walls in
+/// its inside whichever way it was drawn, an open one has its wall on its left.
+pub fn plan_line_fences(
+    f: &FenceLine,
+    edges: &StreetEdges,
+    params: &Params,
+    file: &str,
+) -> (Vec<PlannedFence>, Vec<String>) {
+    let mut warnings = Vec::new();
+    let mut pts = f.line.0.clone();
+    let closed = pts.len() >= 4 && {
+        let (a, b) = (pts[0], pts[pts.len() - 1]);
+        (a.x - b.x).hypot(a.y - b.y) < 1e-3
+    };
+    if closed {
+        pts.pop();
+        let area: f64 = (0..pts.len())
+            .map(|i| {
+                let (p, q) = (pts[i], pts[(i + 1) % pts.len()]);
+                p.x * q.y - q.x * p.y
+            })
+            .sum();
+        if area < 0.0 {
+            pts.reverse();
+        }
+    }
+    if pts.len() < 2 {
+        return (Vec::new(), warnings);
+    }
+    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+    for p in &pts {
+        lo = [lo[0].min(p.x), lo[1].min(p.y)];
+        hi = [hi[0].max(p.x), hi[1].max(p.y)];
+    }
+    let centre = Coord {
+        x: (lo[0] + hi[0]) / 2.0,
+        y: (lo[1] + hi[1]) / 2.0,
+    };
+    let what = format!("{file}: fence {}", f.id);
+    // Segment numbering for `eN` and `1` follows the line as it is walled.
+    let gate = gate_of(&f.attrs, &pts, edges, params, &what, &mut warnings);
+    let gate = if closed {
+        gate
+    } else {
+        gate.filter(|g| *g + 1 < pts.len())
+    };
+    let template = attr(&f.attrs, &params.fence.type_field)
+        .map(str::to_string)
+        .unwrap_or_else(|| params.fence.default_type.clone());
+    let w = Walled {
+        id: &f.id,
+        record: f.record,
+        layer: "fences",
+        file,
+        template,
+        ground: 0.0,
+        district: None,
+        tile: tiling::tile_id(centre, params.tile_size, params.tile_origin),
+        attrs: height_attr(&f.attrs, params),
+    };
+    let out = segments(&w, &pts, closed, gate, params, &mut warnings);
     (out, warnings)
 }
 

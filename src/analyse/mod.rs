@@ -101,7 +101,13 @@ pub fn analyse(
             .filter(|l| params.fence.uses.iter().any(|u| u == l.lot_use.name()))
             .map(|l| fences::plan_lot_fences(l, &edges, params, lots_file))
             .collect();
-        for (segments, warnings) in walled {
+        let fences_file = params.layers.fences.file.clone();
+        let lines: Vec<(Vec<crate::model::PlannedFence>, Vec<String>)> = data
+            .fence_lines
+            .par_iter()
+            .map(|f| fences::plan_line_fences(f, &edges, params, &fences_file))
+            .collect();
+        for (segments, warnings) in walled.into_iter().chain(lines) {
             plan.warnings.extend(warnings);
             for f in segments {
                 plan.tiles.entry(f.tile.clone()).or_default();

@@ -84,9 +84,12 @@ pub fn build_segment(
 }
 
 /// The object a segment goes into.
+/// `fence_<lot>` / `gate_<lot>_<edge>` for a walled lot, `fenceline_<id>` /
+/// `gateline_<id>_<edge>` for a line of the fences layer (ids of two layers may coincide).
 pub fn object_name(f: &PlannedFence) -> String {
+    let line = if f.layer == "fences" { "line" } else { "" };
     match f.kind {
-        FenceKind::Wall => format!("fence_{}", f.id),
-        FenceKind::Gate => format!("gate_{}_{}", f.id, f.edge + 1),
+        FenceKind::Wall => format!("fence{line}_{}", f.id),
+        FenceKind::Gate => format!("gate{line}_{}_{}", f.id, f.edge + 1),
     }
 }

@@ -30,6 +30,7 @@ pub struct TileMeshes {
 pub struct LayerFiles {
     pub lots: String,
     pub footprints: String,
+    pub fences: String,
 }
 
 /// The `random` input of a feature's template: its own stream, apart from the type draw.
@@ -177,7 +178,11 @@ fn build_fences(
             }
             Err(reason) => out.stats.skipped.push(Skipped {
                 layer: first.layer.clone(),
-                file: files.lots.clone(),
+                file: if first.layer == "fences" {
+                    files.fences.clone()
+                } else {
+                    files.lots.clone()
+                },
                 id: first.id.clone(),
                 reason: format!("its fence: {reason}"),
             }),

@@ -20,7 +20,9 @@ use std::path::Path;
 use geo_types::{Coord, LineString};
 use thiserror::Error;
 
-use crate::model::{Dataset, Footprint, LayerInfo, Lot, LotUse, Skipped, Street, TableJoin};
+use crate::model::{
+    Dataset, FenceLine, Footprint, LayerInfo, Lot, LotUse, Skipped, Street, TableJoin,
+};
 use crate::params::Params;
 use crs::Crs;
 use fields::{resolve_field, AttributeRule};
@@ -244,6 +246,13 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         &l.districts.encoding,
         "",
     )?;
+    let mut fences = open(
+        dir,
+        "fences",
+        &l.fences.file,
+        &l.fences.encoding,
+        &dl.fences.file,
+    )?;
 
     let mut data = Dataset::default();
     let target = {
@@ -254,6 +263,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             &mut blocks,
             &mut widths,
             &mut districts,
+            &mut fences,
         ]
         .into_iter()
         .filter_map(|o| o.as_mut())
@@ -267,6 +277,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         &mut blocks,
         &mut widths,
         &mut districts,
+        &mut fences,
     ]
     .into_iter()
     .flatten()
@@ -277,7 +288,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         .as_ref()
         .map(|c| c.definition.clone())
         .unwrap_or_default();
-    for o in [&lots, &footprints, &streets, &blocks, &widths]
+    for o in [&lots, &footprints, &streets, &blocks, &widths, &fences]
         .into_iter()
         .flatten()
     {
@@ -348,6 +359,9 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             dir.join(&l.blocks.file).display(),
             dir.join(&l.streets.file).display()
         )));
+    }
+    if let Some(o) = &fences {
+        read_fence_lines(params, o, &target, &mut data)?;
     }
     simplify::generalise(&mut data, params.simplify.tolerance);
     Ok(data)
@@ -574,6 +588,57 @@ fn read_footprints(
              height came from the next source (height, storeys x storey_height, default_height)",
             o.file
         ));
+    }
+    Ok(())
+}
+
+/// Free-standing fence lines: each part of each polyline, with the feature's attributes.
+fn read_fence_lines(
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let fp = &params.layers.fences;
+    let id_field = resolve_field(&fp.id_field, &o.layer.fields, o.layer.text_encoding);
+    for f in &o.layer.features {
+        let lines = lines_of(&f.shape).map_err(|kind| InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "record {} is a {kind}; the fences layer must hold polylines",
+                f.record
+            ),
+        })?;
+        let id = id_field
+            .and_then(|k| f.attrs.get(k))
+            .map(|v| v.trim().to_string())
+            .filter(|v| !v.is_empty())
+            .unwrap_or_else(|| (f.record + 1).to_string());
+        let parts = lines.len();
+        for (k, mut line) in lines.into_iter().enumerate() {
+            let ok = line.0.len() >= 2
+                && line.0.iter().all(|c| c.x.is_finite() && c.y.is_finite())
+                && to_target(o, target, &mut line.0).is_ok();
+            if !ok {
+                data.skipped.push(Skipped {
+                    layer: "fences".into(),
+                    file: o.file.clone(),
+                    id: id.clone(),
+                    reason: "a line with fewer than 2 usable points".into(),
+                });
+                continue;
+            }
+            data.fence_lines.push(FenceLine {
+                id: if parts > 1 {
+                    format!("{id}-{}", k + 1)
+                } else {
+                    id.clone()
+                },
+                record: f.record,
+                line,
+                attrs: f.attrs.clone(),
+            });
+        }
     }
     Ok(())
 }

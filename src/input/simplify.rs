@@ -149,6 +149,13 @@ pub fn generalise(data: &mut Dataset, tol: f64) {
         a += s.line.0.len();
     }
     count("streets", b, a);
+    let (mut b, mut a) = (0, 0);
+    for f in &mut data.fence_lines {
+        b += f.line.0.len();
+        f.line = LineString(reduce_open(&f.line.0, tol));
+        a += f.line.0.len();
+    }
+    count("fences", b, a);
 }
 
 #[cfg(test)]
