@@ -135,6 +135,8 @@ pub struct Dataset {
     pub lots: Vec<Lot>,
     /// Free-standing fence lines.
     pub fence_lines: Vec<FenceLine>,
+    /// The terrain, when the input has one.
+    pub dem: Option<crate::input::dem::Dem>,
     /// City blocks (machi 町 / gaiku 街区): their boundaries are street edges.
     pub blocks: Vec<Polygon<f64>>,
     pub streets: Vec<Street>,
@@ -244,7 +246,9 @@ pub struct PlannedFence {
     /// Mitres at the two ends (cot of half the interior angle; 0 = a square end).
     pub start_mitre: f64,
     pub end_mitre: f64,
+    /// Ground elevation at `a` and at `b` (the same without a DEM).
     pub ground: f64,
+    pub ground_end: f64,
     pub district: Option<String>,
     pub tile: TileId,
     /// Numeric attributes for the template (`height`).

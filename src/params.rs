@@ -106,6 +106,15 @@ pub struct Layers {
     pub footprints: FootprintsLayer,
     pub districts: DistrictsLayer,
     pub fences: FencesLayer,
+    pub dem: DemLayer,
+}
+
+/// A terrain elevation grid (ESRI ASCII grid) in the output CRS.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DemLayer {
+    /// Path in the input directory; a missing default file means no DEM.
+    pub file: String,
 }
 
 /// Free-standing fences (a PolyLine layer), walled like lot outlines: a closed line encloses
@@ -594,6 +603,13 @@ mod partial {
         footprints: Option<Footprints>,
         districts: Option<Districts>,
         fences: Option<FencesLayer>,
+        dem: Option<DemLayer>,
+    }
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct DemLayer {
+        file: Option<String>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]

@@ -129,6 +129,7 @@ fn segments(
             start_mitre: c0,
             end_mitre: c1,
             ground: w.ground,
+            ground_end: w.ground,
             district: w.district.clone(),
             tile: w.tile.clone(),
             attrs: w.attrs.clone(),

@@ -5,6 +5,7 @@ pub mod fences;
 pub mod frontage;
 pub mod kura;
 pub mod street;
+pub mod terrain;
 pub mod tiling;
 
 use geo::Centroid;
@@ -72,6 +73,10 @@ pub fn analyse(
             Outcome::Skipped(_) => None,
         })
         .collect();
+    let mut off_dem = 0;
+    if let Some(dem) = &data.dem {
+        off_dem += terrain::ground_houses(&mut planned, dem);
+    }
     kura::decide(&mut planned, catalog, params);
     let mut plan = Plan {
         origin,
@@ -107,12 +112,24 @@ pub fn analyse(
             .par_iter()
             .map(|f| fences::plan_line_fences(f, &edges, params, &fences_file))
             .collect();
-        for (segments, warnings) in walled.into_iter().chain(lines) {
+        for (mut segments, warnings) in walled.into_iter().chain(lines) {
+            if let Some(dem) = &data.dem {
+                off_dem += terrain::ground_fences(&mut segments, dem);
+            }
             plan.warnings.extend(warnings);
             for f in segments {
                 plan.tiles.entry(f.tile.clone()).or_default();
                 plan.fences.entry(f.tile.clone()).or_default().push(f);
             }
+        }
+    }
+    if off_dem > 0 {
+        if let Some(dem) = &data.dem {
+            plan.warnings.push(format!(
+                "{}: {off_dem} point(s) of houses or fences lie outside the DEM; they stand on \
+                 the elevation of its nearest edge",
+                dem.file
+            ));
         }
     }
     plan

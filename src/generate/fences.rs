@@ -32,6 +32,7 @@ fn site(f: &PlannedFence) -> Option<(Site, f64)> {
             v: Coord { x: -u.y, y: u.x },
         },
         ground: f.ground,
+        slope: (f.ground_end - f.ground) / len,
     };
     Some((site, len))
 }

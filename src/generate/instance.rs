@@ -50,8 +50,11 @@ pub struct Site {
     /// The lot in the frontage frame (exterior counter-clockwise, holes clockwise).
     pub lot: LocalPoly,
     pub local: Local,
-    /// Ground elevation, metres: h = 0 of the template.
+    /// Ground elevation, metres: h = 0 of the template at u = 0 ...
     pub ground: f64,
+    /// ... rising this much per metre of u (a fence on a slope); 0 for houses, whose flat
+    /// base stands on the lowest ground under them.
+    pub slope: f64,
 }
 
 impl Lot for Site {
@@ -71,6 +74,7 @@ impl Site {
                 v: Coord { x: 0.0, y: 1.0 },
             },
             ground: 0.0,
+            slope: 0.0,
         }
     }
 
@@ -276,14 +280,14 @@ fn prism(
         wall: p.side_material,
         facade,
     };
-    let g = site.ground;
+    let (g, slope) = (site.ground, site.slope);
     extrude(
         mesh,
         frame,
         site.local,
         &pieces,
-        &|q| g + at(&p.bottom, q),
-        &|q| g + at(&p.top, q),
+        &|q| g + slope * q[0] + at(&p.bottom, q),
+        &|q| g + slope * q[0] + at(&p.top, q),
         &splits_v,
         &splits_u,
         &dress,
@@ -321,7 +325,8 @@ fn faces(
             .zip(uvs)
             .map(|(&i, [s, t])| {
                 let p = pts[i];
-                let pos = mesh.vertex(frame, site.local.to_map([p[0], p[1]]), site.ground + p[2]);
+                let h = site.ground + site.slope * p[0] + p[2];
+                let pos = mesh.vertex(frame, site.local.to_map([p[0], p[1]]), h);
                 (pos, mesh.uv(s, t))
             })
             .collect();

@@ -40,6 +40,7 @@ pub fn build(
             v,
         },
         ground: m.ground,
+        slope: 0.0,
     };
     let (a, b, c) = (
         at([rect[0], rect[1]]),

@@ -56,6 +56,7 @@ pub fn site_of(m: &PlannedMachiya) -> Result<Site, String> {
         lot,
         local,
         ground: m.ground,
+        slope: 0.0,
     })
 }
 

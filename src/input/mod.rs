@@ -7,6 +7,7 @@
 //! problems with single features skip that feature with a reason, and the rest is built.
 
 pub mod crs;
+pub mod dem;
 pub mod fields;
 pub mod geometry;
 pub mod shp;
@@ -363,6 +364,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
     if let Some(o) = &fences {
         read_fence_lines(params, o, &target, &mut data)?;
     }
+    data.dem = read_dem(dir, params, &target, &dl.dem.file)?;
     simplify::generalise(&mut data, params.simplify.tolerance);
     Ok(data)
 }
@@ -590,6 +592,47 @@ fn read_footprints(
         ));
     }
     Ok(())
+}
+
+/// The DEM, if there is one; its `.prj`, if any, must name the output CRS.
+fn read_dem(
+    dir: &Path,
+    params: &Params,
+    target: &Option<Crs>,
+    default_file: &str,
+) -> Result<Option<dem::Dem>, InputError> {
+    let file = params.layers.dem.file.trim();
+    if file.is_empty() {
+        return Ok(None);
+    }
+    let path = dir.join(file);
+    if !path.exists() {
+        if file == default_file {
+            return Ok(None);
+        }
+        return Err(InputError::Missing(format!(
+            "no DEM: {} does not exist (set `layers.dem.file` to the right path, or to \"\")",
+            path.display()
+        )));
+    }
+    let prj = path.with_extension("prj");
+    if let (Ok(wkt), Some(t)) = (std::fs::read_to_string(&prj), target) {
+        let own = Crs::from_wkt(&wkt).map_err(|m| InputError::Layer {
+            file: prj.display().to_string(),
+            message: m,
+        })?;
+        if !own.same_as(t) {
+            return Err(InputError::Layer {
+                file: path.display().to_string(),
+                message: format!(
+                    "the DEM is in {} but the city is built in {}: reproject the DEM (for \
+                     example with gdalwarp) to the output CRS",
+                    own.definition, t.definition
+                ),
+            });
+        }
+    }
+    Ok(Some(dem::Dem::read_ascii(&path)?))
 }
 
 /// Free-standing fence lines: each part of each polyline, with the feature's attributes.

@@ -1,0 +1,243 @@
+//! Terrain: an elevation grid (ESRI ASCII grid, `.asc`) sampled bilinearly.
+//!
+//! The grid is in the output CRS (a `.prj` beside it that says otherwise is an error: reproject
+//! the DEM first). Cells equal to `NODATA_value` are left out of the interpolation; a point
+//! outside the grid gets the elevation of the nearest edge cell and is counted, so the report
+//! can say how many features stood off the DEM.
+
+use std::path::Path;
+
+use geo_types::Coord;
+
+use super::InputError;
+
+/// An elevation grid: `z[row * ncols + col]`, row 0 at the top (north).
+#[derive(Debug, Clone)]
+pub struct Dem {
+    pub file: String,
+    pub ncols: usize,
+    pub nrows: usize,
+    /// Lower-left corner of the lower-left cell.
+    pub xll: f64,
+    pub yll: f64,
+    pub cell: f64,
+    z: Vec<f64>,
+}
+
+/// An elevation, and whether the point lay outside the grid.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    pub z: f64,
+    pub outside: bool,
+}
+
+impl Dem {
+    /// Reads an ESRI ASCII grid.
+    pub fn read_ascii(path: &Path) -> Result<Dem, InputError> {
+        let file = path.display().to_string();
+        let bad = |message: String| InputError::Layer {
+            file: file.clone(),
+            message,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+        let mut words = text.split_ascii_whitespace().peekable();
+        let (mut ncols, mut nrows, mut cell, mut nodata) = (None, None, None, None);
+        let (mut x, mut y, mut centre) = (None, None, false);
+        while let Some(w) = words.peek() {
+            let key = w.to_ascii_lowercase();
+            if key.parse::<f64>().is_ok() {
+                break;
+            }
+            words.next();
+            let v = words
+                .next()
+                .ok_or_else(|| bad(format!("header `{key}` has no value")))?;
+            let num = |v: &str| -> Result<f64, InputError> {
+                v.parse::<f64>()
+                    .map_err(|_| bad(format!("header `{key}` = `{v}` is not a number")))
+            };
+            match key.as_str() {
+                "ncols" => ncols = Some(num(v)? as usize),
+                "nrows" => nrows = Some(num(v)? as usize),
+                "xllcorner" => x = Some(num(v)?),
+                "yllcorner" => y = Some(num(v)?),
+                "xllcenter" => {
+                    x = Some(num(v)?);
+                    centre = true;
+                }
+                "yllcenter" => {
+                    y = Some(num(v)?);
+                    centre = true;
+                }
+                "cellsize" => cell = Some(num(v)?),
+                "nodata_value" => nodata = Some(num(v)?),
+                other => return Err(bad(format!("unknown header `{other}` (an ESRI ASCII grid has ncols, nrows, xllcorner, yllcorner, cellsize, NODATA_value)"))),
+            }
+        }
+        let missing = |k: &str| bad(format!("the header lacks `{k}`"));
+        let (ncols, nrows) = (
+            ncols.ok_or_else(|| missing("ncols"))?,
+            nrows.ok_or_else(|| missing("nrows"))?,
+        );
+        let cell = cell.ok_or_else(|| missing("cellsize"))?;
+        let (mut xll, mut yll) = (
+            x.ok_or_else(|| missing("xllcorner"))?,
+            y.ok_or_else(|| missing("yllcorner"))?,
+        );
+        if !(cell.is_finite() && cell > 0.0) || ncols == 0 || nrows == 0 {
+            return Err(bad(format!(
+                "a grid of {ncols} x {nrows} cells of {cell} m is empty"
+            )));
+        }
+        if ncols.saturating_mul(nrows) > 400_000_000 {
+            return Err(bad(format!("{ncols} x {nrows} cells is more than this tool reads (4e8); crop or resample the DEM")));
+        }
+        if centre {
+            xll -= cell / 2.0;
+            yll -= cell / 2.0;
+        }
+        let mut z = Vec::with_capacity(ncols * nrows);
+        for w in words {
+            let v: f64 = w
+                .parse()
+                .map_err(|_| bad(format!("value {} (`{w}`) is not a number", z.len() + 1)))?;
+            z.push(if Some(v) == nodata || !v.is_finite() {
+                f64::NAN
+            } else {
+                v
+            });
+        }
+        if z.len() != ncols * nrows {
+            return Err(bad(format!(
+                "{} values for {ncols} x {nrows} = {} cells (is the file cut short?)",
+                z.len(),
+                ncols * nrows
+            )));
+        }
+        if z.iter().all(|v| v.is_nan()) {
+            return Err(bad("every cell is NODATA".into()));
+        }
+        Ok(Dem {
+            file,
+            ncols,
+            nrows,
+            xll,
+            yll,
+            cell,
+            z,
+        })
+    }
+
+    fn at(&self, col: usize, row: usize) -> f64 {
+        self.z[row * self.ncols + col]
+    }
+
+    /// The elevation at `p`: bilinear between the four nearest cell centres (NODATA cells
+    /// left out), the nearest edge cell's outside the grid, the nearest valid cell's when all
+    /// four are NODATA.
+    pub fn sample(&self, p: Coord<f64>) -> Sample {
+        let top = self.yll + self.nrows as f64 * self.cell;
+        let fx = (p.x - self.xll) / self.cell - 0.5;
+        let fy = (top - p.y) / self.cell - 0.5;
+        let outside = p.x < self.xll
+            || p.x > self.xll + self.ncols as f64 * self.cell
+            || p.y < self.yll
+            || p.y > top;
+        let fx = fx.clamp(0.0, (self.ncols - 1) as f64);
+        let fy = fy.clamp(0.0, (self.nrows - 1) as f64);
+        let (c0, r0) = (fx.floor() as usize, fy.floor() as usize);
+        let (c1, r1) = ((c0 + 1).min(self.ncols - 1), (r0 + 1).min(self.nrows - 1));
+        let (tx, ty) = (fx - c0 as f64, fy - r0 as f64);
+        let mut sum = 0.0;
+        let mut weight = 0.0;
+        for (c, r, w) in [
+            (c0, r0, (1.0 - tx) * (1.0 - ty)),
+            (c1, r0, tx * (1.0 - ty)),
+            (c0, r1, (1.0 - tx) * ty),
+            (c1, r1, tx * ty),
+        ] {
+            let v = self.at(c, r);
+            if !v.is_nan() && w > 0.0 {
+                sum += v * w;
+                weight += w;
+            }
+        }
+        let z = if weight > 0.0 {
+            sum / weight
+        } else {
+            self.nearest_valid(c0, r0)
+        };
+        Sample { z, outside }
+    }
+
+    /// The valid cell nearest (col, row), searching rings outward.
+    fn nearest_valid(&self, col: usize, row: usize) -> f64 {
+        let reach = self.ncols.max(self.nrows);
+        for d in 1..=reach {
+            let mut best: Option<(usize, f64)> = None;
+            let (c0, c1) = (col.saturating_sub(d), (col + d).min(self.ncols - 1));
+            let (r0, r1) = (row.saturating_sub(d), (row + d).min(self.nrows - 1));
+            for r in r0..=r1 {
+                for c in c0..=c1 {
+                    let v = self.at(c, r);
+                    let dist = c.abs_diff(col).pow(2) + r.abs_diff(row).pow(2);
+                    if !v.is_nan() && best.is_none_or(|(bd, _)| dist < bd) {
+                        best = Some((dist, v));
+                    }
+                }
+            }
+            if let Some((_, v)) = best {
+                return v;
+            }
+        }
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(text: &str) -> Result<Dem, InputError> {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("dem.asc");
+        std::fs::write(&p, text).unwrap();
+        Dem::read_ascii(&p)
+    }
+
+    const SLOPE: &str =
+        "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 10\nNODATA_value -9999\n\
+                         0 10 20\n0 10 20\n";
+
+    #[test]
+    fn bilinear_inside_and_nearest_edge_outside() {
+        let d = grid(SLOPE).unwrap();
+        // Cell centres at x = 5, 15, 25: z rises 1 m per metre east.
+        let s = d.sample(Coord { x: 10.0, y: 10.0 });
+        assert!((s.z - 5.0).abs() < 1e-9 && !s.outside, "{s:?}");
+        let s = d.sample(Coord { x: 22.5, y: 3.0 });
+        assert!((s.z - 17.5).abs() < 1e-9);
+        let s = d.sample(Coord { x: 100.0, y: 5.0 });
+        assert!(s.outside && (s.z - 20.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn nodata_cells_are_left_out() {
+        let d = grid("ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 10\nNODATA_value -9999\n7 -9999\n").unwrap();
+        assert!((d.sample(Coord { x: 12.0, y: 5.0 }).z - 7.0).abs() < 1e-12);
+        assert!((d.sample(Coord { x: 19.0, y: 5.0 }).z - 7.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn broken_grids_say_what_is_wrong() {
+        let e = grid("ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 10\n1 2 3\n4 5\n")
+            .unwrap_err();
+        assert!(e.to_string().contains("5 values for 3 x 2"), "{e}");
+        let e = grid("ncols 3\nnrows 2\nxllcorner 0\ncellsize 10\n1 2 3 4 5 6\n").unwrap_err();
+        assert!(e.to_string().contains("lacks `yllcorner`"), "{e}");
+        let e =
+            grid("ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 10\nNODATA_value 1\n1\n")
+                .unwrap_err();
+        assert!(e.to_string().contains("every cell is NODATA"), "{e}");
+    }
+}

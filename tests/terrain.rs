@@ -1,0 +1,148 @@
+//! Terrain from a DEM: houses on the lowest ground under their lots, fences on the ground
+//! under each end, clear messages for a DEM that is off the lots or in another CRS.
+
+mod common;
+
+use std::path::Path;
+
+use common::{build_ok, copy_fixture, edo_city, fixture, load_tile, read_json, read_lots};
+
+/// A plane rising 5 cm per metre east and 2 cm per metre north, as an ESRI ASCII grid of
+/// `n` x `n` cells of 10 m from (x0, y0).
+fn write_plane(path: &Path, x0: f64, y0: f64, n: usize) {
+    let mut s = format!(
+        "ncols {n}\nnrows {n}\nxllcorner {x0}\nyllcorner {y0}\ncellsize 10\nNODATA_value -9999\n"
+    );
+    for row in 0..n {
+        let y = y0 + (n - row) as f64 * 10.0 - 5.0;
+        let line: Vec<String> = (0..n)
+            .map(|c| {
+                let x = x0 + c as f64 * 10.0 + 5.0;
+                format!("{:.4}", plane(x - x0, y - y0))
+            })
+            .collect();
+        s.push_str(&line.join(" "));
+        s.push('\n');
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+fn plane(dx: f64, dy: f64) -> f64 {
+    0.05 * dx + 0.02 * dy
+}
+
+const X0: f64 = -23_100.0;
+const Y0: f64 = -110_100.0;
+
+#[test]
+fn houses_and_fences_stand_on_the_dem() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    copy_fixture("kyoto-small", &input);
+    write_plane(&input.join("dem.asc"), X0, Y0, 100);
+    let out = dir.path().join("out");
+    let r = build_ok(&input, &out, &["--quiet", "--no-plan"]);
+    assert!(
+        !r["warnings"].to_string().contains("outside the DEM"),
+        "{}",
+        r["warnings"]
+    );
+    let m = read_json(&out.join("manifest.json"));
+    let origin = [
+        m["origin"][0].as_f64().unwrap(),
+        m["origin"][1].as_f64().unwrap(),
+    ];
+    let lots = read_lots(&fixture("kyoto-small").join("lots.shp"));
+    let (mut houses, mut fences) = (0, 0);
+    for t in m["tiles"].as_array().unwrap() {
+        for o in load_tile(&out.join(t["obj"]["path"].as_str().unwrap()), origin) {
+            let (kind, id) = o.name.split_once('_').unwrap();
+            let base = o
+                .vertices
+                .iter()
+                .map(|v| v[2])
+                .fold(f64::INFINITY, f64::min);
+            match kind {
+                "machiya" => {
+                    // The flat base is the lowest ground under the lot: never floating.
+                    let lot = &lots[id].2;
+                    let lowest = lot
+                        .exterior()
+                        .0
+                        .iter()
+                        .map(|c| plane(c.x - X0, c.y - Y0))
+                        .fold(f64::INFINITY, f64::min);
+                    assert!(
+                        (base - lowest).abs() < 0.002,
+                        "{}: base {base}, lowest ground {lowest}",
+                        o.name
+                    );
+                    houses += 1;
+                }
+                "fence" => {
+                    // Every vertex on the lot's edge, at the foot of a wall, is on the ground
+                    // under it; the inner foot of a thick wall follows the edge's slope, so
+                    // it sits within the cross slope x thickness (5 cm/m x 0.6 m) of it.
+                    for v in &o.vertices {
+                        let g = plane(v[0] - X0, v[1] - Y0);
+                        assert!(v[2] >= g - 0.031, "{}: {v:?} below ground {g}", o.name);
+                    }
+                    let on_ground = o
+                        .vertices
+                        .iter()
+                        .filter(|v| (v[2] - plane(v[0] - X0, v[1] - Y0)).abs() < 0.002)
+                        .count();
+                    assert!(
+                        on_ground >= 8,
+                        "{}: {on_ground} vertices on the ground",
+                        o.name
+                    );
+                    fences += 1;
+                }
+                _ => {}
+            }
+        }
+    }
+    assert!(
+        houses > 300 && fences == 2,
+        "{houses} houses, {fences} fences"
+    );
+}
+
+#[test]
+fn a_dem_off_the_lots_warns_and_one_in_another_crs_stops() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    copy_fixture("kyoto-small", &input);
+    // Covers only the south-west corner of the town.
+    write_plane(&input.join("dem.asc"), X0, Y0, 25);
+    let r = build_ok(&input, &dir.path().join("out"), &["--quiet", "--no-plan"]);
+    assert!(
+        r["warnings"].to_string().contains("lie outside the DEM"),
+        "{}",
+        r["warnings"]
+    );
+
+    // A .prj in another zone: an error naming the file and what to do, nothing written.
+    std::fs::write(
+        input.join("dem.prj"),
+        std::fs::read_to_string(input.join("lots.prj"))
+            .unwrap()
+            .replace("136", "139"),
+    )
+    .unwrap();
+    let out = dir.path().join("out2");
+    let run = edo_city()
+        .arg("build")
+        .arg(&input)
+        .args(["--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        err.contains("dem.asc") && err.contains("reproject the DEM"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
