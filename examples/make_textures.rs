@@ -352,6 +352,21 @@ fn main() {
     });
     c.save("tsuchikabe.png");
 
+    // Bare ground of streets and yards: packed earth with pebbles, 4 m per repeat.
+    let mut c = Canvas::new(128, 128);
+    c.band(0.0, 1.0, |x, y| {
+        let pebble = if noise(x / 3, y / 3, 48) > 0.82 {
+            -0.2
+        } else {
+            0.0
+        };
+        shade(
+            [150, 128, 98],
+            noise(x, y, 49) * 0.06 + noise(x / 8, y / 8, 50) * 0.05 + pebble,
+        )
+    });
+    c.save("ground.png");
+
     // Koshi (格子) lattice on its own, tileable: 8 slats per repeat.
     let mut c = Canvas::new(128, 128);
     c.band(0.0, 1.0, lattice(16, 7));

@@ -281,8 +281,9 @@ fn run(
         .map(|(id, lots)| {
             let t = Instant::now();
             let fences = plan.fences.get(*id).map_or(&[][..], Vec::as_slice);
+            let ground = terrain_of(&data, params, id);
             let meshes =
-                generate::generate_tile(lots, fences, catalog, params, plan.origin, &files);
+                generate::generate_tile(lots, fences, ground, catalog, params, plan.origin, &files);
             gen_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
             let t = Instant::now();
             let written = output::write_tile(&opts.out, id, plan.origin, &meshes.meshes)
@@ -390,7 +391,7 @@ pub fn check(
         .map(|(id, lots)| {
             let fences = plan.fences.get(id).map_or(&[][..], Vec::as_slice);
             let meshes =
-                generate::generate_tile(lots, fences, &catalog, params, plan.origin, &files);
+                generate::generate_tile(lots, fences, None, &catalog, params, plan.origin, &files);
             let none = report::ManifestFile {
                 path: String::new(),
                 bytes: 0,
@@ -446,6 +447,17 @@ pub fn draw_plan_of(out: &Path, tile: Option<&str>) -> Result<Vec<u8>, BuildErro
     output::plan::View::fit(&data, bounds)
         .and_then(|view| output::plan::draw_plan(&data, &plan, &view, grid, kura_view(params)))
         .ok_or_else(|| BuildError::Config("nothing to draw: no lots or footprints".into()))
+}
+
+/// The DEM and a tile's bounds, when `terrain = true` and there is a DEM.
+fn terrain_of<'a>(
+    data: &'a Dataset,
+    params: &Params,
+    tile: &'a str,
+) -> Option<(&'a crate::input::dem::Dem, &'a str, [f64; 4])> {
+    let dem = data.dem.as_ref().filter(|_| params.terrain)?;
+    let b = analyse::tiling::tile_bounds(tile, params.tile_size, params.tile_origin)?;
+    Some((dem, tile, b))
 }
 
 /// How plan.png shows kura: not at all, or built ones filled and (with avoidance) refused

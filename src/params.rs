@@ -57,6 +57,9 @@ pub struct Params {
     /// directory.
     #[serde(default)]
     pub textures: String,
+    /// Write the DEM's terrain as a textured mesh `terrain_<tile>` in each tile.
+    #[serde(default)]
+    pub terrain: bool,
     /// Template parameter values: `[template.<name>] <param> = <number>`.
     #[serde(default)]
     pub template: BTreeMap<String, BTreeMap<String, f64>>,
@@ -582,6 +585,7 @@ mod partial {
         fence: Option<Fence>,
         type_mix: Option<BTreeMap<String, f64>>,
         textures: Option<String>,
+        terrain: Option<bool>,
         template: Option<BTreeMap<String, BTreeMap<String, f64>>>,
         district: Option<BTreeMap<String, District>>,
     }

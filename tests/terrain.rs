@@ -146,3 +146,59 @@ fn a_dem_off_the_lots_warns_and_one_in_another_crs_stops() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn the_terrain_mesh_is_the_dem_clipped_to_each_tile() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    copy_fixture("kyoto-small", &input);
+    write_plane(&input.join("dem.asc"), X0, Y0, 100);
+    let params = dir.path().join("p.toml");
+    std::fs::write(&params, "terrain = true\n").unwrap();
+    let out = dir.path().join("out");
+    build_ok(
+        &input,
+        &out,
+        &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
+    );
+    let m = read_json(&out.join("manifest.json"));
+    let origin = [
+        m["origin"][0].as_f64().unwrap(),
+        m["origin"][1].as_f64().unwrap(),
+    ];
+    let size = m["tile_size"].as_f64().unwrap();
+    let grid = m["params"]["tile_origin"].as_array().unwrap();
+    let (gx, gy) = (grid[0].as_f64().unwrap(), grid[1].as_f64().unwrap());
+    let mut tiles = 0;
+    for t in m["tiles"].as_array().unwrap() {
+        let id = t["id"].as_str().unwrap();
+        let (c, r) = id.split_once('_').unwrap();
+        let (x0, y0) = (
+            gx + c.parse::<f64>().unwrap() * size,
+            gy + r.parse::<f64>().unwrap() * size,
+        );
+        let objects = load_tile(&out.join(t["obj"]["path"].as_str().unwrap()), origin);
+        let ground: Vec<_> = objects
+            .iter()
+            .filter(|o| o.name == format!("terrain_{id}"))
+            .collect();
+        assert_eq!(ground.len(), 1, "{id}: one terrain object");
+        for v in &ground[0].vertices {
+            assert!(
+                v[0] >= x0 - 1e-3
+                    && v[0] <= x0 + size + 1e-3
+                    && v[1] >= y0 - 1e-3
+                    && v[1] <= y0 + size + 1e-3,
+                "{id}: {v:?} off the tile"
+            );
+            // Inside the DEM's cell centres the bilinear surface is the plane itself.
+            if v[0] > X0 + 5.0 && v[1] > Y0 + 5.0 && v[0] < X0 + 995.0 && v[1] < Y0 + 995.0 {
+                let g = plane(v[0] - X0, v[1] - Y0);
+                assert!((v[2] - g).abs() < 0.002, "{id}: {v:?} vs {g}");
+            }
+        }
+        assert!(ground[0].materials.contains(&"ground".to_string()));
+        tiles += 1;
+    }
+    assert_eq!(tiles, 4);
+}

@@ -43,6 +43,13 @@ pub fn parse_tile_id(id: &str) -> Option<(i64, i64)> {
     Some((c.parse().ok()?, r.parse().ok()?))
 }
 
+/// The rectangle `[xmin, ymin, xmax, ymax]` a tile id covers.
+pub fn tile_bounds(id: &str, size: f64, origin: [f64; 2]) -> Option<[f64; 4]> {
+    let (c, r) = parse_tile_id(id)?;
+    let (x, y) = (origin[0] + c as f64 * size, origin[1] + r as f64 * size);
+    Some([x, y, x + size, y + size])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

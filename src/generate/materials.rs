@@ -209,6 +209,12 @@ pub const MATERIALS: &[Material] = &[
         alpha: true,
         texture: Some("person_08.png"),
     },
+    Material {
+        name: "ground",
+        kd: [0.55, 0.48, 0.38],
+        alpha: false,
+        texture: Some("ground.png"),
+    },
 ];
 
 /// Texture files, compiled in: (file name, PNG bytes).
@@ -289,6 +295,7 @@ pub const TEXTURES: &[(&str, &[u8])] = &[
         "person_08.png",
         include_bytes!("../../textures/person_08.png"),
     ),
+    ("ground.png", include_bytes!("../../textures/ground.png")),
 ];
 
 /// Index of a material by name.

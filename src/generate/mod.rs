@@ -10,6 +10,7 @@ pub mod kura;
 pub mod machiya;
 pub mod materials;
 pub mod mesh;
+pub mod terrain;
 
 use crate::model::{FenceKind, KuraDecision, PlannedFence, PlannedMachiya, Skipped, TileStats};
 use crate::params::Params;
@@ -39,9 +40,12 @@ fn template_random(seed: u64, layer: &str, id: &str) -> f64 {
     crate::rng::feature_rng(seed, &format!("{layer}/template"), id).random::<f64>()
 }
 
+/// `ground`: the DEM and the tile's bounds, when the terrain is to be written.
+#[allow(clippy::too_many_arguments)]
 pub fn generate_tile(
     lots: &[PlannedMachiya],
     fences: &[PlannedFence],
+    ground: Option<(&crate::input::dem::Dem, &str, [f64; 4])>,
     catalog: &Catalog,
     params: &Params,
     origin: [f64; 2],
@@ -125,6 +129,14 @@ pub fn generate_tile(
         }
     }
     build_fences(fences, catalog, params, frame, files, &mut out);
+    if let Some((dem, tile, bounds)) = ground {
+        out.meshes.extend(terrain::terrain_mesh(
+            format!("terrain_{tile}"),
+            dem,
+            bounds,
+            frame,
+        ));
+    }
     out
 }
 
