@@ -10,7 +10,7 @@ use crate::generate::instance::{instantiate, Site};
 use crate::generate::mesh::{open_edges, Frame, Mesh};
 use crate::output::{atomic::write_atomic, mtl, obj, texture_library};
 use crate::params::Params;
-use crate::templates::template::{input, N_INPUTS};
+use crate::templates::template::{SiteInputs, N_INPUTS};
 use crate::templates::{Catalog, Template};
 
 /// A template built alone.
@@ -27,22 +27,21 @@ pub struct Alone {
 
 /// The inputs of a rectangle `width` x `depth` at the origin, frontage along x.
 pub fn rectangle_inputs(width: f64, depth: f64, params: &Params) -> [f64; N_INPUTS] {
-    let mut x = [0.0; N_INPUTS];
-    for (name, value) in [
-        ("width", width),
-        ("lot_depth", depth),
-        ("frontage_bx", width),
-        ("centroid_x", width / 2.0),
-        ("centroid_y", depth / 2.0),
-        ("feature_id", -1.0),
-        ("district", -1.0),
-        ("machiya_depth", params.machiya.depth),
-        ("min_depth", params.machiya.min_depth),
-        ("random", 0.5),
-    ] {
-        x[input(name)] = value;
+    SiteInputs {
+        width,
+        lot_depth: depth,
+        b: geo_types::Coord { x: width, y: 0.0 },
+        centroid: geo_types::Coord {
+            x: width / 2.0,
+            y: depth / 2.0,
+        },
+        id: "",
+        machiya_depth: params.machiya.depth,
+        min_depth: params.machiya.min_depth,
+        random: 0.5,
+        ..SiteInputs::default()
     }
-    x
+    .slots()
 }
 
 /// Builds template `t` on a `width` x `depth` rectangle with the parameter file's values for

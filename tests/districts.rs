@@ -2,25 +2,13 @@
 
 mod common;
 
-use common::{build_ok, edo_city};
+use common::{build_ok, edo_city, synth};
 
 #[test]
 fn two_districts_draw_from_their_own_type_mixes() {
     let dir = tempfile::tempdir().unwrap();
     let town = dir.path().join("town");
-    assert!(edo_city()
-        .args([
-            "synth",
-            town.to_str().unwrap(),
-            "--lots",
-            "3000",
-            "--seed",
-            "3"
-        ])
-        .output()
-        .unwrap()
-        .status
-        .success());
+    synth(&town, 3000, 3);
     let params = dir.path().join("p.toml");
     std::fs::write(
         &params,

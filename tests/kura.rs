@@ -5,7 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{build_ok, distance_to_lot, edo_city, load_tile, read_json};
+use common::{build_ok, distance_to_lot, edo_city, load_tile, read_json, synth};
 use edo_city::synth::{write_blocks, write_lots, SynthLot};
 use geo_types::{Coord, LineString, Polygon};
 
@@ -118,18 +118,7 @@ fn back_to_back_lots_collide_and_lose_their_kura_unless_avoidance_is_off() {
 fn table2_is_in_the_report_per_district_and_beside_the_paper() {
     let dir = tempfile::tempdir().unwrap();
     let town = dir.path().join("town");
-    let out = edo_city()
-        .args([
-            "synth",
-            town.to_str().unwrap(),
-            "--lots",
-            "1500",
-            "--seed",
-            "4",
-        ])
-        .output()
-        .unwrap();
-    assert!(out.status.success());
+    synth(&town, 1500, 4);
     let city = dir.path().join("city");
     let run = edo_city()
         .args([
@@ -180,19 +169,7 @@ fn table2_is_in_the_report_per_district_and_beside_the_paper() {
 fn kura_do_not_depend_on_tiles_or_threads() {
     let dir = tempfile::tempdir().unwrap();
     let town = dir.path().join("town");
-    assert!(edo_city()
-        .args([
-            "synth",
-            town.to_str().unwrap(),
-            "--lots",
-            "1200",
-            "--seed",
-            "11"
-        ])
-        .output()
-        .unwrap()
-        .status
-        .success());
+    synth(&town, 1200, 11);
     let full = dir.path().join("full");
     build_ok(&town, &full, &["--quiet", "--no-plan", "-j", "2"]);
     let m = read_json(&full.join("manifest.json"));

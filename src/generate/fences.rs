@@ -10,7 +10,7 @@ use super::mesh::{Frame, Mesh};
 use crate::model::{FenceKind, PlannedFence};
 use crate::params::Params;
 use crate::templates::expr::Lot;
-use crate::templates::template::{input, N_INPUTS};
+use crate::templates::template::SiteInputs;
 use crate::templates::Catalog;
 
 /// The site of a segment: u from `a` to `b`, the enclosed side (v > 0) on the left.
@@ -54,30 +54,23 @@ pub fn build_segment(
         x: (f.a.x + f.b.x) / 2.0,
         y: (f.a.y + f.b.y) / 2.0,
     };
-    let mut x = [0.0; N_INPUTS];
-    for (name, value) in [
-        ("width", len),
-        ("lot_depth", 1.0),
-        ("frontage_ax", f.a.x),
-        ("frontage_ay", f.a.y),
-        ("frontage_bx", f.b.x),
-        ("frontage_by", f.b.y),
-        ("centroid_x", mid.x),
-        ("centroid_y", mid.y),
-        ("ground", f.ground),
-        ("feature_id", super::machiya::numeric_id(Some(&f.id))),
-        (
-            "district",
-            super::machiya::numeric_id(f.district.as_deref()),
-        ),
-        ("machiya_depth", params.machiya.depth),
-        ("min_depth", params.machiya.min_depth),
-        ("random", random),
-        ("start_mitre", f.start_mitre),
-        ("end_mitre", f.end_mitre),
-    ] {
-        x[input(name)] = value;
+    let x = SiteInputs {
+        width: len,
+        lot_depth: 1.0,
+        a: f.a,
+        b: f.b,
+        centroid: mid,
+        ground: f.ground,
+        id: &f.id,
+        district: f.district.as_deref(),
+        machiya_depth: params.machiya.depth,
+        min_depth: params.machiya.min_depth,
+        random,
+        start_mitre: f.start_mitre,
+        end_mitre: f.end_mitre,
+        ..SiteInputs::default()
     }
+    .slots();
     let overrides = catalog.overrides(&t.name, f.district.as_deref());
     let slots = t.evaluate(&x, &overrides, &f.attrs, &site as &dyn Lot)?;
     instantiate(t, &slots, &site, frame, mesh)?;

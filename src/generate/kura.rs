@@ -11,7 +11,7 @@ use super::mesh::{Frame, Mesh};
 use crate::model::PlannedMachiya;
 use crate::params::MachiyaParams;
 use crate::templates::expr::Lot;
-use crate::templates::template::{input, N_INPUTS};
+use crate::templates::template::SiteInputs;
 use crate::templates::Template;
 
 /// Builds the kura of `m` on `rect` (`[u0, v0, u1, v1]` in the machiya's frame).
@@ -47,28 +47,21 @@ pub fn build(
         at([rect[2], rect[1]]),
         at([(rect[0] + rect[2]) / 2.0, (rect[1] + rect[3]) / 2.0]),
     );
-    let mut x = [0.0; N_INPUTS];
-    for (name, value) in [
-        ("width", w),
-        ("lot_depth", d),
-        ("frontage_ax", a.x),
-        ("frontage_ay", a.y),
-        ("frontage_bx", b.x),
-        ("frontage_by", b.y),
-        ("centroid_x", c.x),
-        ("centroid_y", c.y),
-        ("ground", m.ground),
-        ("feature_id", super::machiya::numeric_id(Some(&m.id))),
-        (
-            "district",
-            super::machiya::numeric_id(m.district.as_deref()),
-        ),
-        ("machiya_depth", params.depth),
-        ("min_depth", params.min_depth),
-        ("random", random),
-    ] {
-        x[input(name)] = value;
+    let x = SiteInputs {
+        width: w,
+        lot_depth: d,
+        a,
+        b,
+        centroid: c,
+        ground: m.ground,
+        id: &m.id,
+        district: m.district.as_deref(),
+        machiya_depth: params.depth,
+        min_depth: params.min_depth,
+        random,
+        ..SiteInputs::default()
     }
+    .slots();
     let slots = t.evaluate(&x, overrides, &[], &site as &dyn Lot)?;
     let mut mesh = Mesh::new(format!("kura_{}", m.id));
     instantiate(t, &slots, &site, frame, &mut mesh)?;

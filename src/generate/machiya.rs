@@ -5,15 +5,13 @@
 //! looks like is its type's template (`templates/machiya/`); this module gives the template
 //! its site (the lot in the frontage frame) and its inputs.
 
-use geo_types::Coord;
-
 use super::clip::{area, dedup, LocalPoly, LocalRing};
 use super::instance::{instantiate, Local, Site};
 use super::mesh::{Frame, Mesh};
 use crate::model::PlannedMachiya;
 use crate::params::MachiyaParams;
 use crate::templates::expr::Lot;
-use crate::templates::template::{input, N_INPUTS};
+use crate::templates::template::{SiteInputs, N_INPUTS};
 use crate::templates::Template;
 
 /// The lot of `m` in its frontage frame.
@@ -60,13 +58,6 @@ pub fn site_of(m: &PlannedMachiya) -> Result<Site, String> {
     })
 }
 
-/// A number for an id-like text: the text itself when it is a number, else -1.
-pub fn numeric_id(s: Option<&str>) -> f64 {
-    s.and_then(|s| s.trim().parse::<f64>().ok())
-        .filter(|x| x.is_finite())
-        .unwrap_or(-1.0)
-}
-
 /// What every template is told about a feature (see `template::INPUTS`).
 pub fn inputs(
     site: &Site,
@@ -74,39 +65,24 @@ pub fn inputs(
     params: &MachiyaParams,
     random: f64,
 ) -> [f64; N_INPUTS] {
-    let mut x = [0.0; N_INPUTS];
-    let c = m
-        .outline
-        .exterior()
-        .0
-        .first()
-        .copied()
-        .unwrap_or(Coord { x: 0.0, y: 0.0 });
-    let centroid = {
-        use geo::Centroid;
-        m.outline.centroid().map_or(c, |p| p.0)
-    };
+    use geo::Centroid;
     let f = &m.frontage;
-    for (name, value) in [
-        ("width", f.width()),
-        ("lot_depth", site.depth()),
-        ("frontage_ax", f.a.x),
-        ("frontage_ay", f.a.y),
-        ("frontage_bx", f.b.x),
-        ("frontage_by", f.b.y),
-        ("centroid_x", centroid.x),
-        ("centroid_y", centroid.y),
-        ("ground", m.ground),
-        ("feature_id", numeric_id(Some(&m.id))),
-        ("district", numeric_id(m.district.as_deref())),
-        ("building_height", m.height.unwrap_or(0.0)),
-        ("machiya_depth", params.depth),
-        ("min_depth", params.min_depth),
-        ("random", random),
-    ] {
-        x[input(name)] = value;
+    SiteInputs {
+        width: f.width(),
+        lot_depth: site.depth(),
+        a: f.a,
+        b: f.b,
+        centroid: m.outline.centroid().map_or(f.a, |p| p.0),
+        ground: m.ground,
+        id: &m.id,
+        district: m.district.as_deref(),
+        building_height: m.height.unwrap_or(0.0),
+        machiya_depth: params.depth,
+        min_depth: params.min_depth,
+        random,
+        ..SiteInputs::default()
     }
-    x
+    .slots()
 }
 
 /// Builds the mesh of one machiya, or says why it cannot be built.
@@ -141,6 +117,7 @@ mod tests {
     use crate::model::Frontage;
     use crate::params::Params;
     use crate::templates::Catalog;
+    use geo_types::Coord;
 
     fn build_plain(
         m: &PlannedMachiya,

@@ -4,6 +4,8 @@
 use std::collections::BTreeMap;
 use std::ops::Range;
 
+use geo_types::Coord;
+
 use super::expr::{compile, Expr, Lot};
 use super::file::{Loc, OutlineSource, PartSource, Source, Src, Text};
 use crate::generate::materials;
@@ -74,6 +76,63 @@ pub const INPUTS: &[(&str, &str)] = &[
 ];
 
 pub const N_INPUTS: usize = INPUTS.len();
+
+/// What a template is told about the site it is built on (the [`INPUTS`]); fields a kind of
+/// model does not have stay at their default.
+#[derive(Debug, Clone, Default)]
+pub struct SiteInputs<'a> {
+    pub width: f64,
+    pub lot_depth: f64,
+    /// The frontage's two vertices and the site's centroid, map coordinates.
+    pub a: Coord<f64>,
+    pub b: Coord<f64>,
+    pub centroid: Coord<f64>,
+    pub ground: f64,
+    pub id: &'a str,
+    pub district: Option<&'a str>,
+    pub building_height: f64,
+    pub machiya_depth: f64,
+    pub min_depth: f64,
+    pub random: f64,
+    pub start_mitre: f64,
+    pub end_mitre: f64,
+}
+
+/// A number for an id-like text: the text itself when it is a number, else -1.
+pub fn numeric_id(s: Option<&str>) -> f64 {
+    s.and_then(|s| s.trim().parse::<f64>().ok())
+        .filter(|x| x.is_finite())
+        .unwrap_or(-1.0)
+}
+
+impl SiteInputs<'_> {
+    /// The input slots, in [`INPUTS`] order.
+    pub fn slots(&self) -> [f64; N_INPUTS] {
+        let mut x = [0.0; N_INPUTS];
+        for (name, value) in [
+            ("width", self.width),
+            ("lot_depth", self.lot_depth),
+            ("frontage_ax", self.a.x),
+            ("frontage_ay", self.a.y),
+            ("frontage_bx", self.b.x),
+            ("frontage_by", self.b.y),
+            ("centroid_x", self.centroid.x),
+            ("centroid_y", self.centroid.y),
+            ("ground", self.ground),
+            ("feature_id", numeric_id(Some(self.id))),
+            ("district", numeric_id(self.district)),
+            ("building_height", self.building_height),
+            ("machiya_depth", self.machiya_depth),
+            ("min_depth", self.min_depth),
+            ("random", self.random),
+            ("start_mitre", self.start_mitre),
+            ("end_mitre", self.end_mitre),
+        ] {
+            x[input(name)] = value;
+        }
+        x
+    }
+}
 
 /// Slot of an input by name (for callers that fill inputs).
 pub fn input(name: &str) -> usize {

@@ -36,6 +36,12 @@ pub fn build_ok(input: &Path, out: &Path, extra: &[&str]) -> serde_json::Value {
     read_json(&out.join("report.json"))
 }
 
+/// A synthetic town of `lots` lots written by the library's `synth` (the same as the CLI's).
+#[allow(dead_code)]
+pub fn synth(dir: &Path, lots: usize, seed: u64) {
+    edo_city::synth::write_town(dir, lots, seed).expect("synth writes the town");
+}
+
 pub fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).expect("json exists")).expect("valid json")
 }
