@@ -33,6 +33,8 @@ pub const SKIPPED: [u8; 3] = [220, 90, 80];
 pub const OTHER_USE: [u8; 3] = [200, 215, 190];
 pub const FRONTAGE: [u8; 3] = [200, 30, 30];
 pub const KURA: [u8; 3] = [70, 70, 78];
+pub const FENCE: [u8; 3] = [95, 60, 35];
+pub const GATE: [u8; 3] = [210, 40, 40];
 pub const KURA_REFUSED: [u8; 3] = [235, 120, 30];
 
 /// What the image shows and how metres map to pixels.
@@ -239,6 +241,28 @@ pub fn draw_plan(
             }
         }
     }
+    // Walls and gates (section 4.3): a dark line along each wall segment, a red bar per gate.
+    let (wall, gate_bar) = (
+        Stroke {
+            width: 2.0,
+            ..Stroke::default()
+        },
+        Stroke {
+            width: 4.0,
+            ..Stroke::default()
+        },
+    );
+    let mut any_fence = false;
+    for f in plan.fences.values().flatten() {
+        if let Some(path) = line_path(view, &[f.a, f.b]) {
+            any_fence = true;
+            let (colour, stroke) = match f.kind {
+                crate::model::FenceKind::Wall => (FENCE, &wall),
+                crate::model::FenceKind::Gate => (GATE, &gate_bar),
+            };
+            pm.stroke_path(&path, &paint(colour, 255), stroke, id, None);
+        }
+    }
     // Centrelines on top: in cadastral data the roads are parcels too and hide the bands.
     for street in &data.streets {
         if let Some(path) = line_path(view, &street.line.0) {
@@ -260,7 +284,13 @@ pub fn draw_plan(
         Some(_) => 1 + usize::from(refused_any),
         None => 0,
     };
-    draw_legend(&mut pm, &colours, !data.footprints.is_empty(), kura_rows);
+    draw_legend(
+        &mut pm,
+        &colours,
+        !data.footprints.is_empty(),
+        kura_rows,
+        any_fence,
+    );
     encode_png(&pm)
 }
 
@@ -368,6 +398,7 @@ fn draw_legend(
     colours: &BTreeMap<String, [u8; 3]>,
     footprints: bool,
     kura_rows: usize,
+    fences: bool,
 ) {
     let mut rows: Vec<(String, [u8; 3])> = colours.iter().map(|(t, c)| (t.clone(), *c)).collect();
     if footprints {
@@ -381,6 +412,10 @@ fn draw_legend(
     .take(kura_rows)
     {
         rows.push((name.into(), colour));
+    }
+    if fences {
+        rows.push(("wall".into(), FENCE));
+        rows.push(("gate".into(), GATE));
     }
     rows.push(("other use".into(), OTHER_USE));
     rows.push(("skipped".into(), SKIPPED));
