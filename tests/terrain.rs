@@ -202,3 +202,48 @@ fn the_terrain_mesh_is_the_dem_clipped_to_each_tile() {
     }
     assert_eq!(tiles, 4);
 }
+
+#[test]
+fn a_geotiff_gives_the_same_city_as_the_same_ascii_grid() {
+    use tiff::encoder::{colortype, TiffEncoder};
+    use tiff::tags::Tag;
+    let n = 100;
+    // Values exact in f32 and in decimal, so both files hold the very same numbers.
+    let z = |col: usize, row: usize| (col as f32) * 0.5 + ((n - row) as f32) * 0.25;
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    copy_fixture("kyoto-small", &a);
+    copy_fixture("kyoto-small", &b);
+    let mut asc = format!("ncols {n}\nnrows {n}\nxllcorner {X0}\nyllcorner {Y0}\ncellsize 10\n");
+    for row in 0..n {
+        let line: Vec<String> = (0..n).map(|c| z(c, row).to_string()).collect();
+        asc.push_str(&line.join(" "));
+        asc.push('\n');
+    }
+    std::fs::write(a.join("dem.asc"), asc).unwrap();
+    // The GeoTIFF, found by the default name's stem (dem.tif), placed by its tags.
+    let mut enc = TiffEncoder::new(std::fs::File::create(b.join("dem.tif")).unwrap()).unwrap();
+    let mut img = enc
+        .new_image::<colortype::Gray32Float>(n as u32, n as u32)
+        .unwrap();
+    img.encoder()
+        .write_tag(Tag::ModelPixelScaleTag, &[10.0f64, 10.0, 0.0][..])
+        .unwrap();
+    let top = Y0 + n as f64 * 10.0;
+    img.encoder()
+        .write_tag(Tag::ModelTiepointTag, &[0.0f64, 0.0, 0.0, X0, top, 0.0][..])
+        .unwrap();
+    let data: Vec<f32> = (0..n)
+        .flat_map(|row| (0..n).map(move |c| z(c, row)))
+        .collect();
+    img.write_data(&data).unwrap();
+    let (oa, ob) = (dir.path().join("oa"), dir.path().join("ob"));
+    build_ok(&a, &oa, &["--quiet", "--no-plan"]);
+    build_ok(&b, &ob, &["--quiet", "--no-plan"]);
+    let tiles = |o: &Path| common::all_files(&o.join("tiles"));
+    assert_eq!(tiles(&oa), tiles(&ob), "the same tiles, byte for byte");
+    // And the DEM did move the houses: the same town without it differs.
+    let flat = dir.path().join("flat");
+    build_ok(&fixture("kyoto-small"), &flat, &["--quiet", "--no-plan"]);
+    assert_ne!(tiles(&oa), tiles(&flat));
+}

@@ -605,15 +605,20 @@ fn read_dem(
     if file.is_empty() {
         return Ok(None);
     }
-    let path = dir.join(file);
+    let mut path = dir.join(file);
     if !path.exists() {
-        if file == default_file {
+        // The default name also finds a GeoTIFF of the same stem.
+        let tif = path.with_extension("tif");
+        if file == default_file && tif.exists() {
+            path = tif;
+        } else if file == default_file {
             return Ok(None);
+        } else {
+            return Err(InputError::Missing(format!(
+                "no DEM: {} does not exist (set `layers.dem.file` to the right path, or to \"\")",
+                path.display()
+            )));
         }
-        return Err(InputError::Missing(format!(
-            "no DEM: {} does not exist (set `layers.dem.file` to the right path, or to \"\")",
-            path.display()
-        )));
     }
     let prj = path.with_extension("prj");
     if let (Ok(wkt), Some(t)) = (std::fs::read_to_string(&prj), target) {
@@ -632,7 +637,7 @@ fn read_dem(
             });
         }
     }
-    Ok(Some(dem::Dem::read_ascii(&path)?))
+    Ok(Some(dem::Dem::read(&path)?))
 }
 
 /// Free-standing fence lines: each part of each polyline, with the feature's attributes.
