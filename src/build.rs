@@ -158,6 +158,7 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
             )));
         }
     }
+    check_billboards(&catalog, params)?;
     let mixes = std::iter::once(("type_mix".to_string(), &params.type_mix)).chain(
         params
             .district
@@ -251,23 +252,7 @@ fn run(
     let textures =
         output::write_textures(&opts.out, texture_set).map_err(|e| write_err(&opts.out, e))?;
 
-    let files = generate::LayerFiles {
-        lots: opts
-            .input
-            .join(&params.layers.lots.file)
-            .display()
-            .to_string(),
-        footprints: opts
-            .input
-            .join(&params.layers.footprints.file)
-            .display()
-            .to_string(),
-        fences: opts
-            .input
-            .join(&params.layers.fences.file)
-            .display()
-            .to_string(),
-    };
+    let files = layer_files(&opts.input, params);
     let tiles: Vec<_> = plan
         .tiles
         .iter()
@@ -278,12 +263,13 @@ fn run(
     let (gen_ns, write_ns) = (AtomicU64::new(0), AtomicU64::new(0));
     let results: Vec<Result<report::ManifestTile, BuildError>> = tiles
         .par_iter()
-        .map(|(id, lots)| {
+        .map(|(id, _)| {
             let t = Instant::now();
-            let fences = plan.fences.get(*id).map_or(&[][..], Vec::as_slice);
-            let ground = terrain_of(&data, params, id);
-            let meshes =
-                generate::generate_tile(lots, fences, ground, catalog, params, plan.origin, &files);
+            let tile = generate::TilePlan {
+                ground: terrain_of(&data, params, id),
+                ..generate::TilePlan::of(&plan, id)
+            };
+            let meshes = generate::generate_tile(&tile, catalog, params, plan.origin, &files);
             gen_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
             let t = Instant::now();
             let written = output::write_tile(&opts.out, id, plan.origin, &meshes.meshes)
@@ -376,22 +362,14 @@ pub fn check(
 ) -> Result<report::Report, BuildError> {
     let catalog = load_catalog(params, templates)?;
     let (data, plan, _, _) = read_and_analyse(input, params, &catalog, &NoProgress)?;
-    let files = generate::LayerFiles {
-        lots: input.join(&params.layers.lots.file).display().to_string(),
-        footprints: input
-            .join(&params.layers.footprints.file)
-            .display()
-            .to_string(),
-        fences: input.join(&params.layers.fences.file).display().to_string(),
-    };
+    let files = layer_files(input, params);
     // Generate every tile (to find the houses that cannot be built), write nothing.
     let tiles: Vec<report::ManifestTile> = plan
         .tiles
         .par_iter()
-        .map(|(id, lots)| {
-            let fences = plan.fences.get(id).map_or(&[][..], Vec::as_slice);
-            let meshes =
-                generate::generate_tile(lots, fences, None, &catalog, params, plan.origin, &files);
+        .map(|(id, _)| {
+            let tile = generate::TilePlan::of(&plan, id);
+            let meshes = generate::generate_tile(&tile, &catalog, params, plan.origin, &files);
             let none = report::ManifestFile {
                 path: String::new(),
                 bytes: 0,
@@ -458,6 +436,55 @@ fn terrain_of<'a>(
     let dem = data.dem.as_ref().filter(|_| params.terrain)?;
     let b = analyse::tiling::tile_bounds(tile, params.tile_size, params.tile_origin)?;
     Some((dem, tile, b))
+}
+
+/// `people.template` / `trees.template` name templates of their kind, and every texture
+/// they list is in the library.
+fn check_billboards(catalog: &Catalog, params: &Params) -> Result<(), BuildError> {
+    let p = &params.people;
+    let t = &params.trees;
+    for (table, enabled, template, kind, textures) in [
+        ("people", p.enabled, &p.template, Kind::Person, &p.textures),
+        ("trees", t.enabled, &t.template, Kind::Tree, &t.textures),
+    ] {
+        if !enabled {
+            continue;
+        }
+        if catalog
+            .get(template)
+            .is_none_or(|t| t.kind != kind || t.is_abstract)
+        {
+            return Err(BuildError::Config(format!(
+                "{table}.template names `{template}`, which is not a {} template ({} templates: {})",
+                kind.name(),
+                kind.name(),
+                catalog.names_of(kind).join(", ")
+            )));
+        }
+        if let Some(bad) = textures
+            .iter()
+            .find(|n| generate::materials::find(n).is_none())
+        {
+            return Err(BuildError::Config(format!(
+                "{table}.textures names `{bad}`, which is not in the texture library ({})",
+                generate::materials::names().join(", ")
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The files each layer's features come from, for skip reports.
+fn layer_files(input: &Path, params: &Params) -> generate::LayerFiles {
+    let l = &params.layers;
+    let path = |f: &str| input.join(f).display().to_string();
+    generate::LayerFiles {
+        lots: path(&l.lots.file),
+        footprints: path(&l.footprints.file),
+        fences: path(&l.fences.file),
+        people: path(&l.people.file),
+        trees: path(&l.trees.file),
+    }
 }
 
 /// How plan.png shows kura: not at all, or built ones filled and (with avoidance) refused

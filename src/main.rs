@@ -537,6 +537,7 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
                 .join(", ")
         );
     }
+    print_billboards(r);
     println!(
         "  tiles      {:>7}  ({} written now, {:.1} MB)",
         c.tiles,
@@ -568,6 +569,33 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
 }
 
 /// The paper's Table 2 beside this build's figures.
+/// People and trees: how many, from where, and per district when there are districts.
+fn print_billboards(r: &edo_city::output::report::Report) {
+    let c = &r.counts;
+    for (name, n, by_district, drawn) in [
+        ("people", c.people, &c.people_by_district, "people.per_100m"),
+        ("trees", c.trees, &c.trees_by_district, "trees.per_ha"),
+    ] {
+        if n == 0 {
+            continue;
+        }
+        let source = match r.layers.iter().find(|l| l.role == name) {
+            Some(l) => format!("points of {}", l.file),
+            None => format!("drawn at {drawn}"),
+        };
+        let districts = if by_district.keys().any(|d| !d.is_empty()) {
+            let list: Vec<String> = by_district
+                .iter()
+                .map(|(d, n)| format!("{} {n}", if d.is_empty() { "(none)" } else { d }))
+                .collect();
+            format!("; by district: {}", list.join(", "))
+        } else {
+            String::new()
+        };
+        println!("  {name:<10} {n:>7}  ({source}{districts})");
+    }
+}
+
 fn print_table2(r: &edo_city::output::report::Report, enabled: bool, avoid: bool) {
     let (t, p) = (&r.table2.all, &r.table2.paper);
     if !enabled {

@@ -82,6 +82,18 @@ pub struct FenceLine {
     pub attrs: BTreeMap<String, String>,
 }
 
+/// A person or a tree given as a point (`people.shp`, `trees.shp`).
+#[derive(Debug, Clone)]
+pub struct PointFeature {
+    pub id: String,
+    pub record: usize,
+    pub at: Coord<f64>,
+    /// The `height` field, metres, when given.
+    pub height: Option<f64>,
+    /// The `texture` field as written (a material name or a number), when given.
+    pub texture: Option<String>,
+}
+
 /// A building footprint from the data, built as a house of its own height.
 #[derive(Debug, Clone)]
 pub struct Footprint {
@@ -135,6 +147,10 @@ pub struct Dataset {
     pub lots: Vec<Lot>,
     /// Free-standing fence lines.
     pub fence_lines: Vec<FenceLine>,
+    /// People and trees from point layers; `None` when the layer is absent (then they are
+    /// generated).
+    pub people: Option<Vec<PointFeature>>,
+    pub trees: Option<Vec<PointFeature>>,
     /// The terrain, when the input has one.
     pub dem: Option<crate::input::dem::Dem>,
     /// City blocks (machi 町 / gaiku 街区): their boundaries are street edges.
@@ -255,6 +271,41 @@ pub struct PlannedFence {
     pub attrs: Vec<(String, f64)>,
 }
 
+/// A billboard: a person or a tree (section 4.4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum BillboardKind {
+    Person,
+    Tree,
+}
+
+impl BillboardKind {
+    /// The layer name in reports, and the object name in a tile.
+    pub fn layer(self) -> &'static str {
+        match self {
+            BillboardKind::Person => "people",
+            BillboardKind::Tree => "trees",
+        }
+    }
+}
+
+/// One person or tree to build.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannedBillboard {
+    pub kind: BillboardKind,
+    /// The point's id, or for a generated point `<street or lot id>/<n>`.
+    pub id: String,
+    pub at: Coord<f64>,
+    /// The direction the picture faces, radians counter-clockwise from map east: along its
+    /// street for a person, any for a tree.
+    pub facing: f64,
+    pub height: f64,
+    /// Library material of the picture.
+    pub texture: String,
+    pub ground: f64,
+    pub district: Option<String>,
+    pub tile: TileId,
+}
+
 /// What section 4.2 decided for a machiya's kura (蔵). A rectangle is `[u0, v0, u1, v1]` in
 /// the machiya's frontage frame (u along the street, v into the lot).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -339,9 +390,14 @@ pub struct Plan {
     pub warnings: Vec<String>,
     /// Time spent placing kura and testing their provisional plots (for `--timings`).
     pub kura_time: std::time::Duration,
+    /// Time spent placing people and trees.
+    pub billboards_time: std::time::Duration,
     /// Fence segments and gates per tile, in input order (a tile here always has an entry,
     /// maybe empty, in `tiles`).
     pub fences: BTreeMap<TileId, Vec<PlannedFence>>,
+    /// People and trees per tile, only in tiles that have an entry in `tiles`; people first,
+    /// each kind in a fixed order.
+    pub billboards: BTreeMap<TileId, Vec<PlannedBillboard>>,
 }
 
 /// What generation found in one tile.
@@ -368,6 +424,13 @@ pub struct TileStats {
     pub gates: usize,
     #[serde(default)]
     pub wall_mm: BTreeMap<String, u64>,
+    /// People and trees built, per district ("" = none), and per texture.
+    #[serde(default)]
+    pub people_by_district: BTreeMap<String, usize>,
+    #[serde(default)]
+    pub trees_by_district: BTreeMap<String, usize>,
+    #[serde(default)]
+    pub billboard_textures: BTreeMap<String, usize>,
     /// Table 2 counts per district ("" = none).
     #[serde(default)]
     pub kura_counts: BTreeMap<String, KuraCounts>,

@@ -10,6 +10,9 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+mod billboards;
+pub use billboards::{PeopleParams, PointsLayer, TreesParams};
+
 /// The default parameter file, shipped inside the binary.
 pub const DEFAULT_TOML: &str = include_str!("../params/default.toml");
 
@@ -50,6 +53,8 @@ pub struct Params {
     pub kura: KuraParams,
     pub simplify: SimplifyParams,
     pub fence: FenceParams,
+    pub people: PeopleParams,
+    pub trees: TreesParams,
     /// Relative weights of the machiya types drawn for lots of unknown type.
     pub type_mix: BTreeMap<String, f64>,
     /// Directory of textures that replace the shipped ones by file name (a texture set, as
@@ -79,6 +84,14 @@ pub struct DistrictParams {
     /// Template parameter values in this district, on top of `[template.<name>]`.
     #[serde(default)]
     pub template: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Billboard densities in this district, replacing `people.per_100m`, `trees.per_ha`
+    /// and `trees.per_ha_machiya` there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub people_per_100m: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trees_per_ha: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trees_per_ha_machiya: Option<f64>,
 }
 
 impl Params {
@@ -88,6 +101,19 @@ impl Params {
             .and_then(|d| self.district.get(d))
             .and_then(|d| d.type_mix.as_ref())
             .unwrap_or(&self.type_mix)
+    }
+
+    /// A district's own value of a billboard density (`pick` chooses which), else `default`.
+    pub fn district_density(
+        &self,
+        district: Option<&str>,
+        pick: fn(&DistrictParams) -> Option<f64>,
+        default: f64,
+    ) -> f64 {
+        district
+            .and_then(|d| self.district.get(d))
+            .and_then(pick)
+            .unwrap_or(default)
     }
 
     /// `[district.<id>.template...]` of every district, as the catalog takes them.
@@ -109,6 +135,8 @@ pub struct Layers {
     pub footprints: FootprintsLayer,
     pub districts: DistrictsLayer,
     pub fences: FencesLayer,
+    pub people: PointsLayer,
+    pub trees: PointsLayer,
     pub dem: DemLayer,
 }
 
@@ -475,7 +503,20 @@ impl Params {
             if let Some(mix) = &d.type_mix {
                 check_mix(&format!("district.{id}.type_mix"), mix)?;
             }
+            for (key, v) in [
+                ("people_per_100m", d.people_per_100m),
+                ("trees_per_ha", d.trees_per_ha),
+                ("trees_per_ha_machiya", d.trees_per_ha_machiya),
+            ] {
+                if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+                    return Err(bad(format!(
+                        "`district.{id}.{key}` must be 0 or more, got {v}"
+                    )));
+                }
+            }
         }
+        self.people.validate().map_err(bad)?;
+        self.trees.validate().map_err(bad)?;
         Ok(())
     }
 }
@@ -583,6 +624,8 @@ mod partial {
         kura: Option<Kura>,
         simplify: Option<Simplify>,
         fence: Option<Fence>,
+        people: Option<super::billboards::partial::People>,
+        trees: Option<super::billboards::partial::Trees>,
         type_mix: Option<BTreeMap<String, f64>>,
         textures: Option<String>,
         terrain: Option<bool>,
@@ -595,6 +638,9 @@ mod partial {
     struct District {
         type_mix: Option<BTreeMap<String, f64>>,
         template: Option<BTreeMap<String, BTreeMap<String, f64>>>,
+        people_per_100m: Option<f64>,
+        trees_per_ha: Option<f64>,
+        trees_per_ha_machiya: Option<f64>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]
@@ -607,6 +653,8 @@ mod partial {
         footprints: Option<Footprints>,
         districts: Option<Districts>,
         fences: Option<FencesLayer>,
+        people: Option<super::billboards::partial::PointsLayer>,
+        trees: Option<super::billboards::partial::PointsLayer>,
         dem: Option<DemLayer>,
     }
     #[derive(Deserialize)]

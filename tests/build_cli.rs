@@ -36,6 +36,9 @@ fn kyoto_small_builds_and_every_tile_rereads_cleanly() {
             // A kura (storehouse) stands wholly inside its machiya's lot, roof included; the
             // walls of the samurai and temple lots stand on them, copings reaching out above
             // 2 m like eaves.
+            if o.name == "people" || o.name == "trees" {
+                continue; // billboards: tests/billboards.rs
+            }
             let (kind, id) = o.name.split_once('_').expect("objects are <kind>_<id>");
             let is_kura = kind == "kura";
             kura += is_kura as usize;

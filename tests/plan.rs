@@ -32,9 +32,15 @@ fn lots_are_painted_in_their_types_colours() {
         let c = m.outline.centroid().unwrap();
         let (x, y) = view.pixel(&c.0);
         // Leave out what the legend (top right) and the scale bar (bottom left) cover.
-        let under_legend = x > 2400.0 - 480.0 && y < 340.0;
+        let under_legend = x > 2400.0 - 480.0 && y < 480.0;
         let under_scale = x < 400.0 && y > 2400.0 - 80.0;
-        if under_legend || under_scale {
+        // ... and what a tree's crown (a quarter of its height) or a person's dot covers.
+        let under_billboard = plan.billboards.values().flatten().any(|b| {
+            let (bx, by) = view.pixel(&b.at);
+            let r = (b.height * 0.25 * view.scale).max(2.5) as f32 + 2.0;
+            (bx - x).hypot(by - y) <= r
+        });
+        if under_legend || under_scale || under_billboard {
             continue;
         }
         let p = png.get_pixel(x as u32, y as u32);

@@ -147,7 +147,8 @@ mod random_geometry {
             let files = edo_city::generate::LayerFiles::default();
             let mut houses = 0;
             for lots in plan.tiles.values() {
-                let t = edo_city::generate::generate_tile(lots, &[], None, &catalog, &params, plan.origin, &files);
+                let tile = edo_city::generate::TilePlan { lots, ..Default::default() };
+                let t = edo_city::generate::generate_tile(&tile, &catalog, &params, plan.origin, &files);
                 for s in &t.stats.skipped {
                     prop_assert!(!s.reason.is_empty());
                 }

@@ -25,21 +25,21 @@ pub type Quad = [Coord<f64>; 4];
 
 /// A machiya's frontage frame: u along the street, v into the lot.
 #[derive(Clone, Copy)]
-struct Frame {
-    a: Coord<f64>,
-    u: Coord<f64>,
-    v: Coord<f64>,
+pub(crate) struct Frame {
+    pub a: Coord<f64>,
+    pub u: Coord<f64>,
+    pub v: Coord<f64>,
 }
 
 impl Frame {
-    fn of(m: &PlannedMachiya) -> Frame {
+    pub fn of(m: &PlannedMachiya) -> Frame {
         Frame {
             a: m.frontage.a,
             u: m.frontage.u_axis(),
             v: m.frontage.v_axis(),
         }
     }
-    fn local(&self, c: Coord<f64>) -> [f64; 2] {
+    pub fn local(&self, c: Coord<f64>) -> [f64; 2] {
         let (dx, dy) = (c.x - self.a.x, c.y - self.a.y);
         [dx * self.u.x + dy * self.u.y, dx * self.v.x + dy * self.v.y]
     }
@@ -50,7 +50,7 @@ impl Frame {
         }
     }
     /// The rectangle `[u0, v0, u1, v1]` as a map quad.
-    fn quad(&self, r: [f64; 4]) -> Quad {
+    pub fn quad(&self, r: [f64; 4]) -> Quad {
         [
             self.map([r[0], r[1]]),
             self.map([r[2], r[1]]),
@@ -61,7 +61,7 @@ impl Frame {
 }
 
 /// The exterior ring in the frame, not closed.
-fn local_ring(m: &PlannedMachiya, f: Frame) -> Vec<[f64; 2]> {
+pub(crate) fn local_ring(m: &PlannedMachiya, f: Frame) -> Vec<[f64; 2]> {
     let r = &m.outline.exterior().0;
     r[..r.len().saturating_sub(1)]
         .iter()
@@ -71,7 +71,12 @@ fn local_ring(m: &PlannedMachiya, f: Frame) -> Vec<[f64; 2]> {
 
 /// Where the house ends behind the frontage: its type's `setback` + `depth` (else
 /// `machiya.depth`), at most the lot; a footprint building is its whole outline.
-fn house_end(m: &PlannedMachiya, lot_depth: f64, catalog: &Catalog, params: &Params) -> f64 {
+pub(crate) fn house_end(
+    m: &PlannedMachiya,
+    lot_depth: f64,
+    catalog: &Catalog,
+    params: &Params,
+) -> f64 {
     if m.height.is_some() {
         return lot_depth;
     }

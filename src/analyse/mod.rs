@@ -1,9 +1,11 @@
 //! Stage 2: analysis. Turns the [`Dataset`] into a [`Plan`]: for every machiya lot its
 //! frontage, type and tile. No I/O; every random choice through [`crate::rng`].
 
+pub mod billboards;
 pub mod fences;
 pub mod frontage;
 pub mod kura;
+pub mod obstacles;
 pub mod street;
 pub mod terrain;
 pub mod tiling;
@@ -123,6 +125,9 @@ pub fn analyse(
             }
         }
     }
+    let t = std::time::Instant::now();
+    billboards::plan_billboards(data, &mut plan, catalog, params);
+    plan.billboards_time = t.elapsed();
     if off_dem > 0 {
         if let Some(dem) = &data.dem {
             plan.warnings.push(format!(

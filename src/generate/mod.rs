@@ -3,6 +3,7 @@
 //! Generation is a pure function of the plan, the type catalog and the parameters: no I/O,
 //! no randomness of its own. A lot whose house cannot be built is skipped with a reason.
 
+pub mod billboards;
 pub mod clip;
 pub mod fences;
 pub mod instance;
@@ -12,7 +13,9 @@ pub mod materials;
 pub mod mesh;
 pub mod terrain;
 
-use crate::model::{FenceKind, KuraDecision, PlannedFence, PlannedMachiya, Skipped, TileStats};
+use crate::model::{
+    FenceKind, KuraDecision, PlannedBillboard, PlannedFence, PlannedMachiya, Skipped, TileStats,
+};
 use crate::params::Params;
 use crate::templates::Catalog;
 use mesh::{Frame, Mesh};
@@ -32,6 +35,30 @@ pub struct LayerFiles {
     pub lots: String,
     pub footprints: String,
     pub fences: String,
+    pub people: String,
+    pub trees: String,
+}
+
+/// What one tile of the plan holds.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TilePlan<'a> {
+    pub lots: &'a [PlannedMachiya],
+    pub fences: &'a [PlannedFence],
+    pub billboards: &'a [PlannedBillboard],
+    /// The DEM, the tile's id and its bounds, when the terrain is to be written.
+    pub ground: Option<(&'a crate::input::dem::Dem, &'a str, [f64; 4])>,
+}
+
+impl<'a> TilePlan<'a> {
+    /// Tile `id` of `plan`, without terrain.
+    pub fn of(plan: &'a crate::model::Plan, id: &str) -> TilePlan<'a> {
+        TilePlan {
+            lots: plan.tiles.get(id).map_or(&[][..], Vec::as_slice),
+            fences: plan.fences.get(id).map_or(&[][..], Vec::as_slice),
+            billboards: plan.billboards.get(id).map_or(&[][..], Vec::as_slice),
+            ground: None,
+        }
+    }
 }
 
 /// The `random` input of a feature's template: its own stream, apart from the type draw.
@@ -40,12 +67,10 @@ fn template_random(seed: u64, layer: &str, id: &str) -> f64 {
     crate::rng::feature_rng(seed, &format!("{layer}/template"), id).random::<f64>()
 }
 
-/// `ground`: the DEM and the tile's bounds, when the terrain is to be written.
-#[allow(clippy::too_many_arguments)]
+/// Every model of one tile: houses with their kura, fences and gates, people, trees and the
+/// terrain, in that order.
 pub fn generate_tile(
-    lots: &[PlannedMachiya],
-    fences: &[PlannedFence],
-    ground: Option<(&crate::input::dem::Dem, &str, [f64; 4])>,
+    tile: &TilePlan,
     catalog: &Catalog,
     params: &Params,
     origin: [f64; 2],
@@ -58,7 +83,7 @@ pub fn generate_tile(
         .enabled
         .then(|| catalog.get(&params.kura.template))
         .flatten();
-    for m in lots {
+    for m in tile.lots {
         let layer = if m.height.is_some() {
             "footprints"
         } else {
@@ -128,10 +153,19 @@ pub fn generate_tile(
             Err(reason) => out.stats.skipped.push(skip(format!("its kura: {reason}"))),
         }
     }
-    build_fences(fences, catalog, params, frame, files, &mut out);
-    if let Some((dem, tile, bounds)) = ground {
+    build_fences(tile.fences, catalog, params, frame, files, &mut out);
+    let people_and_trees = billboards::build(
+        tile.billboards,
+        catalog,
+        params,
+        frame,
+        files,
+        &mut out.stats,
+    );
+    out.meshes.extend(people_and_trees);
+    if let Some((dem, id, bounds)) = tile.ground {
         out.meshes.extend(terrain::terrain_mesh(
-            format!("terrain_{tile}"),
+            format!("terrain_{id}"),
             dem,
             bounds,
             frame,

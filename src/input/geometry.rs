@@ -83,6 +83,21 @@ pub fn lines_of(shape: &Shape) -> Result<Vec<LineString<f64>>, &'static str> {
     })
 }
 
+/// Points of a shape (a multipoint gives each of its points).
+pub fn points_of(shape: &Shape) -> Result<Vec<Coord<f64>>, &'static str> {
+    let xy = |x: f64, y: f64| Coord { x, y };
+    Ok(match shape {
+        Shape::Point(p) => vec![xy(p.x, p.y)],
+        Shape::PointM(p) => vec![xy(p.x, p.y)],
+        Shape::PointZ(p) => vec![xy(p.x, p.y)],
+        Shape::Multipoint(m) => m.points().iter().map(|p| xy(p.x, p.y)).collect(),
+        Shape::MultipointM(m) => m.points().iter().map(|p| xy(p.x, p.y)).collect(),
+        Shape::MultipointZ(m) => m.points().iter().map(|p| xy(p.x, p.y)).collect(),
+        Shape::NullShape => Vec::new(),
+        other => return Err(shape_kind(other)),
+    })
+}
+
 /// A polygon the later stages can work on: finite, at least a triangle, with an area.
 pub fn check_polygon(poly: &Polygon<f64>) -> Result<(), String> {
     let ext = poly.exterior();

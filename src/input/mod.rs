@@ -10,6 +10,7 @@ pub mod crs;
 pub mod dem;
 pub mod fields;
 pub mod geometry;
+mod points;
 pub mod shp;
 pub mod simplify;
 pub mod table;
@@ -111,6 +112,8 @@ fn layer_coords(o: &Opened) -> Vec<Coord<f64>> {
             for l in lines {
                 out.extend(l.0);
             }
+        } else if let Ok(points) = geometry::points_of(&f.shape) {
+            out.extend(points);
         }
     }
     out
@@ -254,6 +257,20 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         &l.fences.encoding,
         &dl.fences.file,
     )?;
+    let mut people = open(
+        dir,
+        "people",
+        &l.people.file,
+        &l.people.encoding,
+        &dl.people.file,
+    )?;
+    let mut trees = open(
+        dir,
+        "trees",
+        &l.trees.file,
+        &l.trees.encoding,
+        &dl.trees.file,
+    )?;
 
     let mut data = Dataset::default();
     let target = {
@@ -265,6 +282,8 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             &mut widths,
             &mut districts,
             &mut fences,
+            &mut people,
+            &mut trees,
         ]
         .into_iter()
         .filter_map(|o| o.as_mut())
@@ -279,6 +298,8 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         &mut widths,
         &mut districts,
         &mut fences,
+        &mut people,
+        &mut trees,
     ]
     .into_iter()
     .flatten()
@@ -289,9 +310,18 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         .as_ref()
         .map(|c| c.definition.clone())
         .unwrap_or_default();
-    for o in [&lots, &footprints, &streets, &blocks, &widths, &fences]
-        .into_iter()
-        .flatten()
+    for o in [
+        &lots,
+        &footprints,
+        &streets,
+        &blocks,
+        &widths,
+        &fences,
+        &people,
+        &trees,
+    ]
+    .into_iter()
+    .flatten()
     {
         data.warnings.extend(o.layer.warnings.iter().cloned());
         data.layers.push(LayerInfo {
@@ -363,6 +393,20 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
     }
     if let Some(o) = &fences {
         read_fence_lines(params, o, &target, &mut data)?;
+    }
+    for (o, settings, slot) in [
+        (&people, &l.people, &mut data.people),
+        (&trees, &l.trees, &mut data.trees),
+    ] {
+        if let Some(o) = o {
+            *slot = Some(points::read_points(
+                settings,
+                o,
+                &target,
+                &mut data.skipped,
+                &mut data.warnings,
+            )?);
+        }
     }
     data.dem = read_dem(dir, params, &target, &dl.dem.file)?;
     simplify::generalise(&mut data, params.simplify.tolerance);

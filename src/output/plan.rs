@@ -36,6 +36,8 @@ pub const KURA: [u8; 3] = [70, 70, 78];
 pub const FENCE: [u8; 3] = [95, 60, 35];
 pub const GATE: [u8; 3] = [210, 40, 40];
 pub const KURA_REFUSED: [u8; 3] = [235, 120, 30];
+pub const TREE: [u8; 3] = [40, 130, 50];
+pub const PERSON: [u8; 3] = [30, 40, 120];
 
 /// What the image shows and how metres map to pixels.
 #[derive(Debug, Clone, Copy)]
@@ -263,6 +265,19 @@ pub fn draw_plan(
             pm.stroke_path(&path, &paint(colour, 255), stroke, id, None);
         }
     }
+    // People and trees (section 4.4): a dot each, a tree's as wide as its crown.
+    let mut any_billboard = false;
+    for b in plan.billboards.values().flatten() {
+        let (x, y) = view.pixel(&b.at);
+        let (colour, r) = match b.kind {
+            crate::model::BillboardKind::Tree => (TREE, (b.height * 0.25 * view.scale) as f32),
+            crate::model::BillboardKind::Person => (PERSON, 2.5),
+        };
+        if let Some(dot) = tiny_skia::PathBuilder::from_circle(x, y, r.max(1.5)) {
+            any_billboard = true;
+            pm.fill_path(&dot, &paint(colour, 220), FillRule::Winding, id, None);
+        }
+    }
     // Centrelines on top: in cadastral data the roads are parcels too and hide the bands.
     for street in &data.streets {
         if let Some(path) = line_path(view, &street.line.0) {
@@ -290,6 +305,7 @@ pub fn draw_plan(
         !data.footprints.is_empty(),
         kura_rows,
         any_fence,
+        any_billboard,
     );
     encode_png(&pm)
 }
@@ -399,6 +415,7 @@ fn draw_legend(
     footprints: bool,
     kura_rows: usize,
     fences: bool,
+    billboards: bool,
 ) {
     let mut rows: Vec<(String, [u8; 3])> = colours.iter().map(|(t, c)| (t.clone(), *c)).collect();
     if footprints {
@@ -416,6 +433,10 @@ fn draw_legend(
     if fences {
         rows.push(("wall".into(), FENCE));
         rows.push(("gate".into(), GATE));
+    }
+    if billboards {
+        rows.push(("tree".into(), TREE));
+        rows.push(("person".into(), PERSON));
     }
     rows.push(("other use".into(), OTHER_USE));
     rows.push(("skipped".into(), SKIPPED));

@@ -43,6 +43,12 @@ pub struct Counts {
     pub fence_segments: usize,
     pub gates: usize,
     pub wall_metres: BTreeMap<String, f64>,
+    /// People and trees built (billboards), per district ("" = none) and per texture.
+    pub people: usize,
+    pub trees: usize,
+    pub people_by_district: BTreeMap<String, usize>,
+    pub trees_by_district: BTreeMap<String, usize>,
+    pub billboard_textures: BTreeMap<String, usize>,
     pub skipped: usize,
 }
 
@@ -232,6 +238,11 @@ pub fn assemble_report(m: &Manifest) -> Report {
             kura_all.add(k);
             kura_by_district.entry(d.clone()).or_default().add(k);
         }
+        add(&mut c.people_by_district, &s.people_by_district);
+        add(&mut c.trees_by_district, &s.trees_by_district);
+        add(&mut c.billboard_textures, &s.billboard_textures);
+        c.people += s.people_by_district.values().sum::<usize>();
+        c.trees += s.trees_by_district.values().sum::<usize>();
         c.machiya += s.machiya;
         c.footprints += s.footprints;
         c.type_given += s.type_given;

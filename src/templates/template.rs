@@ -73,6 +73,10 @@ pub const INPUTS: &[(&str, &str)] = &[
         "fences: cot of half the interior angle at the segment's start (1 at a right angle, 0 at a free or straight end, < 0 at a reflex corner)",
     ),
     ("end_mitre", "fences: the same at the segment's end"),
+    (
+        "billboard_height",
+        "people and trees: the height drawn from people.height / trees.height (or the point's height field); 0 for other models",
+    ),
 ];
 
 pub const N_INPUTS: usize = INPUTS.len();
@@ -96,6 +100,7 @@ pub struct SiteInputs<'a> {
     pub random: f64,
     pub start_mitre: f64,
     pub end_mitre: f64,
+    pub billboard_height: f64,
 }
 
 /// A number for an id-like text: the text itself when it is a number, else -1.
@@ -127,6 +132,7 @@ impl SiteInputs<'_> {
             ("random", self.random),
             ("start_mitre", self.start_mitre),
             ("end_mitre", self.end_mitre),
+            ("billboard_height", self.billboard_height),
         ] {
             x[input(name)] = value;
         }
@@ -168,6 +174,19 @@ pub struct Template {
     /// The height the model declares (checked by tests against the mesh).
     pub height: Option<(Expr, Loc)>,
     pub parts: Vec<Part>,
+    /// The `[materials]` slots and the library material each names: a billboard's drawn
+    /// texture replaces its `picture` slot.
+    pub material_slots: Vec<(String, u16)>,
+}
+
+impl Template {
+    /// The library material a `[materials]` slot names.
+    pub fn material_slot(&self, slot: &str) -> Option<u16> {
+        self.material_slots
+            .iter()
+            .find(|(k, _)| k == slot)
+            .map(|s| s.1)
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -386,8 +405,20 @@ pub fn compile_template(s: &Source) -> Result<Template, String> {
         Some(t) => Some((scalar_names.compile(t)?, t.loc.clone())),
         None => None,
     };
+    let mut material_slots = Vec::new();
     for (k, m) in &s.materials {
-        material_of(&[], m).map_err(|e| format!("{e} (material slot `{k}`)"))?;
+        let id = material_of(&[], m).map_err(|e| format!("{e} (material slot `{k}`)"))?;
+        material_slots.push((k.clone(), id));
+    }
+    if matches!(kind, Kind::Tree | Kind::Person)
+        && !s.is_abstract
+        && !material_slots.iter().any(|(k, _)| k == "picture")
+    {
+        return Err(err(
+            &here,
+            "a tree or person template needs a `picture` slot in `[materials]`: the texture \
+             drawn for each billboard replaces it",
+        ));
     }
     let checks = s
         .checks
@@ -424,6 +455,7 @@ pub fn compile_template(s: &Source) -> Result<Template, String> {
         height,
         parts,
         names,
+        material_slots,
     })
 }
 

@@ -1,0 +1,633 @@
+//! People and trees, section 4.4 of the paper: billboard points, from point layers or drawn
+//! from the spatial probability distributions of the parameter file.
+//!
+//! The process is declared and deterministic: a Poisson process per source (a piece of street
+//! centreline for people, a lot for trees), each source with its own RNG seeded by (seed,
+//! layer, source id); points falling in a building, kura or fence (the [`Obstacles`] R-tree)
+//! or outside the source are dropped; then a hard-core thinning gives the Poisson-disk
+//! spacing: points are visited in the order of a random key drawn with each point and kept
+//! when no kept point lies within `min_spacing`. Neither step depends on input order or on
+//! the thread count.
+
+use std::collections::{BTreeMap, HashMap};
+
+use geo::{Area, BoundingRect, Centroid, Contains};
+use geo_types::{Coord, Polygon};
+use rand::RngExt;
+use rand_distr::{Distribution, Poisson};
+use rayon::prelude::*;
+use rstar::primitives::GeomWithData;
+use rstar::RTree;
+
+use super::obstacles::{boundary_distance, sane, Obstacles, FAR};
+use super::street::Segment;
+use super::tiling::tile_id;
+use crate::model::{BillboardKind, Dataset, Plan, PlannedBillboard, PointFeature, Skipped};
+use crate::params::Params;
+use crate::rng::feature_rng;
+use crate::templates::Catalog;
+
+/// Streets are cut into pieces no longer than this, each a source of its own.
+const PIECE: f64 = 20.0;
+
+/// Where a point is and what it stands on: the district and ground of the nearest lot (the
+/// DEM's ground when there is one), the direction of the nearest street.
+struct Surroundings<'a> {
+    lots: RTree<GeomWithData<[f64; 2], usize>>,
+    info: Vec<(Option<&'a str>, f64)>,
+    streets: RTree<Segment>,
+    dem: Option<&'a crate::input::dem::Dem>,
+}
+
+impl<'a> Surroundings<'a> {
+    fn new(data: &'a Dataset) -> Surroundings<'a> {
+        let mut points = Vec::new();
+        let mut info = Vec::new();
+        let lots = data
+            .lots
+            .iter()
+            .map(|l| (&l.outline, &l.district, l.ground));
+        let fps = data
+            .footprints
+            .iter()
+            .map(|f| (&f.outline, &f.district, f.ground));
+        for (outline, district, ground) in lots.chain(fps) {
+            if let Some(c) = outline
+                .centroid()
+                .filter(|c| c.x().is_finite() && c.y().is_finite())
+            {
+                points.push(GeomWithData::new([c.x(), c.y()], info.len()));
+                info.push((district.as_deref(), ground));
+            }
+        }
+        // People face along their street: the centrelines, else the block edges (which run
+        // along the streets too).
+        let mut segs: Vec<Segment> = data
+            .streets
+            .iter()
+            .flat_map(|s| s.line.lines())
+            .map(|l| segment(l.start, l.end))
+            .collect();
+        if segs.is_empty() {
+            segs = data
+                .blocks
+                .iter()
+                .flat_map(|b| b.exterior().lines())
+                .map(|l| segment(l.start, l.end))
+                .collect();
+        }
+        segs.retain(|s| s.a.iter().chain(&s.b).all(|x| x.abs() < FAR) && s.a != s.b);
+        Surroundings {
+            lots: RTree::bulk_load(points),
+            info,
+            streets: RTree::bulk_load(segs),
+            dem: data.dem.as_ref(),
+        }
+    }
+
+    /// District and ground at `p`.
+    fn at(&self, p: Coord<f64>, ground: Option<f64>) -> (Option<String>, f64) {
+        let near = self
+            .lots
+            .nearest_neighbor(&[p.x, p.y])
+            .map(|g| self.info[g.data]);
+        let district = near.and_then(|n| n.0).map(str::to_string);
+        let ground = match self.dem {
+            Some(dem) => dem.sample(p).z,
+            None => ground.or(near.map(|n| n.1)).unwrap_or(0.0),
+        };
+        (district, ground)
+    }
+
+    /// Direction of the street nearest `p`, radians.
+    fn street_angle(&self, p: Coord<f64>) -> f64 {
+        self.streets
+            .nearest_neighbor(&[p.x, p.y])
+            .map_or(0.0, |s| (s.b[1] - s.a[1]).atan2(s.b[0] - s.a[0]))
+    }
+}
+
+fn segment(a: Coord<f64>, b: Coord<f64>) -> Segment {
+    Segment {
+        a: [a.x, a.y],
+        b: [b.x, b.y],
+        value: 0.0,
+    }
+}
+
+/// A source of generated points: a street piece or a lot.
+struct Source<'a> {
+    id: String,
+    /// Where its expected count is charged against `max_points_per_tile`.
+    tile: String,
+    district: Option<&'a str>,
+    /// Expected points in the source.
+    expected: f64,
+    shape: SourceShape<'a>,
+}
+
+enum SourceShape<'a> {
+    /// A street piece from `a` to `b`; points within `half` of it across.
+    Street {
+        a: Coord<f64>,
+        b: Coord<f64>,
+        half: f64,
+    },
+    /// A lot; points anywhere inside it, `clearance` from its edges. `cover` is how much of
+    /// the bounding box is planted (expected / points drawn in the box).
+    Lot {
+        outline: &'a Polygon<f64>,
+        ground: f64,
+        cover: f64,
+    },
+}
+
+/// A generated or given point with its thinning key.
+struct Candidate {
+    key: u64,
+    b: PlannedBillboard,
+}
+
+/// Plans the people and trees of the whole city into `plan.billboards`: from the point
+/// layers when the data has them, else generated.
+pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: &Params) {
+    let people = &params.people;
+    let trees = &params.trees;
+    if !people.enabled && !trees.enabled {
+        return;
+    }
+    let near = Surroundings::new(data);
+    let obstacles = Obstacles::new(
+        plan.tiles.values().flatten(),
+        plan.fences.values().flatten(),
+        catalog,
+        params,
+    );
+    let mut all = Vec::new();
+    for kind in [BillboardKind::Person, BillboardKind::Tree] {
+        let k = Kind::of(kind, params);
+        if !k.enabled {
+            continue;
+        }
+        let given = match kind {
+            BillboardKind::Person => data.people.as_ref(),
+            BillboardKind::Tree => data.trees.as_ref(),
+        };
+        // Given points are all kept; generated ones are thinned to the minimum spacing.
+        let spacing = if given.is_some() { 0.0 } else { k.min_spacing };
+        let candidates = match given {
+            Some(points) => from_points(points, &k, &near, &obstacles, params, plan),
+            None => {
+                let mut sources = match kind {
+                    BillboardKind::Person => street_sources(data, &near, params),
+                    BillboardKind::Tree => lot_sources(data, plan, catalog, params),
+                };
+                // Generated billboards dress the built city: a tile with no house, kura or
+                // fence gets none (streets often run on past the lots).
+                sources.retain(|s| plan.tiles.contains_key(&s.tile));
+                let scale = budget(&sources, &k, &mut plan.warnings);
+                let drawn: Vec<Vec<Candidate>> = sources
+                    .par_iter()
+                    .map(|s| {
+                        draw(
+                            s,
+                            scale.get(&s.tile).copied(),
+                            &k,
+                            &near,
+                            &obstacles,
+                            params,
+                        )
+                    })
+                    .collect();
+                drawn.into_iter().flatten().collect()
+            }
+        };
+        let kept = thin(candidates, spacing);
+        let capped = cap_tiles(kept, &k, &mut plan.warnings);
+        all.extend(capped.into_iter().map(|b| (b, given.is_some())));
+    }
+    for (b, given) in all {
+        if given {
+            plan.tiles.entry(b.tile.clone()).or_default();
+        } else if !plan.tiles.contains_key(&b.tile) {
+            continue; // strayed over a tile border into a tile with nothing built
+        }
+        plan.billboards.entry(b.tile.clone()).or_default().push(b);
+    }
+}
+
+/// The settings of one kind of billboard.
+struct Kind<'a> {
+    kind: BillboardKind,
+    enabled: bool,
+    layer: &'static str,
+    file: &'a str,
+    height: [f64; 2],
+    textures: &'a [String],
+    min_spacing: f64,
+    clearance: f64,
+    max_per_tile: usize,
+    max_turn: f64,
+    /// The parameter that sets the density, for messages.
+    density_key: &'static str,
+}
+
+impl<'a> Kind<'a> {
+    fn of(kind: BillboardKind, p: &'a Params) -> Kind<'a> {
+        match kind {
+            BillboardKind::Person => Kind {
+                kind,
+                enabled: p.people.enabled,
+                layer: "people",
+                file: &p.layers.people.file,
+                height: p.people.height,
+                textures: &p.people.textures,
+                min_spacing: p.people.min_spacing,
+                clearance: p.people.clearance,
+                max_per_tile: p.people.max_points_per_tile,
+                max_turn: p.people.max_turn_deg.to_radians(),
+                density_key: "people.per_100m",
+            },
+            BillboardKind::Tree => Kind {
+                kind,
+                enabled: p.trees.enabled,
+                layer: "trees",
+                file: &p.layers.trees.file,
+                height: p.trees.height,
+                textures: &p.trees.textures,
+                min_spacing: p.trees.min_spacing,
+                clearance: p.trees.clearance,
+                max_per_tile: p.trees.max_points_per_tile,
+                max_turn: std::f64::consts::PI,
+                density_key: "trees.per_ha / trees.per_ha_machiya",
+            },
+        }
+    }
+
+    /// Height, texture, facing and key of a point, drawn from `rng` (or taken from the point).
+    fn dress(
+        &self,
+        rng: &mut impl rand::Rng,
+        id: String,
+        at: Coord<f64>,
+        along: f64,
+        (district, ground): (Option<String>, f64),
+        tile_of: impl Fn(Coord<f64>) -> String,
+    ) -> Candidate {
+        let [lo, hi] = self.height;
+        let height = lo + rng.random::<f64>() * (hi - lo);
+        let texture = self.textures[rng.random_range(0..self.textures.len())].clone();
+        // A person walks either way along the street, turned by at most max_turn; a tree
+        // turns freely (its two quads repeat every quarter turn).
+        let facing = match self.kind {
+            BillboardKind::Person => {
+                let back = if rng.random_bool(0.5) {
+                    std::f64::consts::PI
+                } else {
+                    0.0
+                };
+                along + back + (2.0 * rng.random::<f64>() - 1.0) * self.max_turn
+            }
+            BillboardKind::Tree => rng.random::<f64>() * std::f64::consts::FRAC_PI_2,
+        };
+        Candidate {
+            key: rng.random::<u64>(),
+            b: PlannedBillboard {
+                kind: self.kind,
+                id,
+                at,
+                facing,
+                height,
+                texture,
+                ground,
+                district,
+                tile: tile_of(at),
+            },
+        }
+    }
+}
+
+/// People along every street centreline, in pieces of at most [`PIECE`] metres.
+fn street_sources<'a>(data: &'a Dataset, near: &Surroundings<'a>, p: &Params) -> Vec<Source<'a>> {
+    let mut out = Vec::new();
+    for s in &data.streets {
+        for (k, line) in s.line.lines().enumerate() {
+            let d = line.end - line.start;
+            let len = d.x.hypot(d.y);
+            if !(sane(line.start) && sane(line.end) && len > 0.0) {
+                continue;
+            }
+            let pieces = (len / PIECE).ceil().max(1.0) as usize;
+            for j in 0..pieces {
+                let at = |t: f64| line.start + (line.end - line.start) * t;
+                let (a, b) = (
+                    at(j as f64 / pieces as f64),
+                    at((j + 1) as f64 / pieces as f64),
+                );
+                let mid = at((j as f64 + 0.5) / pieces as f64);
+                let district = near
+                    .lots
+                    .nearest_neighbor(&[mid.x, mid.y])
+                    .and_then(|g| near.info[g.data].0);
+                let density =
+                    p.district_density(district, |d| d.people_per_100m, p.people.per_100m);
+                out.push(Source {
+                    id: format!("{}/{}/{}", s.id, k + 1, j + 1),
+                    tile: tile_id(mid, p.tile_size, p.tile_origin),
+                    district,
+                    expected: len / pieces as f64 / 100.0 * density,
+                    shape: SourceShape::Street {
+                        a,
+                        b,
+                        half: (s.width / 2.0 - p.people.edge_margin).max(0.0),
+                    },
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Trees in estate lots (`trees.uses`) over the whole lot, and in town lots behind the
+/// house (the obstacles keep them out of the house and its kura).
+fn lot_sources<'a>(
+    data: &'a Dataset,
+    plan: &Plan,
+    catalog: &Catalog,
+    p: &Params,
+) -> Vec<Source<'a>> {
+    let t = &p.trees;
+    // How deep each planned town lot's house is, as a share of the lot's depth.
+    let mut built: HashMap<&str, f64> = HashMap::new();
+    for m in plan.tiles.values().flatten().filter(|m| m.height.is_none()) {
+        let f = super::kura::Frame::of(m);
+        let depth = super::kura::local_ring(m, f)
+            .iter()
+            .map(|q| q[1])
+            .fold(0.0, f64::max);
+        let end = super::kura::house_end(m, depth, catalog, p);
+        built.insert(m.id.as_str(), if depth > 0.0 { end / depth } else { 1.0 });
+    }
+    let mut out = Vec::new();
+    for lot in &data.lots {
+        let district = lot.district.as_deref();
+        let (density, open) = if t.uses.iter().any(|u| u == lot.lot_use.name()) {
+            (
+                p.district_density(district, |d| d.trees_per_ha, t.per_ha),
+                1.0,
+            )
+        } else if let Some(share) = built.get(lot.id.as_str()) {
+            let d = p.district_density(district, |d| d.trees_per_ha_machiya, t.per_ha_machiya);
+            (d, (1.0 - share).max(0.0))
+        } else {
+            continue;
+        };
+        let (Some(bb), Some(c)) = (lot.outline.bounding_rect(), lot.outline.centroid()) else {
+            continue;
+        };
+        if !(sane(bb.min()) && sane(bb.max())) {
+            continue;
+        }
+        let box_area = bb.width() * bb.height();
+        let planted = lot.outline.unsigned_area() * open;
+        if !(density > 0.0 && planted > 0.0 && box_area.is_finite()) {
+            continue;
+        }
+        out.push(Source {
+            id: lot.id.clone(),
+            tile: tile_id(c.0, p.tile_size, p.tile_origin),
+            district,
+            expected: planted * density / 10_000.0,
+            shape: SourceShape::Lot {
+                outline: &lot.outline,
+                ground: lot.ground,
+                cover: planted / box_area,
+            },
+        });
+    }
+    out
+}
+
+/// Density scale per tile: a tile whose sources expect more than `max_points_per_tile`
+/// points has its densities scaled down to it, with a warning.
+fn budget(sources: &[Source], k: &Kind, warnings: &mut Vec<String>) -> BTreeMap<String, f64> {
+    let mut expected: BTreeMap<&str, f64> = BTreeMap::new();
+    for s in sources {
+        *expected.entry(s.tile.as_str()).or_default() += s.expected;
+    }
+    let mut scale = BTreeMap::new();
+    for (tile, e) in expected {
+        if e > k.max_per_tile as f64 {
+            let f = k.max_per_tile as f64 / e;
+            warnings.push(format!(
+                "{}: tile {tile} would get about {e:.0} {} at `{}`, more than \
+                 max_points_per_tile = {}; its density was scaled by {f:.4}",
+                k.layer, k.layer, k.density_key, k.max_per_tile
+            ));
+            scale.insert(tile.to_string(), f);
+        }
+    }
+    scale
+}
+
+/// The Poisson process of one source, points in obstacles or outside the source dropped.
+fn draw(
+    s: &Source,
+    scale: Option<f64>,
+    k: &Kind,
+    near: &Surroundings,
+    obstacles: &Obstacles,
+    p: &Params,
+) -> Vec<Candidate> {
+    let mut rng = feature_rng(p.seed, k.layer, &s.id);
+    let tile_of = |c: Coord<f64>| tile_id(c, p.tile_size, p.tile_origin);
+    // Lots draw in their bounding box and keep what falls on planted ground.
+    let mean = match s.shape {
+        SourceShape::Street { .. } => s.expected,
+        SourceShape::Lot { cover, .. } => s.expected / cover,
+    } * scale.unwrap_or(1.0);
+    let n = match Poisson::new(mean) {
+        Ok(d) if mean > 0.0 => (d.sample(&mut rng) as usize).min(4 * k.max_per_tile),
+        _ => 0,
+    };
+    let mut out = Vec::new();
+    for i in 0..n {
+        let id = format!("{}/{}", s.id, i + 1);
+        let (at, along, place) = match s.shape {
+            SourceShape::Street { a, b, half } => {
+                let d = b - a;
+                let len = d.x.hypot(d.y);
+                let across = Coord {
+                    x: -d.y / len,
+                    y: d.x / len,
+                };
+                let t = rng.random::<f64>();
+                let off = (2.0 * rng.random::<f64>() - 1.0) * half;
+                let at = a + d * t + across * off;
+                // Counted in the district whose density it was drawn at.
+                let ground = near.at(at, None).1;
+                (at, d.y.atan2(d.x), (s.district.map(str::to_string), ground))
+            }
+            SourceShape::Lot {
+                outline, ground, ..
+            } => {
+                let bb = outline.bounding_rect().expect("sources have a box");
+                let at = Coord {
+                    x: bb.min().x + rng.random::<f64>() * bb.width(),
+                    y: bb.min().y + rng.random::<f64>() * bb.height(),
+                };
+                let inside = outline.contains(&at) && boundary_distance(at, outline) >= k.clearance;
+                if !inside {
+                    continue;
+                }
+                let district = s.district.map(str::to_string);
+                let ground = near.dem.map_or(ground, |dem| dem.sample(at).z);
+                (at, 0.0, (district, ground))
+            }
+        };
+        // Dress before testing, so a point's values do not depend on the points dropped.
+        let c = k.dress(&mut rng, id, at, along, place, tile_of);
+        if !obstacles.hit(at, k.clearance) {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// Points from a point layer: each with its own RNG for what the layer does not give; a
+/// point inside a building, kura or fence is skipped and reported.
+fn from_points(
+    points: &[PointFeature],
+    k: &Kind,
+    near: &Surroundings,
+    obstacles: &Obstacles,
+    p: &Params,
+    plan: &mut Plan,
+) -> Vec<Candidate> {
+    let tile_of = |c: Coord<f64>| tile_id(c, p.tile_size, p.tile_origin);
+    let mut out = Vec::new();
+    for f in points {
+        if !sane(f.at) {
+            plan.skipped.push(Skipped {
+                layer: k.layer.into(),
+                file: k.file.into(),
+                id: f.id.clone(),
+                reason: format!("the point lies {FAR} m or more from the CRS's origin"),
+            });
+            continue;
+        }
+        if obstacles.hit(f.at, 0.0) {
+            plan.skipped.push(Skipped {
+                layer: k.layer.into(),
+                file: k.file.into(),
+                id: f.id.clone(),
+                reason: "the point lies inside a building, kura or fence".into(),
+            });
+            continue;
+        }
+        let mut rng = feature_rng(p.seed, k.layer, &f.id);
+        let along = near.street_angle(f.at);
+        let mut c = k.dress(
+            &mut rng,
+            f.id.clone(),
+            f.at,
+            along,
+            near.at(f.at, None),
+            tile_of,
+        );
+        if let Some(h) = f.height {
+            c.b.height = h;
+        }
+        if let Some(t) = &f.texture {
+            match texture_of(t, k.textures) {
+                Some(name) => c.b.texture = name,
+                None => plan.warnings.push(format!(
+                    "{}: {} {}: texture `{t}` is neither a library material nor a number \
+                     from 1 to {}; one was drawn",
+                    k.file,
+                    k.layer,
+                    f.id,
+                    k.textures.len()
+                )),
+            }
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// A texture field's value: a library material name, or a number into `textures`.
+fn texture_of(raw: &str, textures: &[String]) -> Option<String> {
+    let raw = raw.trim();
+    if let Ok(n) = raw.parse::<usize>() {
+        return (1..=textures.len())
+            .contains(&n)
+            .then(|| textures[n - 1].clone());
+    }
+    crate::generate::materials::find(raw).map(|_| raw.to_string())
+}
+
+/// Hard-core thinning: in the order of the points' random keys, a point is kept when no kept
+/// point lies within `spacing`. The result is in key order, so it does not depend on the
+/// order the points were made in.
+fn thin(mut points: Vec<Candidate>, spacing: f64) -> Vec<PlannedBillboard> {
+    points.sort_by(|a, b| a.key.cmp(&b.key).then_with(|| a.b.id.cmp(&b.b.id)));
+    if spacing <= 0.0 {
+        return points.into_iter().map(|c| c.b).collect();
+    }
+    let cell = |c: Coord<f64>| {
+        (
+            (c.x / spacing).floor() as i64,
+            (c.y / spacing).floor() as i64,
+        )
+    };
+    let mut grid: HashMap<(i64, i64), Vec<Coord<f64>>> = HashMap::new();
+    let mut kept = Vec::new();
+    for c in points {
+        let (i, j) = cell(c.b.at);
+        let crowded = (i - 1..=i + 1).any(|x| {
+            (j - 1..=j + 1).any(|y| {
+                grid.get(&(x, y)).is_some_and(|v| {
+                    v.iter()
+                        .any(|q| (q.x - c.b.at.x).hypot(q.y - c.b.at.y) < spacing)
+                })
+            })
+        });
+        if !crowded {
+            grid.entry((i, j)).or_default().push(c.b.at);
+            kept.push(c.b);
+        }
+    }
+    kept
+}
+
+/// At most `max_points_per_tile` per tile (the densities were scaled to that, but a Poisson
+/// draw can exceed it): the first in key order stay. Each tile's points are then put in id
+/// order.
+fn cap_tiles(
+    points: Vec<PlannedBillboard>,
+    k: &Kind,
+    warnings: &mut Vec<String>,
+) -> Vec<PlannedBillboard> {
+    let mut per_tile: BTreeMap<String, Vec<PlannedBillboard>> = BTreeMap::new();
+    for b in points {
+        per_tile.entry(b.tile.clone()).or_default().push(b);
+    }
+    let mut out = Vec::new();
+    for (tile, mut v) in per_tile {
+        if v.len() > k.max_per_tile {
+            warnings.push(format!(
+                "{}: tile {tile} has {} points, more than max_points_per_tile = {}; the first \
+                 {} were kept",
+                k.layer,
+                v.len(),
+                k.max_per_tile,
+                k.max_per_tile
+            ));
+            v.truncate(k.max_per_tile);
+        }
+        v.sort_by(|a, b| a.id.cmp(&b.id));
+        out.extend(v);
+    }
+    out
+}

@@ -1,0 +1,224 @@
+//! What a person or a tree must not stand in: houses, kura and fences, in one R-tree.
+//!
+//! Built once from the plan after kura and fences are decided, so the billboards of section
+//! 4.4 see exactly what will be built. A house is its lot cut to the band behind its frontage
+//! where the house stands (the same `house_end` the kura placement uses); a footprint
+//! building is its whole outline; a kura its rectangle; a fence its segment with a half
+//! thickness.
+
+use geo::{Contains, Distance, Euclidean};
+use geo_types::{Coord, Point, Polygon};
+use rstar::primitives::{GeomWithData, Rectangle};
+use rstar::{RTree, AABB};
+
+use super::kura::{house_end, local_ring, Frame};
+use super::street::segment_distance_2;
+use crate::model::{PlannedFence, PlannedMachiya};
+use crate::params::Params;
+use crate::templates::Catalog;
+
+/// Half the thickness counted for a wall or fence (a tsuiji's base is about 0.9 m).
+const WALL_HALF: f64 = 0.45;
+
+/// Coordinates beyond this (metres; the Earth is 4e7 round) come from damaged data: their
+/// squares overflow, and the R-trees' distance arithmetic with them. Such features are left
+/// out of the indexes here.
+pub const FAR: f64 = 1e8;
+
+/// Whether a point is within [`FAR`] of the CRS's origin.
+pub fn sane(c: Coord<f64>) -> bool {
+    c.x.abs() < FAR && c.y.abs() < FAR
+}
+
+enum Obstacle {
+    /// The part of `outline` with `v < v_max` in the frame `(a, v)`.
+    House {
+        outline: Polygon<f64>,
+        a: Coord<f64>,
+        v: Coord<f64>,
+        v_max: f64,
+    },
+    Rect(Polygon<f64>),
+    Wall([f64; 2], [f64; 2]),
+}
+
+/// The buildings, kura and fences of a city, indexed by their bounding boxes.
+pub struct Obstacles {
+    tree: RTree<GeomWithData<Rectangle<[f64; 2]>, usize>>,
+    items: Vec<Obstacle>,
+}
+
+impl Obstacles {
+    /// Every house and kura that will be built (kura as `kura.collision` decides) and every
+    /// fence segment.
+    pub fn new<'a>(
+        houses: impl Iterator<Item = &'a PlannedMachiya>,
+        fences: impl Iterator<Item = &'a PlannedFence>,
+        catalog: &Catalog,
+        params: &Params,
+    ) -> Obstacles {
+        let mut items = Vec::new();
+        for m in houses {
+            let f = Frame::of(m);
+            let depth = local_ring(m, f).iter().map(|p| p[1]).fold(0.0, f64::max);
+            items.push(Obstacle::House {
+                outline: m.outline.clone(),
+                a: f.a,
+                v: f.v,
+                v_max: house_end(m, depth, catalog, params),
+            });
+            if let Some(r) = m.kura.to_build(params.kura.collision) {
+                let q = f.quad(r);
+                items.push(Obstacle::Rect(Polygon::new(
+                    q.iter().chain(&q[..1]).copied().collect(),
+                    vec![],
+                )));
+            }
+        }
+        for s in fences {
+            items.push(Obstacle::Wall([s.a.x, s.a.y], [s.b.x, s.b.y]));
+        }
+        let boxes = items
+            .iter()
+            .enumerate()
+            .filter_map(|(i, o)| Some(GeomWithData::new(envelope(o)?, i)))
+            .collect();
+        Obstacles {
+            tree: RTree::bulk_load(boxes),
+            items,
+        }
+    }
+
+    /// Whether `p` lies in an obstacle or within `clearance` of one.
+    pub fn hit(&self, p: Coord<f64>, clearance: f64) -> bool {
+        let c = clearance.max(0.0) + WALL_HALF;
+        let query = AABB::from_corners([p.x - c, p.y - c], [p.x + c, p.y + c]);
+        self.tree
+            .locate_in_envelope_intersecting(&query)
+            .any(|g| hits(&self.items[g.data], p, clearance.max(0.0)))
+    }
+}
+
+fn envelope(o: &Obstacle) -> Option<Rectangle<[f64; 2]>> {
+    let (lo, hi) = match o {
+        Obstacle::House { outline: p, .. } | Obstacle::Rect(p) => {
+            let r = geo::BoundingRect::bounding_rect(p)?;
+            ([r.min().x, r.min().y], [r.max().x, r.max().y])
+        }
+        Obstacle::Wall(a, b) => (
+            [a[0].min(b[0]) - WALL_HALF, a[1].min(b[1]) - WALL_HALF],
+            [a[0].max(b[0]) + WALL_HALF, a[1].max(b[1]) + WALL_HALF],
+        ),
+    };
+    (lo.iter().chain(&hi).all(|x| x.abs() < FAR)).then(|| Rectangle::from_corners(lo, hi))
+}
+
+fn hits(o: &Obstacle, p: Coord<f64>, clearance: f64) -> bool {
+    let near = |poly: &Polygon<f64>| {
+        if clearance == 0.0 {
+            poly.contains(&p)
+        } else {
+            Euclidean.distance(&Point(p), poly) < clearance
+        }
+    };
+    match o {
+        Obstacle::House {
+            outline,
+            a,
+            v,
+            v_max,
+        } => {
+            let depth = (p.x - a.x) * v.x + (p.y - a.y) * v.y;
+            depth < v_max + clearance && near(outline)
+        }
+        Obstacle::Rect(poly) => near(poly),
+        Obstacle::Wall(a, b) => {
+            let reach = WALL_HALF + clearance;
+            segment_distance_2([p.x, p.y], *a, *b) < reach * reach
+        }
+    }
+}
+
+/// Distance from `p` to the nearest edge of `poly` (exterior or hole).
+pub fn boundary_distance(p: Coord<f64>, poly: &Polygon<f64>) -> f64 {
+    std::iter::once(poly.exterior())
+        .chain(poly.interiors())
+        .flat_map(|r| r.lines())
+        .map(|l| segment_distance_2([p.x, p.y], [l.start.x, l.start.y], [l.end.x, l.end.y]))
+        .fold(f64::INFINITY, f64::min)
+        .sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Frontage, KuraDecision};
+
+    fn house(kura: KuraDecision) -> PlannedMachiya {
+        let outline = Polygon::new(
+            vec![(0.0, 0.0), (6.0, 0.0), (6.0, 30.0), (0.0, 30.0), (0.0, 0.0)].into(),
+            vec![],
+        );
+        PlannedMachiya {
+            id: "1".into(),
+            record: 0,
+            outline,
+            frontage: Frontage {
+                a: Coord { x: 0.0, y: 0.0 },
+                b: Coord { x: 6.0, y: 0.0 },
+                fallback: false,
+            },
+            mtype: "hiraya".into(),
+            type_given: true,
+            district: None,
+            tile: "0_0".into(),
+            ground: 0.0,
+            height: None,
+            attrs: vec![],
+            kura,
+        }
+    }
+
+    #[test]
+    fn the_house_band_and_the_kura_are_obstacles_the_garden_is_not() {
+        let catalog = Catalog::load(None).unwrap();
+        let params = Params::default();
+        let m = house(KuraDecision::Clear([1.0, 22.0, 5.0, 27.0]));
+        let obs = Obstacles::new(std::iter::once(&m), std::iter::empty(), &catalog, &params);
+        let at = |x, y| Coord { x, y };
+        assert!(obs.hit(at(3.0, 2.0), 0.0), "in the house");
+        assert!(obs.hit(at(3.0, 24.0), 0.0), "in the kura");
+        assert!(!obs.hit(at(3.0, 18.0), 0.0), "in the garden between them");
+        assert!(!obs.hit(at(3.0, -3.0), 0.0), "in the street");
+        assert!(obs.hit(at(3.0, -0.2), 0.3), "too close to the house");
+        assert!(obs.hit(at(3.0, 20.0 + 1.5), 1.0), "too close to the kura");
+    }
+
+    #[test]
+    fn a_fence_keeps_its_thickness_and_clearance() {
+        let catalog = Catalog::load(None).unwrap();
+        let params = Params::default();
+        let f = PlannedFence {
+            id: "w".into(),
+            record: 0,
+            layer: "fences".into(),
+            template: "fence".into(),
+            kind: crate::model::FenceKind::Wall,
+            edge: 0,
+            a: Coord { x: 0.0, y: 0.0 },
+            b: Coord { x: 10.0, y: 0.0 },
+            start_mitre: 0.0,
+            end_mitre: 0.0,
+            ground: 0.0,
+            ground_end: 0.0,
+            district: None,
+            tile: "0_0".into(),
+            attrs: vec![],
+        };
+        let obs = Obstacles::new(std::iter::empty(), std::iter::once(&f), &catalog, &params);
+        assert!(obs.hit(Coord { x: 5.0, y: 0.3 }, 0.0));
+        assert!(!obs.hit(Coord { x: 5.0, y: 0.6 }, 0.0));
+        assert!(obs.hit(Coord { x: 5.0, y: 1.0 }, 1.0));
+        assert!(!obs.hit(Coord { x: 12.0, y: 0.0 }, 1.0));
+    }
+}

@@ -1,0 +1,119 @@
+//! People and trees (section 4.4): every billboard of a tile is its template built on its
+//! point, people in one object `people` and trees in one object `trees`, so a viewer can hide
+//! either at once. The template's `picture` material slot takes the texture drawn for each.
+
+use geo_types::Coord;
+
+use super::clip::LocalPoly;
+use super::instance::{instantiate, Local, Site};
+use super::materials;
+use super::mesh::{Frame, Mesh};
+use crate::model::{BillboardKind, PlannedBillboard, Skipped, TileStats};
+use crate::params::Params;
+use crate::templates::expr::Lot;
+use crate::templates::template::SiteInputs;
+use crate::templates::Catalog;
+
+/// Builds the people and the trees of a tile: up to two meshes, people first. A billboard
+/// whose template fails is skipped with the reason.
+pub fn build(
+    billboards: &[PlannedBillboard],
+    catalog: &Catalog,
+    params: &Params,
+    frame: Frame,
+    files: &super::LayerFiles,
+    stats: &mut TileStats,
+) -> Vec<Mesh> {
+    let mut out = Vec::new();
+    for kind in [BillboardKind::Person, BillboardKind::Tree] {
+        let (template, file) = match kind {
+            BillboardKind::Person => (&params.people.template, &files.people),
+            BillboardKind::Tree => (&params.trees.template, &files.trees),
+        };
+        let mut mesh = Mesh::new(kind.layer().to_string());
+        for b in billboards.iter().filter(|b| b.kind == kind) {
+            match build_one(b, template, catalog, params.seed, frame, &mut mesh) {
+                Ok(()) => {
+                    let district = b.district.clone().unwrap_or_default();
+                    let by_district = match kind {
+                        BillboardKind::Person => &mut stats.people_by_district,
+                        BillboardKind::Tree => &mut stats.trees_by_district,
+                    };
+                    *by_district.entry(district).or_default() += 1;
+                    *stats
+                        .billboard_textures
+                        .entry(b.texture.clone())
+                        .or_default() += 1;
+                }
+                Err(reason) => stats.skipped.push(Skipped {
+                    layer: kind.layer().into(),
+                    file: file.clone(),
+                    id: b.id.clone(),
+                    reason,
+                }),
+            }
+        }
+        if !mesh.faces.is_empty() {
+            out.push(mesh.finish());
+        }
+    }
+    out
+}
+
+/// One billboard into `mesh`: the template on a site whose v axis is the facing direction,
+/// centred on the point, its picture slot given the billboard's texture.
+fn build_one(
+    b: &PlannedBillboard,
+    template: &str,
+    catalog: &Catalog,
+    seed: u64,
+    frame: Frame,
+    mesh: &mut Mesh,
+) -> Result<(), String> {
+    let t = catalog
+        .get(template)
+        .ok_or_else(|| format!("billboard template `{template}` does not exist"))?;
+    let picture = materials::find(&b.texture)
+        .ok_or_else(|| format!("texture `{}` is not in the library", b.texture))?;
+    let v = Coord {
+        x: b.facing.cos(),
+        y: b.facing.sin(),
+    };
+    let u = Coord { x: v.y, y: -v.x };
+    let site = Site {
+        lot: LocalPoly::simple(vec![[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]),
+        local: Local { a: b.at, u, v },
+        ground: b.ground,
+        slope: 0.0,
+    };
+    let x = SiteInputs {
+        width: 0.0,
+        lot_depth: 0.0,
+        a: b.at,
+        b: b.at,
+        centroid: b.at,
+        ground: b.ground,
+        id: &b.id,
+        district: b.district.as_deref(),
+        random: super::template_random(seed, b.kind.layer(), &b.id),
+        billboard_height: b.height,
+        ..SiteInputs::default()
+    }
+    .slots();
+    let overrides = catalog.overrides(&t.name, b.district.as_deref());
+    let slots = t.evaluate(&x, &overrides, &[], &site as &dyn Lot)?;
+    let first = mesh.faces.len();
+    if let Err(e) = instantiate(t, &slots, &site, frame, mesh) {
+        mesh.faces.truncate(first);
+        return Err(e);
+    }
+    if let Some(slot) = t.material_slot("picture") {
+        for f in mesh.faces[first..]
+            .iter_mut()
+            .filter(|f| f.material == slot)
+        {
+            f.material = picture;
+        }
+    }
+    Ok(())
+}

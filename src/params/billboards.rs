@@ -1,0 +1,179 @@
+//! `[people]`, `[trees]` and their point layers: the billboards of section 4.4 of the paper.
+//!
+//! The paper had no GIS data for people and trees and drew their points from an assumed
+//! spatial probability distribution; these are that distribution's parameters, per district
+//! where `[district.<id>]` gives its own density.
+
+use serde::{Deserialize, Serialize};
+
+/// A point layer of people or trees (`people.shp`, `trees.shp`). When it is present its
+/// points are used and none are generated.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointsLayer {
+    pub file: String,
+    #[serde(default)]
+    pub encoding: String,
+    pub id_field: String,
+    /// Height of the billboard, metres; empty or missing = drawn from the height range.
+    pub height_field: String,
+    /// Texture (library material name, or its number in `textures`); else drawn.
+    pub texture_field: String,
+}
+
+/// People (hito 人): one alpha-textured quad each, standing in the street.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PeopleParams {
+    pub enabled: bool,
+    pub template: String,
+    /// Expected people per 100 m of street centreline (`[district.<id>] people_per_100m`).
+    pub per_100m: f64,
+    /// Heights are drawn uniformly from this range, metres.
+    pub height: [f64; 2],
+    /// A person faces along the street, turned by a random angle of at most this.
+    pub max_turn_deg: f64,
+    /// People stand at least this far inside the street's edges.
+    pub edge_margin: f64,
+    /// No two people closer than this (the hard core of the Poisson-disk process).
+    pub min_spacing: f64,
+    /// Distance kept from buildings, kura and fences.
+    pub clearance: f64,
+    /// Library materials drawn from, one per person.
+    pub textures: Vec<String>,
+    /// More points than this in one tile are thinned to it, with a warning.
+    pub max_points_per_tile: usize,
+}
+
+/// Trees (ki 木): two crossed alpha-textured quads each, in estates and back gardens.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TreesParams {
+    pub enabled: bool,
+    pub template: String,
+    /// Lot uses planted at `per_ha` over the whole lot (estates, temples).
+    pub uses: Vec<String>,
+    /// Expected trees per hectare in lots of `uses` (`[district.<id>] trees_per_ha`).
+    pub per_ha: f64,
+    /// Expected trees per hectare of the open back part of a town lot: behind the house,
+    /// outside its kura (`[district.<id>] trees_per_ha_machiya`).
+    pub per_ha_machiya: f64,
+    pub height: [f64; 2],
+    pub min_spacing: f64,
+    /// Distance of a trunk from buildings, kura, fences and the lot's edge.
+    pub clearance: f64,
+    pub textures: Vec<String>,
+    pub max_points_per_tile: usize,
+}
+
+impl PeopleParams {
+    pub(super) fn validate(&self) -> Result<(), String> {
+        common(
+            "people",
+            &[
+                ("per_100m", self.per_100m),
+                ("edge_margin", self.edge_margin),
+                ("min_spacing", self.min_spacing),
+                ("clearance", self.clearance),
+            ],
+            self.height,
+            &self.textures,
+        )?;
+        if !(0.0..=180.0).contains(&self.max_turn_deg) {
+            return Err(format!(
+                "`people.max_turn_deg` must be in [0, 180], got {}",
+                self.max_turn_deg
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl TreesParams {
+    pub(super) fn validate(&self) -> Result<(), String> {
+        common(
+            "trees",
+            &[
+                ("per_ha", self.per_ha),
+                ("per_ha_machiya", self.per_ha_machiya),
+                ("min_spacing", self.min_spacing),
+                ("clearance", self.clearance),
+            ],
+            self.height,
+            &self.textures,
+        )
+    }
+}
+
+/// Densities and distances are 0 or more, the height range is positive and ordered, and
+/// there is a texture to draw from.
+fn common(
+    table: &str,
+    non_negative: &[(&str, f64)],
+    height: [f64; 2],
+    textures: &[String],
+) -> Result<(), String> {
+    for (key, v) in non_negative {
+        if !(v.is_finite() && *v >= 0.0) {
+            return Err(format!("`{table}.{key}` must be 0 or more, got {v}"));
+        }
+    }
+    let [lo, hi] = height;
+    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= hi) {
+        return Err(format!(
+            "`{table}.height` must be [low, high] with 0 < low <= high, got [{lo}, {hi}]"
+        ));
+    }
+    if textures.is_empty() {
+        return Err(format!("`{table}.textures` lists no texture"));
+    }
+    Ok(())
+}
+
+/// The same tables with every field optional, for checking a user's partial file.
+pub(super) mod partial {
+    use serde::Deserialize;
+
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    pub struct PointsLayer {
+        file: Option<String>,
+        encoding: Option<String>,
+        id_field: Option<String>,
+        height_field: Option<String>,
+        texture_field: Option<String>,
+    }
+
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    pub struct People {
+        enabled: Option<bool>,
+        template: Option<String>,
+        per_100m: Option<f64>,
+        height: Option<[f64; 2]>,
+        max_turn_deg: Option<f64>,
+        edge_margin: Option<f64>,
+        min_spacing: Option<f64>,
+        clearance: Option<f64>,
+        textures: Option<Vec<String>>,
+        max_points_per_tile: Option<usize>,
+    }
+
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    pub struct Trees {
+        enabled: Option<bool>,
+        template: Option<String>,
+        uses: Option<Vec<String>>,
+        per_ha: Option<f64>,
+        per_ha_machiya: Option<f64>,
+        height: Option<[f64; 2]>,
+        min_spacing: Option<f64>,
+        clearance: Option<f64>,
+        textures: Option<Vec<String>>,
+        max_points_per_tile: Option<usize>,
+    }
+}
