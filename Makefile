@@ -37,7 +37,8 @@ bench:
 textures:
 	$(CARGO) run --release --example make_textures
 
-## Render every template alone into docs/templates/ (needs f3d and xvfb-run).
+## Render every template alone into docs/templates/ and the people of a street into
+## docs/people.png (needs f3d and xvfb-run).
 pictures:
 	scripts/render_templates.sh
 

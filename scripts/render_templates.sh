@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Renders every shipped template alone into docs/templates/<name>.png, and a street of the
-# example city into docs/street.png (run `make pictures`).
+# example city with its people into docs/people.png (run `make pictures`).
 # Needs f3d and xvfb-run (Debian: apt install f3d xvfb); the pictures are committed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,10 +26,10 @@ render gate 3.03 1 -3,4,7 1.5,2,0
 render tree 1 1 -8,4,15 0,3.4,0
 render person 1 1 -1.5,1.5,3 0,0.8,0
 
-# The bundled example city at street level, people and trees included (README, "People
+# The bundled example city at street level, with its people (README, "People
 # and trees").
 "$bin" build fixtures/kyoto-small --out "$work/city" --no-plan >/dev/null
-xvfb-run -a f3d "$work/city/tiles/1108_760.obj" --output docs/street.png \
+xvfb-run -a f3d "$work/city/tiles/1108_760.obj" --output docs/people.png \
     --resolution 960,600 --camera-position=131,3,-185 --camera-focal-point=133,1.5,-205 \
     --camera-view-up=0,1,0 --grid=0 --bg-color=0.7,0.8,0.9 >/dev/null 2>&1
-echo docs/street.png
+echo docs/people.png
