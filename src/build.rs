@@ -95,6 +95,8 @@ pub struct Timings {
     pub analyse: Duration,
     /// Of `analyse`: kura placement, the R-tree of provisional plots and its queries.
     pub kura: Duration,
+    /// Of `analyse`: people and trees (obstacle R-tree, Poisson draws, thinning).
+    pub billboards: Duration,
     pub generate_and_write: Duration,
     /// Drawing plan.png.
     pub plan: Duration,
@@ -234,6 +236,7 @@ fn run(
     timings.read = read;
     timings.analyse = analysed;
     timings.kura = plan.kura_time;
+    timings.billboards = plan.billboards_time;
     // After reading (a mistyped input is reported as that), before writing anything.
     shards::check_out_dir(opts)?;
 
