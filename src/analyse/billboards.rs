@@ -118,8 +118,9 @@ fn segment(a: Coord<f64>, b: Coord<f64>) -> Segment {
 /// A source of generated points: a street piece or a lot.
 struct Source<'a> {
     id: String,
-    /// Where its expected count is charged against `max_points_per_tile`.
-    tile: String,
+    /// The tiles its points may fall in, with the share of its area in each: its expected
+    /// count is charged against their `max_points_per_tile` by these shares.
+    tiles: Vec<(String, f64)>,
     district: Option<&'a str>,
     /// Expected points in the source.
     expected: f64,
@@ -184,14 +185,18 @@ pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, param
                 };
                 // Generated billboards dress the built city: a tile with no house, kura or
                 // fence gets none (streets often run on past the lots).
-                sources.retain(|s| plan.tiles.contains_key(&s.tile));
+                sources.retain(|s| s.tiles.iter().any(|t| plan.tiles.contains_key(&t.0)));
                 let scale = budget(&sources, &k, &mut plan.warnings);
                 let drawn: Vec<Vec<Candidate>> = sources
                     .par_iter()
                     .map(|s| {
                         draw(
                             s,
-                            scale.get(&s.tile).copied(),
+                            s.tiles
+                                .iter()
+                                .filter_map(|t| scale.get(&t.0))
+                                .copied()
+                                .reduce(f64::min),
                             &k,
                             &near,
                             &obstacles,
@@ -333,7 +338,7 @@ fn street_sources<'a>(data: &'a Dataset, near: &Surroundings<'a>, p: &Params) ->
                     p.district_density(district, |d| d.people_per_100m, p.people.per_100m);
                 out.push(Source {
                     id: format!("{}/{}/{}", s.id, k + 1, j + 1),
-                    tile: tile_id(mid, p.tile_size, p.tile_origin),
+                    tiles: vec![(tile_id(mid, p.tile_size, p.tile_origin), 1.0)],
                     district,
                     expected: len / pieces as f64 / 100.0 * density,
                     shape: SourceShape::Street {
@@ -395,7 +400,7 @@ fn lot_sources<'a>(
         }
         out.push(Source {
             id: lot.id.clone(),
-            tile: tile_id(c.0, p.tile_size, p.tile_origin),
+            tiles: tiles_under(bb, c.0, p),
             district,
             expected: planted * density / 10_000.0,
             shape: SourceShape::Lot {
@@ -408,12 +413,41 @@ fn lot_sources<'a>(
     out
 }
 
+/// The tiles a lot's bounding box overlaps, with the share of the box in each; a box over
+/// more than 4,096 tiles (damaged data) is charged to its centroid's tile alone.
+fn tiles_under(bb: geo_types::Rect<f64>, centroid: Coord<f64>, p: &Params) -> Vec<(String, f64)> {
+    let (size, [ox, oy]) = (p.tile_size, p.tile_origin);
+    let cols =
+        ((bb.min().x - ox) / size).floor() as i64..=((bb.max().x - ox) / size).floor() as i64;
+    let rows =
+        ((bb.min().y - oy) / size).floor() as i64..=((bb.max().y - oy) / size).floor() as i64;
+    let area = bb.width() * bb.height();
+    let n = (cols.end() - cols.start() + 1).saturating_mul(rows.end() - rows.start() + 1);
+    if area.is_nan() || area <= 0.0 || n > 4096 {
+        return vec![(tile_id(centroid, size, p.tile_origin), 1.0)];
+    }
+    let mut out = Vec::new();
+    for c in cols {
+        for r in rows.clone() {
+            let (x0, y0) = (ox + c as f64 * size, oy + r as f64 * size);
+            let w = (bb.max().x.min(x0 + size) - bb.min().x.max(x0)).max(0.0);
+            let h = (bb.max().y.min(y0 + size) - bb.min().y.max(y0)).max(0.0);
+            if w * h > 0.0 {
+                out.push((format!("{c}_{r}"), w * h / area));
+            }
+        }
+    }
+    out
+}
+
 /// Density scale per tile: a tile whose sources expect more than `max_points_per_tile`
 /// points has its densities scaled down to it, with a warning.
 fn budget(sources: &[Source], k: &Kind, warnings: &mut Vec<String>) -> BTreeMap<String, f64> {
     let mut expected: BTreeMap<&str, f64> = BTreeMap::new();
     for s in sources {
-        *expected.entry(s.tile.as_str()).or_default() += s.expected;
+        for (tile, share) in &s.tiles {
+            *expected.entry(tile.as_str()).or_default() += s.expected * share;
+        }
     }
     let mut scale = BTreeMap::new();
     for (tile, e) in expected {
@@ -630,4 +664,78 @@ fn cap_tiles(
         out.extend(v);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lot_over_four_tiles_is_charged_to_each_by_its_share() {
+        let p = Params {
+            tile_size: 100.0,
+            tile_origin: [0.0, 0.0],
+            ..Params::default()
+        };
+        let bb = geo_types::Rect::new(Coord { x: 50.0, y: 75.0 }, Coord { x: 150.0, y: 125.0 });
+        let mut t = tiles_under(bb, Coord { x: 100.0, y: 100.0 }, &p);
+        t.sort_by(|a, b| a.0.cmp(&b.0));
+        let want: [(&str, f64); 4] = [("0_0", 0.25), ("0_1", 0.25), ("1_0", 0.25), ("1_1", 0.25)];
+        assert_eq!(t.len(), 4);
+        for ((id, share), (wid, wshare)) in t.iter().zip(want) {
+            assert_eq!(
+                (id.as_str(), (share * 1e9).round()),
+                (wid, (wshare * 1e9).round())
+            );
+        }
+        // A box over a whole country (damaged data) goes to its centroid's tile alone.
+        let huge = geo_types::Rect::new(Coord { x: 0.0, y: 0.0 }, Coord { x: 1e7, y: 1e7 });
+        assert_eq!(tiles_under(huge, Coord { x: 5.0, y: 5.0 }, &p).len(), 1);
+    }
+
+    fn candidate(key: u64, x: f64) -> Candidate {
+        Candidate {
+            key,
+            b: PlannedBillboard {
+                kind: BillboardKind::Tree,
+                id: format!("{key}"),
+                at: Coord { x, y: 0.0 },
+                facing: 0.0,
+                height: 5.0,
+                texture: "tree_01".into(),
+                ground: 0.0,
+                district: None,
+                tile: "0_0".into(),
+            },
+        }
+    }
+
+    #[test]
+    fn thinning_keeps_the_lowest_key_of_close_points_whatever_their_order() {
+        let make = || {
+            vec![
+                candidate(9, 0.0),
+                candidate(3, 1.0),
+                candidate(5, 2.5),
+                candidate(1, 10.0),
+            ]
+        };
+        let kept: Vec<String> = thin(make(), 2.0).into_iter().map(|b| b.id).collect();
+        // 1 (alone), 3 (beats 9 at 1 m), 5 is 1.5 m from 3: dropped; 9 is 1 m from 3: dropped.
+        assert_eq!(kept, ["1", "3"]);
+        let mut reversed = make();
+        reversed.reverse();
+        let again: Vec<String> = thin(reversed, 2.0).into_iter().map(|b| b.id).collect();
+        assert_eq!(kept, again);
+        assert_eq!(thin(make(), 0.0).len(), 4);
+    }
+
+    #[test]
+    fn a_texture_field_is_a_library_name_or_a_number_into_the_list() {
+        let list = vec!["tree_01".to_string(), "tree_07".to_string()];
+        assert_eq!(texture_of("2", &list).as_deref(), Some("tree_07"));
+        assert_eq!(texture_of("tree_03", &list).as_deref(), Some("tree_03"));
+        assert_eq!(texture_of("3", &list), None);
+        assert_eq!(texture_of("oak", &list), None);
+    }
 }
