@@ -2,7 +2,7 @@
 
 CARGO ?= cargo
 
-.PHONY: run test lint bench real textures fixtures clean pictures
+.PHONY: run test lint bench real textures fixtures clean pictures bad-input
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
@@ -41,6 +41,10 @@ textures:
 ## docs/people.png (needs f3d and xvfb-run).
 pictures:
 	scripts/render_templates.sh
+
+## Rewrite the corpus of broken inputs tests/bad_input/ from tests/common/corpus.rs.
+bad-input:
+	EDO_CITY_WRITE_CORPUS=1 $(CARGO) test --test bad_input the_committed_corpus_is_what_its_script_makes
 
 ## Regenerate the example data (lots.csv is written by hand on top of it).
 fixtures:

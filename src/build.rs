@@ -52,10 +52,14 @@ pub enum BuildError {
     Input(#[from] InputError),
     #[error("{0}")]
     Config(String),
-    #[error("cannot write {path}: {source}")]
+    // The io::Error is in the message, not a `source`: the CLI prints the chain, and it
+    // would say it twice.
+    #[error("cannot write {path}: {cause}{hint}")]
     Write {
         path: String,
-        source: std::io::Error,
+        cause: std::io::Error,
+        /// What to do, when there is something to say.
+        hint: &'static str,
     },
 }
 
@@ -216,10 +220,18 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcom
     pool.install(|| run(opts, &catalog, &textures, progress, t0))
 }
 
-fn write_err(path: &Path, source: std::io::Error) -> BuildError {
+fn write_err(path: &Path, cause: std::io::Error) -> BuildError {
+    let full = cause.raw_os_error() == Some(28) || cause.kind() == std::io::ErrorKind::StorageFull;
+    let hint = if full {
+        ". Every file written is whole (temporaries are removed); free some space or build \
+         into another --out, and run the same command again"
+    } else {
+        ""
+    };
     BuildError::Write {
         path: path.display().to_string(),
-        source,
+        cause,
+        hint,
     }
 }
 
@@ -252,8 +264,8 @@ fn run(
     for dir in [&opts.out, &tiles_dir, &opts.out.join("textures")] {
         output::atomic::remove_leftover_temporaries(dir);
     }
-    let textures =
-        output::write_textures(&opts.out, texture_set).map_err(|e| write_err(&opts.out, e))?;
+    let textures = output::write_textures(&opts.out, texture_set)
+        .map_err(|e| write_err(&opts.out.join("textures"), e))?;
 
     let files = layer_files(&opts.input, params);
     let tiles: Vec<_> = plan

@@ -193,6 +193,23 @@ fn main() -> ExitCode {
     }
 }
 
+/// A proj string cut to what tells CRSs apart in a table: `tmerc lat_0=36 lon_0=136`.
+fn short_crs(def: &str) -> String {
+    let keep = [
+        "+proj=", "+zone=", "+south", "+lat_0=", "+lon_0=", "+datum=",
+    ];
+    let parts: Vec<&str> = def
+        .split_whitespace()
+        .filter(|t| keep.iter().any(|k| t.starts_with(k)))
+        .map(|t| t.trim_start_matches("+proj=").trim_start_matches('+'))
+        .collect();
+    if parts.is_empty() {
+        def.to_string()
+    } else {
+        parts.join(" ")
+    }
+}
+
 /// The table `edo-city check` prints.
 fn print_check(r: &edo_city::output::report::Report) {
     println!("input {}", r.input);
@@ -205,15 +222,16 @@ fn print_check(r: &edo_city::output::report::Report) {
         }
     );
     println!(
-        "\n{:<14} {:>9}  {:<24} {:<8} file",
-        "layer", "features", "text", "reproj."
+        "\n{:<12} {:>9}  {:<30} {:<28} {:<7} file",
+        "layer", "features", "text encoding", "CRS", "reproj."
     );
     for l in &r.layers {
         println!(
-            "{:<14} {:>9}  {:<24} {:<8} {}",
+            "{:<12} {:>9}  {:<30} {:<28} {:<7} {}",
             l.role,
             l.features,
             l.encoding,
+            short_crs(&l.crs),
             if l.reprojected { "yes" } else { "no" },
             l.file
         );
@@ -233,6 +251,9 @@ fn print_check(r: &edo_city::output::report::Report) {
         c.tiles,
         c.frontage_fallback
     );
+    if c.people + c.trees > 0 {
+        println!("people {}, trees {}", c.people, c.trees);
+    }
     for t in &r.tables {
         println!(
             "table {}: {} rows, {} matched, {} without a lot ({}), {} lots without a row",

@@ -8,6 +8,17 @@ use std::collections::BTreeMap;
 use geo_types::{Coord, LineString, Polygon};
 use serde::{Deserialize, Serialize};
 
+/// Coordinates this far from the CRS's origin (metres; the Earth is 4e7 m round) come from
+/// damaged data: their squares overflow, and with them the R-trees' distance arithmetic.
+/// `input/` skips polygons with such a vertex; later stages leave such points out of their
+/// indexes.
+pub const FAR: f64 = 1e8;
+
+/// Whether a point is nearer than [`FAR`] to the CRS's origin.
+pub fn sane(c: Coord<f64>) -> bool {
+    c.x.abs() < FAR && c.y.abs() < FAR
+}
+
 /// What a lot (shikichi 敷地) is used for; decides which generator it gets.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "lowercase")]

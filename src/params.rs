@@ -18,11 +18,8 @@ pub const DEFAULT_TOML: &str = include_str!("../params/default.toml");
 
 #[derive(Debug, Error)]
 pub enum ParamsError {
-    #[error("cannot read parameter file {path}: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
+    #[error("cannot read parameter file {path}: {cause}")]
+    Io { path: String, cause: std::io::Error },
     #[error("parameter file {path}: {message}")]
     Parse { path: String, message: String },
     #[error("parameter file {path}: {message}")]
@@ -368,9 +365,9 @@ impl Default for Params {
 impl Params {
     /// Reads a parameter file. Keys it leaves out keep their default values.
     pub fn from_path(path: &Path) -> Result<Params, ParamsError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ParamsError::Io {
+        let text = std::fs::read_to_string(path).map_err(|cause| ParamsError::Io {
             path: path.display().to_string(),
-            source,
+            cause,
         })?;
         let base = path.parent().unwrap_or(Path::new("."));
         Params::from_toml_in(&text, &path.display().to_string(), base, &mut Vec::new())
@@ -555,9 +552,9 @@ fn resolved_table(
                 }
                 chain.push(key.clone());
                 let parent_text =
-                    std::fs::read_to_string(&file).map_err(|source| ParamsError::Io {
+                    std::fs::read_to_string(&file).map_err(|cause| ParamsError::Io {
                         path: format!("{key} (extended by {path})"),
-                        source,
+                        cause,
                     })?;
                 let dir = file.parent().unwrap_or(Path::new("."));
                 resolved_table(&parent_text, &key, dir, chain)?

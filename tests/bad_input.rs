@@ -173,3 +173,187 @@ fn an_unwritable_output_directory_is_an_error_naming_it() {
         .code(2)
         .stderr(predicate::str::contains("not-a-dir"));
 }
+
+/// Where the committed corpus lives.
+fn corpus_dir() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_input")
+}
+
+/// Every file under `dir` (relative path -> bytes), `expect.toml` included.
+fn tree(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    all_files(dir)
+}
+
+#[test]
+fn the_committed_corpus_is_what_its_script_makes() {
+    let fresh = tempfile::tempdir().unwrap();
+    for case in common::corpus::cases() {
+        let d = fresh.path().join(case.name);
+        std::fs::create_dir_all(&d).unwrap();
+        (case.make)(&d);
+        std::fs::write(d.join("expect.toml"), case.expect).unwrap();
+    }
+    if std::env::var_os("EDO_CITY_WRITE_CORPUS").is_some() {
+        let _ = std::fs::remove_dir_all(corpus_dir());
+        for (rel, bytes) in tree(fresh.path()) {
+            let p = corpus_dir().join(rel);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, bytes).unwrap();
+        }
+    }
+    assert!(
+        tree(fresh.path()) == tree(&corpus_dir()),
+        "tests/bad_input differs from tests/common/corpus.rs: run `make bad-input`"
+    );
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Expect {
+    class: String,
+    #[serde(default)]
+    message: Option<String>,
+    #[serde(default)]
+    args: Vec<String>,
+    #[serde(default)]
+    built: Option<u64>,
+    #[serde(default)]
+    skipped: Vec<ExpectSkip>,
+    /// The output directory's name (a file of that name is put there first).
+    #[serde(default)]
+    out: Option<String>,
+    /// Simulate a disk that is full after this many bytes.
+    #[serde(default)]
+    disk_bytes: Option<u64>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExpectSkip {
+    layer: String,
+    id: String,
+    reason: String,
+}
+
+/// The file a skipped feature of `layer` must be reported in.
+fn file_of(layer: &str) -> &'static str {
+    match layer {
+        "lots table" => "lots.csv",
+        "trees" => "trees.shp",
+        "people" => "people.shp",
+        _ => "lots.shp",
+    }
+}
+
+#[test]
+fn every_broken_input_gets_its_class_of_message() {
+    let mut cases: Vec<_> = std::fs::read_dir(corpus_dir())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    cases.sort();
+    assert!(
+        cases.len() >= 25,
+        "only {} cases in tests/bad_input",
+        cases.len()
+    );
+    // Every case runs; the failures are listed together.
+    let failed: Vec<String> = cases
+        .iter()
+        .filter_map(|case| {
+            std::panic::catch_unwind(|| run_case(case)).err().map(|e| {
+                match e.downcast_ref::<String>() {
+                    Some(m) => m.clone(),
+                    None => format!("{}: {:?}", case.display(), e.downcast_ref::<&str>()),
+                }
+            })
+        })
+        .collect();
+    assert!(
+        failed.is_empty(),
+        "{} case(s) failed:\n{}",
+        failed.len(),
+        failed.join("\n")
+    );
+}
+
+/// Runs one case of the corpus and checks its `expect.toml`.
+fn run_case(case: &Path) {
+    {
+        let name = case.file_name().unwrap().to_string_lossy().to_string();
+        let expect: Expect =
+            toml::from_str(&std::fs::read_to_string(case.join("expect.toml")).unwrap()).unwrap();
+        let work = tempfile::tempdir().unwrap();
+        for (rel, bytes) in tree(case) {
+            std::fs::write(work.path().join(rel), bytes).unwrap();
+        }
+        let out_name = expect.out.clone().unwrap_or_else(|| "out".into());
+        let out = work.path().join(&out_name);
+        if expect.out.is_some() {
+            std::fs::write(&out, "a file where the output should go").unwrap();
+        }
+        let mut cmd = edo_city();
+        cmd.current_dir(work.path())
+            .args(["build", ".", "--out", &out_name, "--quiet"])
+            .args(&expect.args);
+        if let Some(b) = expect.disk_bytes {
+            cmd.env("EDO_CITY_SIMULATE_DISK_BYTES", b.to_string());
+        }
+        let o = cmd.output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr).to_string();
+        let code = o.status.code();
+        match expect.class.as_str() {
+            "error" => {
+                assert_eq!(code, Some(2), "{name}: {stderr}");
+                let m = expect.message.as_deref().unwrap();
+                assert!(stderr.contains(m), "{name}: `{m}` not in: {stderr}");
+                // Nothing written: no manifest, no tile, no temporary.
+                if out.is_dir() {
+                    let files = all_files(&out);
+                    assert!(
+                        files.keys().all(|f| f.starts_with("textures/")),
+                        "{name}: wrote {:?}",
+                        files.keys().collect::<Vec<_>>()
+                    );
+                } else if expect.out.is_some() {
+                    assert!(out.is_file(), "{name}: the blocking file is gone");
+                }
+            }
+            "warning" | "ok" => {
+                assert_eq!(code, Some(0), "{name}: {stderr}");
+                let r = read_json(&out.join("report.json"));
+                if let Some(n) = expect.built {
+                    assert_eq!(r["counts"]["machiya"], n, "{name}");
+                }
+                let skipped = r["skipped"].as_array().unwrap();
+                for s in &expect.skipped {
+                    let hit = skipped.iter().any(|k| {
+                        k["layer"] == s.layer.as_str()
+                            && k["id"] == s.id.as_str()
+                            && k["reason"].as_str().unwrap().contains(&s.reason)
+                            && k["file"].as_str().unwrap().ends_with(file_of(&s.layer))
+                    });
+                    assert!(
+                        hit,
+                        "{name}: no skip {} {} `{}`: {skipped:#?}",
+                        s.layer, s.id, s.reason
+                    );
+                }
+                if let Some(m) = &expect.message {
+                    let said = r["warnings"].to_string() + &r["skipped"].to_string();
+                    assert!(said.contains(m.as_str()), "{name}: `{m}` not in {said}");
+                }
+                if expect.class == "ok" {
+                    assert!(skipped.is_empty(), "{name}: {skipped:#?}");
+                } else {
+                    assert!(
+                        !skipped.is_empty() || expect.message.is_some(),
+                        "{name}: a warning case expects a skip or a message"
+                    );
+                }
+                assert!(out.join("manifest.json").exists(), "{name}");
+            }
+            other => panic!("{name}: unknown class {other}"),
+        }
+    }
+}

@@ -164,13 +164,26 @@ fn points_as_lots_are_refused_with_the_record() {
 
 #[test]
 fn check_reports_without_writing_and_says_by_its_exit_code() {
-    // Clean input: exit 0.
+    // Clean input (the fixture without its table row that matches no lot): exit 0.
+    let clean = tempfile::tempdir().unwrap();
+    copy_fixture("kyoto-small", clean.path());
+    std::fs::write(clean.path().join("lots.csv"), "id,mtype\n5,sangai\n").unwrap();
+    edo_city()
+        .arg("check")
+        .arg(clean.path())
+        .assert()
+        .code(0)
+        .stdout(predicate::str::contains("no problems").and(predicate::str::contains("Shift_JIS")));
+    // The fixture as shipped: its row 9999 is a problem (exit 1) naming the table.
     edo_city()
         .arg("check")
         .arg(fixture("kyoto-small"))
         .assert()
-        .code(0)
-        .stdout(predicate::str::contains("no problems").and(predicate::str::contains("Shift_JIS")));
+        .code(1)
+        .stdout(
+            predicate::str::contains("lots table 9999")
+                .and(predicate::str::contains("no lot has this id")),
+        );
     // A type nobody knows: a warning, exit 1, and the lot named.
     let dir = tempfile::tempdir().unwrap();
     copy_fixture("kyoto-small", dir.path());

@@ -242,3 +242,89 @@ fn a_killed_build_loses_nothing() {
     );
     assert!(done == new_files, "the next run finishes the job");
 }
+
+/// A disk that fills up mid-build (simulated: EDO_CITY_SIMULATE_DISK_BYTES) stops the build
+/// with a message saying so; every file left is the complete old or the complete new
+/// version, no temporary remains, and the same command finishes the job once there is room.
+#[test]
+fn a_full_disk_loses_nothing() {
+    let work = tempfile::tempdir().unwrap();
+    let town = fixture("kyoto-small");
+    let (old_params, new_params) = (work.path().join("old.toml"), work.path().join("new.toml"));
+    std::fs::write(&old_params, "seed = 1\n").unwrap();
+    std::fs::write(&new_params, "seed = 2\n").unwrap();
+    let p = |f: &std::path::Path| f.to_str().unwrap().to_string();
+    let (old_ref, new_ref) = (work.path().join("old"), work.path().join("new"));
+    build_ok(&town, &old_ref, &["--quiet", "--params", &p(&old_params)]);
+    build_ok(&town, &new_ref, &["--quiet", "--params", &p(&new_params)]);
+    let (old_files, new_files) = (all_files(&old_ref), all_files(&new_ref));
+    let textures: usize = new_files
+        .iter()
+        .filter(|(k, _)| k.starts_with("textures/"))
+        .map(|(_, v)| v.len())
+        .sum();
+    let tiles: usize = new_files
+        .iter()
+        .filter(|(k, _)| k.starts_with("tiles/"))
+        .map(|(_, v)| v.len())
+        .sum();
+
+    let out = work.path().join("out");
+    build_ok(&town, &out, &["--quiet", "--params", &p(&old_params)]);
+    // Room for the textures and about half the tiles.
+    let room = textures + tiles / 2;
+    let o = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"))
+        .args([
+            "build",
+            town.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .args(["--quiet", "--force", "--params", &p(&new_params)])
+        .env("EDO_CITY_SIMULATE_DISK_BYTES", room.to_string())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("No space left on device") && stderr.contains("run the same command"),
+        "{stderr}"
+    );
+    assert_eq!(
+        stderr.matches("No space left").count(),
+        1,
+        "said once: {stderr}"
+    );
+    let left = all_files(&out);
+    let (mut old_kept, mut new_written) = (0, 0);
+    for (name, bytes) in &left {
+        assert!(!name.contains(".tmp-"), "{name}: a temporary was left");
+        let (is_old, is_new) = (
+            old_files.get(name) == Some(bytes),
+            new_files.get(name) == Some(bytes),
+        );
+        assert!(
+            is_old || is_new,
+            "{name} is neither the old nor the new version"
+        );
+        if name.starts_with("tiles/") && name.ends_with(".obj") && is_old != is_new {
+            old_kept += is_old as usize;
+            new_written += is_new as usize;
+        }
+    }
+    assert!(
+        new_written > 0 && old_kept > 0,
+        "new {new_written}, old {old_kept}"
+    );
+    assert_eq!(
+        left.get("manifest.json"),
+        old_files.get("manifest.json"),
+        "manifest is last"
+    );
+    build_ok(
+        &town,
+        &out,
+        &["--quiet", "--force", "--params", &p(&new_params)],
+    );
+    assert!(all_files(&out) == new_files, "the rerun finishes the job");
+}

@@ -19,10 +19,12 @@ use rayon::prelude::*;
 use rstar::primitives::GeomWithData;
 use rstar::RTree;
 
-use super::obstacles::{boundary_distance, sane, Obstacles, FAR};
+use super::obstacles::{boundary_distance, Obstacles};
 use super::street::Segment;
 use super::tiling::tile_id;
-use crate::model::{BillboardKind, Dataset, Plan, PlannedBillboard, PointFeature, Skipped};
+use crate::model::{
+    sane, BillboardKind, Dataset, Plan, PlannedBillboard, PointFeature, Skipped, FAR,
+};
 use crate::params::Params;
 use crate::rng::feature_rng;
 use crate::templates::Catalog;

@@ -13,22 +13,12 @@ use rstar::{RTree, AABB};
 
 use super::kura::{house_end, local_ring, Frame};
 use super::street::segment_distance_2;
-use crate::model::{PlannedFence, PlannedMachiya};
+use crate::model::{PlannedFence, PlannedMachiya, FAR};
 use crate::params::Params;
 use crate::templates::Catalog;
 
 /// Half the thickness counted for a wall or fence (a tsuiji's base is about 0.9 m).
 const WALL_HALF: f64 = 0.45;
-
-/// Coordinates beyond this (metres; the Earth is 4e7 round) come from damaged data: their
-/// squares overflow, and the R-trees' distance arithmetic with them. Such features are left
-/// out of the indexes here.
-pub const FAR: f64 = 1e8;
-
-/// Whether a point is within [`FAR`] of the CRS's origin.
-pub fn sane(c: Coord<f64>) -> bool {
-    c.x.abs() < FAR && c.y.abs() < FAR
-}
 
 enum Obstacle {
     /// The part of `outline` with `v < v_max` in the frame `(a, v)`.

@@ -101,8 +101,20 @@ pub fn points_of(shape: &Shape) -> Result<Vec<Coord<f64>>, &'static str> {
 /// A polygon the later stages can work on: finite, at least a triangle, with an area.
 pub fn check_polygon(poly: &Polygon<f64>) -> Result<(), String> {
     let ext = poly.exterior();
-    if ext.0.iter().any(|c| !c.x.is_finite() || !c.y.is_finite()) {
+    let all = || {
+        ext.0
+            .iter()
+            .chain(poly.interiors().iter().flat_map(|r| r.0.iter()))
+    };
+    if all().any(|c| !c.x.is_finite() || !c.y.is_finite()) {
         return Err("a coordinate is not a finite number".into());
+    }
+    if all().any(|c| !crate::model::sane(*c)) {
+        return Err(format!(
+            "a coordinate lies {:.0e} m or more from the CRS's origin (the Earth is 4e7 m \
+             round): the geometry is damaged",
+            crate::model::FAR
+        ));
     }
     let distinct: BTreeSet<(u64, u64)> = ext
         .0
@@ -116,7 +128,18 @@ pub fn check_polygon(poly: &Polygon<f64>) -> Result<(), String> {
         ));
     }
     if poly.unsigned_area() < 1e-6 {
-        return Err("the outline has no area".into());
+        // A bow tie's two loops cancel; a flat outline has no loop at all.
+        let pts: Vec<&Coord<f64>> = ext.0.iter().collect();
+        let flat = pts.windows(3).all(|w| {
+            let (a, b, c) = (w[0], w[1], w[2]);
+            ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)).abs() < 1e-6
+        });
+        return Err(match flat {
+            true => "the outline has no area".into(),
+            false => "the outline crosses itself and its loops enclose no net area (a bow \
+                      tie); redraw it as a simple polygon"
+                .into(),
+        });
     }
     Ok(())
 }

@@ -119,6 +119,32 @@ fn layer_coords(o: &Opened) -> Vec<Coord<f64>> {
     out
 }
 
+/// Warns when a layer said to be in projected metres (by its `.prj` or by `crs`) has every
+/// coordinate within +-180 / +-90, as longitude/latitude degrees would be: a town that small
+/// around a CRS's origin is rare, a `.prj` copied from the wrong file is not.
+fn degrees_in_metres(o: &Opened, params: &Params, warnings: &mut Vec<String>) {
+    let said = match &o.layer.prj {
+        Some(wkt) => Crs::from_wkt(wkt).ok(),
+        None => Crs::from_user(&params.crs).ok(),
+    };
+    let Some(said) = said.filter(|c| !c.is_geographic()) else {
+        return;
+    };
+    let coords = layer_coords(o);
+    if !coords.is_empty() && crs::looks_like_degrees(coords) {
+        let source = match o.layer.prj {
+            Some(_) => "its .prj".to_string(),
+            None => format!("`crs` = {}", params.crs),
+        };
+        warnings.push(format!(
+            "{}: every coordinate lies within +-180 / +-90, like longitude/latitude in degrees, \
+             but {source} says projected metres ({}); if they are degrees, replace the .prj \
+             with a WGS84 one or remove it",
+            o.file, said.definition
+        ));
+    }
+}
+
 /// Chooses the output CRS and the CRS of every layer, with warnings for what was assumed.
 fn resolve_crs(
     params: &Params,
@@ -138,6 +164,9 @@ fn resolve_crs(
         target = Some(c);
     }
     for o in layers.iter_mut() {
+        if o.layer.prj.is_some() || !params.crs.trim().is_empty() {
+            degrees_in_metres(o, params, warnings);
+        }
         o.src = match &o.layer.prj {
             Some(wkt) => Some(Crs::from_wkt(wkt).map_err(|m| InputError::Layer {
                 file: o.file.replace(".shp", ".prj"),
@@ -520,7 +549,8 @@ fn read_lots(
         }
     }
     if let Some(t) = table {
-        data.joins.push(join(&mut lots, t, "lots"));
+        data.joins
+            .push(join(&mut lots, t, "lots", &mut data.skipped));
     }
     let mut bad_ground = 0usize;
     for lot in &mut lots {
@@ -947,8 +977,19 @@ fn checked_parts(
     out
 }
 
-/// Applies a table to the lots: table values win. Returns the match counts.
-fn join(lots: &mut [Lot], table: table::Table, layer: &str) -> TableJoin {
+/// "lot" for "lots": how a feature of the layer is called in messages.
+fn singular(layer: &str) -> &str {
+    layer.strip_suffix('s').unwrap_or(layer)
+}
+
+/// Applies a table to the lots by id, table values winning; returns the match counts. A row
+/// with no lot is skipped and reported.
+fn join(
+    lots: &mut [Lot],
+    table: table::Table,
+    layer: &str,
+    skipped: &mut Vec<Skipped>,
+) -> TableJoin {
     let mut index: HashMap<String, Vec<usize>> = HashMap::new();
     for (i, lot) in lots.iter().enumerate() {
         // Parts of a multipart lot share their record's id; a row applies to all of them.
@@ -981,6 +1022,12 @@ fn join(lots: &mut [Lot], table: table::Table, layer: &str) -> TableJoin {
             }
             None => {
                 out.rows_without_feature += 1;
+                skipped.push(Skipped {
+                    layer: format!("{layer} table"),
+                    file: table.file.clone(),
+                    id: id.clone(),
+                    reason: format!("no {} has this id; the row was not used", singular(layer)),
+                });
                 if out.rows_without_feature_ids.len() < 20 {
                     out.rows_without_feature_ids.push(id);
                 }

@@ -5,6 +5,32 @@ use std::fs;
 use std::io::Write;
 use std::path::Path;
 
+/// Fault injection: with `EDO_CITY_SIMULATE_DISK_BYTES=N` in the environment, the disk is
+/// full after `N` bytes written through [`write_atomic`] by this process, and a write fails
+/// the way a full disk fails it (`ENOSPC`) after writing what still fitted. Tests use it to
+/// show a full disk loses nothing; without the variable it does nothing. (The one piece of
+/// process-wide state, because a disk is one for all threads.)
+fn disk_room(want: usize) -> Option<usize> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    use std::sync::OnceLock;
+    static ROOM: OnceLock<Option<AtomicU64>> = OnceLock::new();
+    let room = ROOM.get_or_init(|| {
+        std::env::var("EDO_CITY_SIMULATE_DISK_BYTES")
+            .ok()
+            .and_then(|v| v.trim().parse::<u64>().ok())
+            .map(AtomicU64::new)
+    });
+    let room = room.as_ref()?;
+    let mut left = room.load(Ordering::SeqCst);
+    loop {
+        let take = left.min(want as u64);
+        match room.compare_exchange(left, left - take, Ordering::SeqCst, Ordering::SeqCst) {
+            Ok(_) => return Some(take as usize),
+            Err(now) => left = now,
+        }
+    }
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same directory.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let name = path
@@ -14,7 +40,13 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
     let result = (|| {
         let mut f = fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
+        match disk_room(bytes.len()) {
+            Some(fits) if fits < bytes.len() => {
+                f.write_all(&bytes[..fits])?;
+                return Err(std::io::Error::from_raw_os_error(28)); // ENOSPC
+            }
+            _ => f.write_all(bytes)?,
+        }
         f.flush()?;
         drop(f);
         fs::rename(&tmp, path)

@@ -70,8 +70,8 @@ pub enum TemplateError {
     /// Already `file:line:column: message`.
     #[error("{0}")]
     Invalid(String),
-    #[error("cannot read template directory {dir}: {source}")]
-    Io { dir: String, source: std::io::Error },
+    #[error("cannot read template directory {dir}: {cause}")]
+    Io { dir: String, cause: std::io::Error },
 }
 
 /// All loaded templates, by name.
@@ -127,9 +127,9 @@ impl Catalog {
             sources.insert(s.name.value.clone(), s);
         }
         if let Some(dir) = dir {
-            let io = |source| TemplateError::Io {
+            let io = |cause| TemplateError::Io {
                 dir: dir.display().to_string(),
-                source,
+                cause,
             };
             let mut paths = Vec::new();
             files_under(dir, &mut paths).map_err(io)?;

@@ -1,6 +1,8 @@
 //! Helpers shared by the end-to-end tests: run the real binary, re-read what it wrote.
 #![allow(dead_code)]
 
+pub mod corpus;
+
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
