@@ -276,6 +276,9 @@ pub struct PlannedFence {
     /// Ground elevation at `a` and at `b` (the same without a DEM).
     pub ground: f64,
     pub ground_end: f64,
+    /// How deep a wall on the segment may be and stay inside its lot (a free-standing line:
+    /// `analyse::room::MAX_ROOM`): the template's `lot_depth`.
+    pub room: f64,
     pub district: Option<String>,
     pub tile: TileId,
     /// Numeric attributes for the template (`height`).

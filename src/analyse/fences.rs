@@ -10,6 +10,7 @@
 use geo::Centroid;
 use geo_types::Coord;
 
+use super::room::{LotEdges, MAX_ROOM};
 use super::street::StreetEdges;
 use super::tiling;
 use crate::model::{FenceKind, FenceLine, Lot, PlannedFence};
@@ -25,8 +26,11 @@ pub fn mitre(q: Coord<f64>, p: Coord<f64>, r: Coord<f64>) -> f64 {
     let turn = (a.0 * b.1 - a.1 * b.0).atan2(a.0 * b.0 + a.1 * b.1);
     let half = (std::f64::consts::PI - turn) / 2.0;
     let cot = half.cos() / half.sin();
-    // A hairpin (interior angle near 0) would run the wall to infinity: cap it at 20 x.
-    cot.clamp(-20.0, 20.0)
+    // A hairpin (interior angle near 0) would run the wall to infinity: cap it. The cap is
+    // high so that the mitre line stays on the bisector of any real corner and the wall
+    // never crosses the hairpin's other side (a wall's template keeps its inner corners
+    // within the edge, so a large mitre thins the wall rather than lengthening it).
+    cot.clamp(-1e4, 1e4)
 }
 
 /// Which edge holds the gate, from the `gate` attribute: `1`/`street` = the edge whose middle
@@ -130,6 +134,7 @@ fn segments(
             end_mitre: c1,
             ground: w.ground,
             ground_end: w.ground,
+            room: MAX_ROOM,
             district: w.district.clone(),
             tile: w.tile.clone(),
             attrs: w.attrs.clone(),
@@ -239,7 +244,11 @@ pub fn plan_lot_fences(
         tile: tiling::tile_id(centroid, params.tile_size, params.tile_origin),
         attrs: height_attr(&lot.attrs, params),
     };
-    let out = segments(&w, &ring, true, gate, params, &mut warnings);
+    let mut out = segments(&w, &ring, true, gate, params, &mut warnings);
+    let lot_edges = LotEdges::new(&lot.outline);
+    for f in &mut out {
+        f.room = lot_edges.room(f.edge, f.a, f.b, [f.start_mitre, f.end_mitre]);
+    }
     (out, warnings)
 }
 

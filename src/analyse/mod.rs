@@ -6,6 +6,7 @@ pub mod fences;
 pub mod frontage;
 pub mod kura;
 pub mod obstacles;
+pub mod room;
 pub mod street;
 pub mod terrain;
 pub mod tiling;

@@ -201,6 +201,7 @@ mod tests {
             end_mitre: 0.0,
             ground: 0.0,
             ground_end: 0.0,
+            room: 5.0,
             district: None,
             tile: "0_0".into(),
             attrs: vec![],

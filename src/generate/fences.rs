@@ -56,7 +56,7 @@ pub fn build_segment(
     };
     let x = SiteInputs {
         width: len,
-        lot_depth: 1.0,
+        lot_depth: f.room,
         a: f.a,
         b: f.b,
         centroid: mid,
