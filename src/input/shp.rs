@@ -62,6 +62,10 @@ pub fn encoding_for(name: &str) -> Option<&'static encoding_rs::Encoding> {
     }
 }
 
+/// What to do about a file a reader cannot make sense of.
+const DAMAGED: &str = "the file is damaged or cut short (an interrupted copy or download?): \
+                       copy or export the layer again";
+
 /// Reads a whole layer. `forced` is the encoding from the parameter file, empty for none.
 pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
     let file = path.display().to_string();
@@ -74,7 +78,7 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
         .and_then(|r| r.read())
         .map_err(|e| InputError::Layer {
             file: file.clone(),
-            message: format!("cannot read the shapes: {e}"),
+            message: format!("cannot read the shapes ({e}); {DAMAGED}"),
         })?;
 
     let dbf_path = path.with_extension("dbf");
@@ -119,18 +123,18 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
         .build(BufReader::new(dbf))
         .map_err(|e| InputError::Layer {
             file: dbf_path.display().to_string(),
-            message: format!("cannot read the DBF: {e}"),
+            message: format!("cannot read the DBF ({e}); {DAMAGED}"),
         })?;
     let fields: Vec<String> = dbf.fields().iter().map(|f| f.name().to_string()).collect();
     let records = dbf.read().map_err(|e| InputError::Layer {
         file: dbf_path.display().to_string(),
-        message: format!("cannot read the DBF records: {e}"),
+        message: format!("cannot read the DBF records ({e}); {DAMAGED}"),
     })?;
     if records.len() != shapes.len() {
         return Err(InputError::Layer {
             file: file.clone(),
             message: format!(
-                "the .shp has {} shapes but the .dbf has {} records; the files do not belong together",
+                "the .shp and its .shx index give {} shape(s) but the .dbf has {} record(s); the files do not belong together, or one was cut short",
                 shapes.len(),
                 records.len()
             ),
