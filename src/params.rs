@@ -322,6 +322,9 @@ pub struct SimplifyParams {
     /// A vertex within this distance (metres) of the line through its neighbours is removed
     /// from outlines and lines; 0 = keep every vertex.
     pub tolerance: f64,
+    /// A lot, footprint or fence line with more vertices than this after simplification is
+    /// skipped with a reason (it would cost a wall segment and mesh edges per vertex).
+    pub max_vertices: usize,
 }
 
 /// Kura (蔵) storehouses behind wide, deep machiya, section 4.2 of the paper.
@@ -781,6 +784,7 @@ mod partial {
     #[allow(dead_code)]
     struct Simplify {
         tolerance: Option<f64>,
+        max_vertices: Option<usize>,
     }
     #[derive(Deserialize)]
     #[serde(deny_unknown_fields)]

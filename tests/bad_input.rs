@@ -62,6 +62,12 @@ fn each_broken_lot_is_skipped_with_its_reason_and_the_rest_built() {
         let x = 15.0 - 5.0 * i as f64 / n as f64;
         many.push((x, 25.0 + 0.001 * ((i % 2) as f64)));
     }
+    // A lot traced in 30,000 real steps (a 1 m zigzag simplification cannot remove): more
+    // than `simplify.max_vertices`.
+    let mut traced = vec![(1100.0, 0.0), (1105.0, 0.0)];
+    for i in 0..30_000 {
+        traced.push((1105.0 - 5.0 * i as f64 / 30_000.0, 25.0 + (i % 2) as f64));
+    }
     let cases: Vec<Case> = vec![
         ("ok-1", strip(0.0), None),
         ("ok-2", strip(100.0), None),
@@ -106,6 +112,11 @@ fn each_broken_lot_is_skipped_with_its_reason_and_the_rest_built() {
             None,
         ),
         ("million", many, None),
+        (
+            "traced",
+            traced,
+            Some("more than `simplify.max_vertices` (20000)"),
+        ),
     ];
     let lots: Vec<(&str, Vec<(f64, f64)>)> =
         cases.iter().map(|(id, r, _)| (*id, r.clone())).collect();

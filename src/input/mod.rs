@@ -438,7 +438,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         }
     }
     data.dem = read_dem(dir, params, &target, &dl.dem.file)?;
-    simplify::generalise(&mut data, params.simplify.tolerance);
+    simplify::generalise(&mut data, &params.simplify);
     Ok(data)
 }
 
