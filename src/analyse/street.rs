@@ -85,9 +85,22 @@ impl StreetEdges {
     /// street's width (sloppy digitising); the order of vertices is what matters.
     pub fn distance(&self, p: Coord<f64>) -> f64 {
         let q = [p.x, p.y];
+        // Most points asked about are lot corners a few metres from a street: the segments
+        // within NEAR (plus the widest half-width) of the point answer exactly whenever one
+        // of them is nearer than NEAR, since anything outside that circle is farther. The
+        // box query allocates nothing; rstar's nearest-neighbour search builds a heap per
+        // query (perf: a fifth of a single-tile run before this path).
+        const NEAR: f64 = 12.0;
+        let probe = NEAR + self.max_half_width;
+        let mut best = f64::INFINITY;
+        for seg in self.tree.locate_within_distance(q, probe * probe) {
+            best = best.min(seg.distance_2(&q).sqrt() - seg.value);
+        }
+        if best <= NEAR {
+            return best;
+        }
         // The nearest segment by raw distance bounds the answer; only segments within that
-        // distance plus the widest half-width can still have a nearer edge. (A heap-based
-        // nearest-neighbour iterator did the same, but allocated per query: 15 % of a build.)
+        // distance plus the widest half-width can still have a nearer edge.
         let Some(nearest) = self.tree.nearest_neighbor(&q) else {
             return f64::INFINITY;
         };
