@@ -165,7 +165,7 @@ fn plan_lot(
         return skip("the outline has no centroid".into());
     };
     let centroid = centroid.0;
-    let dist: Vec<f64> = ring.iter().map(|p| edges.distance(*p)).collect();
+    let dist = edges.distances(&ring);
     let frontage = find_frontage(&ring, &dist, centroid, rule);
     let depth = lot_depth(&ring, &frontage);
     if depth < params.machiya.min_depth {
@@ -280,7 +280,7 @@ fn plan_footprint(
             reason: "the outline has no centroid".into(),
         });
     };
-    let dist: Vec<f64> = ring.iter().map(|p| edges.distance(*p)).collect();
+    let dist = edges.distances(&ring);
     let frontage = find_frontage(&ring, &dist, centroid.0, rule);
     let mut warnings = Vec::new();
     let given = f.mtype.as_deref().and_then(|m| catalog.resolve(m));
