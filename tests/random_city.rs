@@ -3,29 +3,14 @@
 //! through frontage, kura, fences and billboards. Whatever is built is finite and stands in
 //! its lot; whatever is not is skipped with a reason; parameters out of range are refused.
 
+mod common;
+
+use common::star;
 use edo_city::model::{BillboardKind, Dataset, Lot, LotUse, Plan, Street};
 use edo_city::params::Params;
 use geo::{orient::Direction, Contains, Distance, Euclidean, Orient};
 use geo_types::{Coord, LineString, Point, Polygon};
 use proptest::prelude::*;
-
-/// A star-shaped ring around (cx, cy): any radii, so concave, thin and tiny lots come up.
-fn star(cx: f64, cy: f64, radii: &[f64], twist: f64) -> Vec<Coord<f64>> {
-    let n = radii.len();
-    let mut pts: Vec<Coord<f64>> = radii
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            let a = twist + i as f64 / n as f64 * std::f64::consts::TAU;
-            Coord {
-                x: cx + r * a.cos(),
-                y: cy + r * a.sin(),
-            }
-        })
-        .collect();
-    pts.push(pts[0]);
-    pts
-}
 
 /// One random lot: its place in a 3 x 2 grid of 60 m cells, its ring around that place, its
 /// use, and the size of a square courtyard at its centre (a share of the ring's inner

@@ -87,25 +87,13 @@ mod random_geometry {
     use edo_city::model::{Dataset, Lot, LotUse, Street};
     use edo_city::params::Params;
     use geo::{orient::Direction, Contains, Distance, Euclidean, Orient};
-    use geo_types::{Coord, LineString, Point, Polygon};
+    use geo_types::{LineString, Point, Polygon};
     use proptest::prelude::*;
 
     /// A star-shaped polygon around (cx, cy): any radii, so concave, thin and tiny ones come up.
     fn star(cx: f64, cy: f64, radii: &[f64], twist: f64) -> Polygon<f64> {
-        let n = radii.len();
-        let mut pts: Vec<Coord<f64>> = radii
-            .iter()
-            .enumerate()
-            .map(|(i, r)| {
-                let a = twist + i as f64 / n as f64 * std::f64::consts::TAU;
-                Coord {
-                    x: cx + r * a.cos(),
-                    y: cy + r * a.sin(),
-                }
-            })
-            .collect();
-        pts.push(pts[0]);
-        Polygon::new(LineString(pts), vec![]).orient(Direction::Default)
+        Polygon::new(LineString(super::star(cx, cy, radii, twist)), vec![])
+            .orient(Direction::Default)
     }
 
     proptest! {
@@ -183,18 +171,16 @@ fn a_killed_build_loses_nothing() {
     let work = tempfile::tempdir().unwrap();
     let town = work.path().join("town");
     edo_city::synth::write_town(&town, 4000, 5).unwrap();
-    let (old_params, new_params) = (work.path().join("old.toml"), work.path().join("new.toml"));
-    std::fs::write(&old_params, "seed = 1\n").unwrap();
-    std::fs::write(&new_params, "seed = 2\n").unwrap();
-    let p = |f: &std::path::Path| f.to_str().unwrap().to_string();
     // References: the complete old and new cities.
-    let (old_ref, new_ref) = (work.path().join("old"), work.path().join("new"));
-    build_ok(&town, &old_ref, &["--quiet", "--params", &p(&old_params)]);
-    build_ok(&town, &new_ref, &["--quiet", "--params", &p(&new_params)]);
-    let (old_files, new_files) = (all_files(&old_ref), all_files(&new_ref));
+    let OldAndNew {
+        old_params,
+        new_params,
+        old_files,
+        new_files,
+    } = old_and_new(&town, work.path());
 
     let out = work.path().join("out");
-    build_ok(&town, &out, &["--quiet", "--params", &p(&old_params)]);
+    build_ok(&town, &out, &["--quiet", "--params", &old_params]);
     let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
     for round in 0..6 {
         let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"))
@@ -210,7 +196,7 @@ fn a_killed_build_loses_nothing() {
                 "--threads",
                 "2",
                 "--params",
-                &p(&new_params),
+                &new_params,
             ])
             .spawn()
             .unwrap();
@@ -232,7 +218,7 @@ fn a_killed_build_loses_nothing() {
     build_ok(
         &town,
         &out,
-        &["--quiet", "--force", "--params", &p(&new_params)],
+        &["--quiet", "--force", "--params", &new_params],
     );
     let done = all_files(&out);
     assert_eq!(
@@ -250,14 +236,12 @@ fn a_killed_build_loses_nothing() {
 fn a_full_disk_loses_nothing() {
     let work = tempfile::tempdir().unwrap();
     let town = fixture("kyoto-small");
-    let (old_params, new_params) = (work.path().join("old.toml"), work.path().join("new.toml"));
-    std::fs::write(&old_params, "seed = 1\n").unwrap();
-    std::fs::write(&new_params, "seed = 2\n").unwrap();
-    let p = |f: &std::path::Path| f.to_str().unwrap().to_string();
-    let (old_ref, new_ref) = (work.path().join("old"), work.path().join("new"));
-    build_ok(&town, &old_ref, &["--quiet", "--params", &p(&old_params)]);
-    build_ok(&town, &new_ref, &["--quiet", "--params", &p(&new_params)]);
-    let (old_files, new_files) = (all_files(&old_ref), all_files(&new_ref));
+    let OldAndNew {
+        old_params,
+        new_params,
+        old_files,
+        new_files,
+    } = old_and_new(&town, work.path());
     let textures: usize = new_files
         .iter()
         .filter(|(k, _)| k.starts_with("textures/"))
@@ -270,7 +254,7 @@ fn a_full_disk_loses_nothing() {
         .sum();
 
     let out = work.path().join("out");
-    build_ok(&town, &out, &["--quiet", "--params", &p(&old_params)]);
+    build_ok(&town, &out, &["--quiet", "--params", &old_params]);
     // Room for the textures and about half the tiles.
     let room = textures + tiles / 2;
     let o = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"))
@@ -280,7 +264,7 @@ fn a_full_disk_loses_nothing() {
             "--out",
             out.to_str().unwrap(),
         ])
-        .args(["--quiet", "--force", "--params", &p(&new_params)])
+        .args(["--quiet", "--force", "--params", &new_params])
         .env("EDO_CITY_SIMULATE_DISK_BYTES", room.to_string())
         .output()
         .unwrap();
@@ -324,7 +308,7 @@ fn a_full_disk_loses_nothing() {
     build_ok(
         &town,
         &out,
-        &["--quiet", "--force", "--params", &p(&new_params)],
+        &["--quiet", "--force", "--params", &new_params],
     );
     assert!(all_files(&out) == new_files, "the rerun finishes the job");
 }
