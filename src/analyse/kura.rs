@@ -180,11 +180,24 @@ fn place(
     // The safety net for lots that are not convex: the kura must lie inside the lot, clear of
     // its courtyards.
     let q = f.quad(rect);
-    let poly = Polygon::new(LineString(vec![q[0], q[1], q[2], q[3], q[0]]), vec![]);
-    if !m.outline.contains(&poly) {
+    if !lot_holds(&m.outline, &q) {
         return KuraDecision::NoRoom;
     }
     KuraDecision::Clear(rect)
+}
+
+/// Whether `lot` holds the quad `q`. A convex lot without courtyards holds it when it holds
+/// its four corners strictly inside, a point-in-polygon test each; any other lot (or a corner
+/// on the boundary) takes geo's full DE-9IM `contains`, which gives the same answer at many
+/// times the cost (perf: 5 % of a single-tile run when every kura took it).
+fn lot_holds(lot: &Polygon<f64>, q: &Quad) -> bool {
+    use geo::IsConvex;
+    if lot.interiors().is_empty() && lot.exterior().is_convex() && q.iter().all(|c| lot.contains(c))
+    {
+        return true;
+    }
+    let poly = Polygon::new(LineString(vec![q[0], q[1], q[2], q[3], q[0]]), vec![]);
+    lot.contains(&poly)
 }
 
 /// Area of the overlap of two convex quads (Sutherland-Hodgman of one by the other).
