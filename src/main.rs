@@ -13,6 +13,15 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use edo_city::build::{build, shards, BuildOptions, BuildOutcome, NoProgress, Progress, Selection};
 use edo_city::params::Params;
 
+/// `println!` that returns the error instead of panicking: a reader that stops early
+/// (`edo-city tiles out | head`) closes the pipe, and that is no failure of ours.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout(), $($arg)*)?
+    }};
+}
+
 #[derive(Parser)]
 #[command(
     name = "edo-city",
@@ -182,6 +191,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if closed_pipe(&e) => ExitCode::SUCCESS,
         Err(e) if e.downcast_ref::<Problems>().is_some() => {
             eprintln!("{e}");
             ExitCode::from(1)
@@ -191,6 +201,14 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// Whether `e` is stdout's reader having gone away.
+fn closed_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }
 
 /// A proj string cut to what tells CRSs apart in a table: `tmerc lat_0=36 lon_0=136`.
@@ -211,9 +229,9 @@ fn short_crs(def: &str) -> String {
 }
 
 /// The table `edo-city check` prints.
-fn print_check(r: &edo_city::output::report::Report) {
-    println!("input {}", r.input);
-    println!(
+fn print_check(r: &edo_city::output::report::Report) -> std::io::Result<()> {
+    say!("input {}", r.input);
+    say!(
         "CRS   {}",
         if r.crs.is_empty() {
             "unknown (no .prj)"
@@ -221,12 +239,16 @@ fn print_check(r: &edo_city::output::report::Report) {
             &r.crs
         }
     );
-    println!(
+    say!(
         "\n{:<12} {:>9}  {:<30} {:<28} {:<7} file",
-        "layer", "features", "text encoding", "CRS", "reproj."
+        "layer",
+        "features",
+        "text encoding",
+        "CRS",
+        "reproj."
     );
     for l in &r.layers {
-        println!(
+        say!(
             "{:<12} {:>9}  {:<30} {:<28} {:<7} {}",
             l.role,
             l.features,
@@ -237,7 +259,7 @@ fn print_check(r: &edo_city::output::report::Report) {
         );
     }
     let c = &r.counts;
-    println!(
+    say!(
         "\nlots {} ({}), machiya {}, footprints {} of {}, tiles {}, frontage fallback {}",
         c.lots,
         c.lots_by_use
@@ -252,10 +274,10 @@ fn print_check(r: &edo_city::output::report::Report) {
         c.frontage_fallback
     );
     if c.people + c.trees > 0 {
-        println!("people {}, trees {}", c.people, c.trees);
+        say!("people {}, trees {}", c.people, c.trees);
     }
     for t in &r.tables {
-        println!(
+        say!(
             "table {}: {} rows, {} matched, {} without a lot ({}), {} lots without a row",
             t.file,
             t.rows,
@@ -266,22 +288,23 @@ fn print_check(r: &edo_city::output::report::Report) {
         );
     }
     if r.skipped.is_empty() && r.warnings.is_empty() {
-        println!("\nno problems: every feature would be built");
-        return;
+        say!("\nno problems: every feature would be built");
+        return Ok(());
     }
-    println!("\nproblems:");
+    say!("\nproblems:");
     for w in &r.warnings {
-        println!("  warning: {w}");
+        say!("  warning: {w}");
     }
     for s in r.skipped.iter().take(50) {
-        println!("  skip {} {} ({}): {}", s.layer, s.id, s.file, s.reason);
+        say!("  skip {} {} ({}): {}", s.layer, s.id, s.file, s.reason);
     }
     if r.skipped.len() > 50 {
-        println!(
+        say!(
             "  ... {} more skipped features (--json lists all)",
             r.skipped.len() - 50
         );
     }
+    Ok(())
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -321,7 +344,7 @@ fn run(cli: Cli) -> Result<()> {
             let bars = Bars::new(quiet || !std::io::stderr().is_terminal());
             let outcome = build(&opts, &bars).context("the build did not finish")?;
             if !quiet {
-                print_summary(&opts, &outcome);
+                print_summary(&opts, &outcome)?;
             }
             if timings {
                 let t = &outcome.timings;
@@ -345,7 +368,7 @@ fn run(cli: Cli) -> Result<()> {
                 anyhow::bail!("--lots must be at least 1");
             }
             let s = edo_city::synth::write_town(&dir, lots, seed).map_err(anyhow::Error::msg)?;
-            println!(
+            say!(
                 "wrote {}: {} lots ({} machiya), {} blocks, {} streets",
                 dir.display(),
                 s.lots,
@@ -369,11 +392,11 @@ fn run(cli: Cli) -> Result<()> {
                 edo_city::build::read_and_analyse(&input, &params, &catalog, &NoProgress)?;
             let tiles = shards::list_tiles(&plan, params.tile_size, params.tile_origin);
             if json {
-                println!("{}", serde_json::to_string_pretty(&tiles)?);
+                say!("{}", serde_json::to_string_pretty(&tiles)?);
             } else {
-                println!("tile\tmachiya\tfootprints\txmin\tymin\txmax\tymax");
+                say!("tile\tmachiya\tfootprints\txmin\tymin\txmax\tymax");
                 for t in tiles {
-                    println!(
+                    say!(
                         "{}\t{}\t{}\t{:.3}\t{:.3}\t{:.3}\t{:.3}",
                         t.id,
                         t.machiya,
@@ -399,9 +422,9 @@ fn run(cli: Cli) -> Result<()> {
             };
             let r = edo_city::build::check(&input, &params, templates.as_deref())?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&r)?);
+                say!("{}", serde_json::to_string_pretty(&r)?);
             } else {
-                print_check(&r);
+                print_check(&r)?;
             }
             let problems = r.counts.skipped + r.warnings.len();
             if problems > 0 {
@@ -412,7 +435,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Compare { a, b, json, plan } => {
             let c = edo_city::compare::compare(&a, &b)?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&c)?);
+                say!("{}", serde_json::to_string_pretty(&c)?);
             } else {
                 print!("{}", edo_city::compare::render(&c));
             }
@@ -421,7 +444,7 @@ fn run(cli: Cli) -> Result<()> {
                 edo_city::output::atomic::write_atomic(&path, &png)
                     .with_context(|| format!("cannot write {}", path.display()))?;
                 if !json {
-                    println!("wrote {}", path.display());
+                    say!("wrote {}", path.display());
                 }
             }
             Ok(())
@@ -430,12 +453,12 @@ fn run(cli: Cli) -> Result<()> {
             let png = edo_city::build::draw_plan_of(&out, tile.as_deref())?;
             edo_city::output::atomic::write_atomic(&output, &png)
                 .with_context(|| format!("cannot write {}", output.display()))?;
-            println!("wrote {}", output.display());
+            say!("wrote {}", output.display());
             Ok(())
         }
         Command::Merge { dirs, no_plan } => {
             let report = shards::merge(&dirs, !no_plan)?;
-            println!(
+            say!(
                 "merged into {}: {} tiles, {} machiya, {} footprints, {} skipped",
                 dirs[0].display(),
                 report.counts.tiles,
@@ -461,7 +484,7 @@ fn run(cli: Cli) -> Result<()> {
                 }
                 edo_city::output::atomic::write_atomic(&output, text.as_bytes())
                     .with_context(|| format!("cannot write {}", output.display()))?;
-                println!(
+                say!(
                     "wrote {}: check the guesses, then edo-city build {} --params {} --plan",
                     output.display(),
                     dir.display(),
@@ -505,15 +528,15 @@ fn parse_shard(s: &str) -> Result<(usize, usize), String> {
     Ok((i, n))
 }
 
-fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
+fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<()> {
     let r = &o.report;
     let c = &r.counts;
-    println!(
+    say!(
         "edo-city: built {} into {}",
         opts.input.display(),
         opts.out.display()
     );
-    println!(
+    say!(
         "  lots       {:>7}  ({})",
         c.lots,
         c.lots_by_use
@@ -522,16 +545,18 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    println!(
+    say!(
         "  machiya    {:>7}  (type from data {}, drawn from type_mix {})",
-        c.machiya, c.type_given, c.type_drawn
+        c.machiya,
+        c.type_given,
+        c.type_drawn
     );
     for (t, n) in &c.by_type {
         let share = 100.0 * *n as f64 / c.machiya.max(1) as f64;
-        println!("    {t:<18} {n:>7}  {share:5.1} %");
+        say!("    {t:<18} {n:>7}  {share:5.1} %");
     }
     if c.footprints_read > 0 {
-        println!(
+        say!(
             "  footprints {:>7}  of {} read ({})",
             c.footprints,
             c.footprints_read,
@@ -542,13 +567,13 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
                 .join(", ")
         );
     }
-    println!(
+    say!(
         "  frontage fallback {:>3}  (no vertex pair passed the Fig.4 test)",
         c.frontage_fallback
     );
-    print_table2(r, opts.params.kura.enabled, opts.params.kura.collision);
+    print_table2(r, opts.params.kura.enabled, opts.params.kura.collision)?;
     if c.fence_segments + c.gates > 0 {
-        println!(
+        say!(
             "  fences     {:>7}  segments, {} gates; walls: {}",
             c.fence_segments,
             c.gates,
@@ -559,40 +584,45 @@ fn print_summary(opts: &BuildOptions, o: &BuildOutcome) {
                 .join(", ")
         );
     }
-    print_billboards(r);
-    println!(
+    print_billboards(r)?;
+    say!(
         "  tiles      {:>7}  ({} written now, {:.1} MB)",
         c.tiles,
         o.tiles_written,
         o.bytes_written as f64 / 1e6
     );
     for t in &r.tables {
-        println!(
+        say!(
             "  table {}: {} rows, {} matched, {} rows without a lot, {} lots without a row",
-            t.file, t.rows, t.matched, t.rows_without_feature, t.features_without_row
+            t.file,
+            t.rows,
+            t.matched,
+            t.rows_without_feature,
+            t.features_without_row
         );
     }
     if c.skipped > 0 {
-        println!("  skipped    {:>7}  (details in report.json):", c.skipped);
+        say!("  skipped    {:>7}  (details in report.json):", c.skipped);
         for (reason, n) in &r.skipped_by_reason {
-            println!("    {n:>5}  {reason}");
+            say!("    {n:>5}  {reason}");
         }
     }
     for w in r.warnings.iter().take(10) {
-        println!("  warning: {w}");
+        say!("  warning: {w}");
     }
     if r.warnings.len() > 10 {
-        println!(
+        say!(
             "  ... {} more warnings in report.json",
             r.warnings.len() - 10
         );
     }
-    println!("  in {:.2} s", o.timings.total.as_secs_f64());
+    say!("  in {:.2} s", o.timings.total.as_secs_f64());
+    Ok(())
 }
 
 /// The paper's Table 2 beside this build's figures.
 /// People and trees: how many, from where, and per district when there are districts.
-fn print_billboards(r: &edo_city::output::report::Report) {
+fn print_billboards(r: &edo_city::output::report::Report) -> std::io::Result<()> {
     let c = &r.counts;
     for (name, n, by_district, drawn) in [
         ("people", c.people, &c.people_by_district, "people.per_100m"),
@@ -614,39 +644,45 @@ fn print_billboards(r: &edo_city::output::report::Report) {
         } else {
             String::new()
         };
-        println!("  {name:<10} {n:>7}  ({source}{districts})");
+        say!("  {name:<10} {n:>7}  ({source}{districts})");
     }
+    Ok(())
 }
 
-fn print_table2(r: &edo_city::output::report::Report, enabled: bool, avoid: bool) {
+fn print_table2(
+    r: &edo_city::output::report::Report,
+    enabled: bool,
+    avoid: bool,
+) -> std::io::Result<()> {
     let (t, p) = (&r.table2.all, &r.table2.paper);
     if !enabled {
-        println!("  kura             0  (kura.enabled = false)");
-        return;
+        say!("  kura             0  (kura.enabled = false)");
+        return Ok(());
     }
-    println!(
+    say!(
         "  kura       {:>7}  built ({} avoidance); Table 2:",
         r.counts.kura,
         if avoid { "with" } else { "without" }
     );
-    println!("                          this build          paper (all Kyoto)");
-    println!(
+    say!("                          this build          paper (all Kyoto)");
+    say!(
         "    machiya              {:>7}             {:>7}",
-        t.machiya, p.machiya
+        t.machiya,
+        p.machiya
     );
-    println!(
+    say!(
         "    kura candidates      {:>7}  {:5.1} %",
         t.kura_candidates,
         100.0 * t.kura_candidates as f64 / t.machiya.max(1) as f64
     );
-    println!(
+    say!(
         "    without avoidance    {:>7}  {:5.1} %    {:>7}  {:5.1} %",
         t.kura_without_avoidance,
         100.0 * t.ratio_without,
         p.kura_without_avoidance,
         100.0 * p.ratio_without
     );
-    println!(
+    say!(
         "    with avoidance       {:>7}  {:5.1} %    {:>7}  {:5.1} %   (painting: {} / {} = {:.1} %)",
         t.kura_with_avoidance,
         100.0 * t.ratio_with,
@@ -656,6 +692,7 @@ fn print_table2(r: &edo_city::output::report::Report, enabled: bool, avoid: bool
         p.painting_machiya,
         100.0 * p.painting_ratio
     );
+    Ok(())
 }
 
 /// indicatif bars, one per stage, drawn on stderr only when it is a terminal.
@@ -715,14 +752,14 @@ fn template_command(
     };
     let catalog = edo_city::build::load_catalog(&params, templates.as_deref())?;
     let Some(name) = name else {
-        println!("template\tkind\tkanji\tfile\tparameters");
+        say!("template\tkind\tkanji\tfile\tparameters");
         for t in catalog.templates.values() {
             let kind = if t.is_abstract {
                 format!("{} (abstract)", t.kind.name())
             } else {
                 t.kind.name().to_string()
             };
-            println!(
+            say!(
                 "{}\t{kind}\t{}\t{}\t{}",
                 t.name,
                 t.kanji,
@@ -762,7 +799,7 @@ fn template_command(
         .map_err(anyhow::Error::msg)?;
     let n =
         edo_city::author::write(&alone, output, &params.textures).map_err(anyhow::Error::msg)?;
-    println!(
+    say!(
         "{} ({}) on a {width} x {depth} m lot: {} vertices, {} faces, parts {}",
         t.name,
         t.kind.name(),
@@ -771,10 +808,10 @@ fn template_command(
         alone.parts.join(", ")
     );
     match alone.declared_height {
-        Some(h) => println!("height {:.3} m (declared {h:.3} m)", alone.top),
-        None => println!("height {:.3} m", alone.top),
+        Some(h) => say!("height {:.3} m (declared {h:.3} m)", alone.top),
+        None => say!("height {:.3} m", alone.top),
     }
-    println!(
+    say!(
         "{}; wrote {} with its .mtl and {n} textures in {}",
         if edo_city::author::is_closed(&alone.mesh) {
             "closed shell"

@@ -312,3 +312,28 @@ fn a_full_disk_loses_nothing() {
     );
     assert!(all_files(&out) == new_files, "the rerun finishes the job");
 }
+
+/// A reader that goes away (`edo-city check dir | head -1`) closes stdout's pipe before the
+/// tool has printed: the tool stops printing and exits 0, with no panic.
+#[test]
+fn a_closed_stdout_is_not_a_crash() {
+    for args in [vec!["check"], vec!["tiles"]] {
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"))
+            .args(&args)
+            .arg(fixture("kyoto-small"))
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Closed before the tool has read its input, let alone printed.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(
+            matches!(out.status.code(), Some(0) | Some(1)),
+            "{args:?}: {:?} {stderr}",
+            out.status
+        );
+    }
+}
