@@ -340,7 +340,7 @@ fn run(
         crs_wkt: data.crs_wkt.clone(),
         tile_size: params.tile_size,
         params: params.clone(),
-        input: input_summary(&opts.input, &data, &plan),
+        input: input_summary(&opts.input, opts.templates.as_deref(), &data, &plan),
         tiles: manifest_tiles,
         textures,
     };
@@ -408,7 +408,7 @@ pub fn check(
         crs_wkt: data.crs_wkt.clone(),
         tile_size: params.tile_size,
         params: params.clone(),
-        input: input_summary(input, &data, &plan),
+        input: input_summary(input, templates, &data, &plan),
         tiles,
         textures: Vec::new(),
     };
@@ -420,7 +420,8 @@ pub fn check(
 pub fn draw_plan_of(out: &Path, tile: Option<&str>) -> Result<Vec<u8>, BuildError> {
     let manifest = shards::previous_manifest(out)?;
     let params = &manifest.params;
-    let catalog = load_catalog(params, None)?;
+    let templates = manifest.input.templates.as_ref().map(PathBuf::from);
+    let catalog = load_catalog(params, templates.as_deref())?;
     let input = PathBuf::from(&manifest.input.input);
     let (data, plan, _, _) = read_and_analyse(&input, params, &catalog, &NoProgress)?;
     let bounds = match tile {
@@ -509,9 +510,15 @@ fn kura_view(params: &Params) -> Option<bool> {
 }
 
 /// The input-wide part of the report.
-fn input_summary(input: &Path, data: &Dataset, plan: &Plan) -> report::InputSummary {
+fn input_summary(
+    input: &Path,
+    templates: Option<&Path>,
+    data: &Dataset,
+    plan: &Plan,
+) -> report::InputSummary {
     let mut s = report::InputSummary {
         input: input.display().to_string(),
+        templates: templates.map(|t| t.display().to_string()),
         crs: data.crs.clone(),
         layers: data.layers.clone(),
         lots: data.lots.len(),

@@ -153,6 +153,10 @@ pub struct TileReport {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct InputSummary {
     pub input: String,
+    /// The `--templates` directory of the build, as typed, so that `edo-city plan` can load
+    /// the same types again.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub templates: Option<String>,
     pub crs: String,
     pub layers: Vec<LayerInfo>,
     pub lots: usize,
