@@ -124,17 +124,24 @@ pub fn reproject(coords: &mut [Coord<f64>], src: &Crs, dst: &Crs) -> Result<(), 
 }
 
 /// True when every coordinate could be a longitude/latitude in degrees: used to catch layers
-/// without a `.prj` whose numbers are degrees where metres are expected.
+/// without a `.prj` whose numbers are degrees where metres are expected. A town in degrees
+/// spans well under a degree, so a layer wider than [`DEGREES_SPAN`] is metres near its
+/// CRS's origin (a local survey grid), not degrees.
 pub fn looks_like_degrees(coords: impl IntoIterator<Item = Coord<f64>>) -> bool {
-    let mut any = false;
+    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
     for c in coords {
-        any = true;
         if !(c.x.abs() <= 180.0 && c.y.abs() <= 90.0) {
             return false;
         }
+        lo = [lo[0].min(c.x), lo[1].min(c.y)];
+        hi = [hi[0].max(c.x), hi[1].max(c.y)];
     }
-    any
+    lo[0] <= hi[0] && hi[0] - lo[0] <= DEGREES_SPAN && hi[1] - lo[1] <= DEGREES_SPAN
 }
+
+/// The widest layer taken for degrees: 2 degrees is about 200 km, more than any city; 2 m is
+/// less than any lot.
+pub const DEGREES_SPAN: f64 = 2.0;
 
 #[cfg(test)]
 mod tests {
@@ -187,6 +194,22 @@ mod tests {
             x: -22_000.0,
             y: -110_000.0
         }]));
+        // A local grid in metres near its origin: 80 m wide is not 80 degrees.
+        assert!(!looks_like_degrees([
+            Coord { x: 0.0, y: 0.0 },
+            Coord { x: 80.0, y: 45.0 }
+        ]));
+        assert!(looks_like_degrees([
+            Coord {
+                x: 135.75,
+                y: 34.98
+            },
+            Coord {
+                x: 135.78,
+                y: 35.01
+            }
+        ]));
+        assert!(!looks_like_degrees(Vec::<Coord<f64>>::new()));
     }
 
     #[test]
