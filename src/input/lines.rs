@@ -1,0 +1,142 @@
+//! The line roles: streets (with their widths) and free-standing fence lines.
+
+use geo_types::LineString;
+
+use super::crs::Crs;
+use super::fields::resolve_field;
+use super::geometry::lines_of;
+use super::target::to_target;
+use super::{widths, InputError, Opened};
+use crate::model::{Dataset, FenceLine, Skipped, Street};
+use crate::params::Params;
+
+/// Free-standing fence lines: each part of each polyline, with the feature's attributes.
+pub(super) fn read_fence_lines(
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let fp = &params.layers.fences;
+    let id_field = resolve_field(&fp.id_field, &o.layer.fields, o.layer.text_encoding);
+    for f in &o.layer.features {
+        let lines = lines_of(&f.shape).map_err(|kind| InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "record {} is a {kind}; the fences layer must hold polylines",
+                f.record
+            ),
+        })?;
+        let id = id_field
+            .and_then(|k| f.attrs.get(k))
+            .map(|v| v.trim().to_string())
+            .filter(|v| !v.is_empty())
+            .unwrap_or_else(|| (f.record + 1).to_string());
+        let parts = lines.len();
+        for (k, mut line) in lines.into_iter().enumerate() {
+            let ok = line.0.len() >= 2
+                && line.0.iter().all(|c| c.x.is_finite() && c.y.is_finite())
+                && to_target(o, target, &mut line.0).is_ok();
+            if !ok {
+                data.skipped.push(Skipped {
+                    layer: "fences".into(),
+                    file: o.file.clone(),
+                    id: id.clone(),
+                    reason: "a line with fewer than 2 usable points".into(),
+                });
+                continue;
+            }
+            data.fence_lines.push(FenceLine {
+                id: if parts > 1 {
+                    format!("{id}-{}", k + 1)
+                } else {
+                    id.clone()
+                },
+                record: f.record,
+                line,
+                attrs: f.attrs.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn read_streets(
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    widths: Option<&Opened>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let sp = &params.layers.streets;
+    let width_field = resolve_field(&sp.width_field, &o.layer.fields, o.layer.text_encoding);
+    let mut bad_width = 0usize;
+    let mut streets = Vec::new();
+    for f in &o.layer.features {
+        let lines = lines_of(&f.shape).map_err(|kind| InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "record {} is a {kind}; the streets layer must hold polylines",
+                f.record
+            ),
+        })?;
+        let width = match width_field
+            .and_then(|wf| f.attrs.get(wf))
+            .map(|w| w.parse::<f64>())
+        {
+            Some(Ok(w)) if w.is_finite() && w > 0.0 => w,
+            Some(_) => {
+                bad_width += 1;
+                sp.default_width
+            }
+            None => sp.default_width,
+        };
+        for mut line in lines {
+            if line.0.len() >= 2
+                && line.0.iter().all(|c| c.x.is_finite() && c.y.is_finite())
+                && to_target(o, target, &mut line.0).is_ok()
+            {
+                streets.push(Street {
+                    id: f.record.to_string(),
+                    line,
+                    width,
+                });
+            }
+        }
+    }
+    if bad_width > 0 {
+        data.warnings.push(format!(
+            "{}: {bad_width} street(s) have no usable `{}`; they get the default width {} m",
+            o.file, sp.width_field, sp.default_width
+        ));
+    }
+    if let Some(wl) = widths {
+        let wp = &params.layers.street_widths;
+        let field =
+            wl.required_field(&wp.width_field, "width", "layers.street_widths.width_field")?;
+        let mut lines: Vec<(LineString<f64>, f64)> = Vec::new();
+        for f in &wl.layer.features {
+            let Some(w) = f.attrs.get(&field).and_then(|v| v.parse::<f64>().ok()) else {
+                continue;
+            };
+            if !(w.is_finite() && w > 0.0) {
+                continue;
+            }
+            for mut line in lines_of(&f.shape).unwrap_or_default() {
+                if to_target(wl, target, &mut line.0).is_ok() {
+                    lines.push((line, w));
+                }
+            }
+        }
+        let (pieces, matched) = widths::apply_widths(streets, &lines, wp.max_distance);
+        data.warnings.push(format!(
+            "{}: {matched} of {} street pieces took their width from {}",
+            o.file,
+            pieces.len(),
+            wl.file
+        ));
+        streets = pieces;
+    }
+    data.streets = streets;
+    Ok(())
+}

@@ -1,0 +1,342 @@
+//! The polygon roles: lots and footprints with their attributes joined and checked, every
+//! part of a multipart feature a feature of its own, and districts given to both.
+
+use std::collections::HashSet;
+use std::path::Path;
+
+use super::crs::Crs;
+use super::fields::AttributeRule;
+use super::geometry::{check_polygon, map_polygon, polygons_of};
+use super::target::to_target;
+use super::{join, rule, shp, table, InputError, Opened};
+use crate::model::{Dataset, Footprint, Lot, LotUse, Skipped};
+use crate::params::Params;
+
+pub(super) fn read_lots(
+    dir: &Path,
+    params: &Params,
+    o: &mut Opened,
+    target: &Option<Crs>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let lp = &params.layers.lots;
+    let defaults = Params::default().layers.lots.fields;
+    let id_field = o.required_field(&lp.fields.id, "id", "layers.lots.fields.id")?;
+    let table = table::find_and_read(dir, &lp.table, &lp.sheet, &lp.fields.id)?;
+    // Table columns count as fields of the layer: a user may keep `mtype` only in lots.csv.
+    let columns: Vec<String> = table
+        .iter()
+        .flat_map(|t| t.rows.iter().flat_map(|r| r.1.keys().cloned()))
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let w = &mut data.warnings;
+    let (v, c, x) = (&lp.values, &lp.constants, &columns);
+    let use_rule = rule(o, x, "use", &lp.fields.lot_use, &defaults.lot_use, v, c, w);
+    let mtype_rule = rule(o, x, "mtype", &lp.fields.mtype, &defaults.mtype, v, c, w);
+    let district_rule = rule(
+        o,
+        x,
+        "district",
+        &lp.fields.district,
+        &defaults.district,
+        v,
+        c,
+        w,
+    );
+    let tile_rule = rule(o, x, "tile", &lp.fields.tile, &defaults.tile, v, c, w);
+    let ground_rule = rule(o, x, "ground", &lp.fields.ground, "", v, c, w);
+
+    let mut seen = HashSet::new();
+    let mut lots = Vec::with_capacity(o.layer.features.len());
+    // The features are used up here: their attributes move into the lots.
+    let features = std::mem::take(&mut o.layer.features);
+    let o = &*o;
+    for f in features {
+        let Some((polys, z, base_id)) = record_polygons(o, &f, &id_field, &mut data.skipped)?
+        else {
+            continue;
+        };
+        let parts = checked_parts(
+            o,
+            target,
+            polys,
+            &base_id,
+            f.record,
+            &mut seen,
+            &mut data.skipped,
+        );
+        let count = parts.len();
+        let mut record_attrs = Some(f.attrs);
+        for (part, (id, poly)) in parts.into_iter().enumerate() {
+            // The last part takes the record's attributes; earlier parts get a copy.
+            let mut attrs = if part + 1 == count {
+                record_attrs.take().unwrap_or_default()
+            } else {
+                record_attrs.clone().unwrap_or_default()
+            };
+            attrs.insert("\u{0}base_id".into(), base_id.clone());
+            lots.push(Lot {
+                id,
+                record: f.record,
+                outline: poly,
+                lot_use: LotUse::Machiya,
+                mtype: None,
+                district: None,
+                tile: None,
+                attrs,
+                ground: z.unwrap_or(0.0),
+            });
+        }
+    }
+    if let Some(t) = table {
+        data.joins
+            .push(join(&mut lots, t, "lots", &mut data.skipped));
+    }
+    let mut bad_ground = 0usize;
+    for lot in &mut lots {
+        lot.lot_use = LotUse::parse(&use_rule.value(&lot.attrs).unwrap_or_default());
+        lot.mtype = mtype_rule.value(&lot.attrs);
+        lot.district = district_rule.value(&lot.attrs);
+        lot.tile = tile_rule.value(&lot.attrs);
+        if let Some(raw) = ground_rule.value(&lot.attrs) {
+            match raw.parse::<f64>() {
+                Ok(g) if g.is_finite() => lot.ground = g,
+                _ => bad_ground += 1,
+            }
+        }
+        lot.attrs.remove("\u{0}base_id");
+    }
+    if bad_ground > 0 {
+        data.warnings.push(format!(
+            "{}: {bad_ground} lot(s) have a `{}` that is not a number; they stand on the \
+             lowest Z of their outline, else 0",
+            o.file, lp.fields.ground
+        ));
+    }
+    data.lots = lots;
+    Ok(())
+}
+
+pub(super) fn read_footprints(
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let fp = &params.layers.footprints;
+    let id_field = o.required_field(&fp.fields.id, "id", "layers.footprints.fields.id")?;
+    let (nv, nc) = (Default::default(), Default::default());
+    let w = &mut data.warnings;
+    let mtype = rule(
+        o,
+        &[],
+        "mtype",
+        &fp.fields.mtype,
+        "mtype",
+        &fp.values,
+        &nc,
+        w,
+    );
+    let height = rule(o, &[], "height", &fp.fields.height, "height", &nv, &nc, w);
+    let storeys = rule(
+        o,
+        &[],
+        "storeys",
+        &fp.fields.storeys,
+        "storeys",
+        &nv,
+        &nc,
+        w,
+    );
+    let ground = rule(o, &[], "ground", &fp.fields.ground, "", &nv, &nc, w);
+    let mut seen = HashSet::new();
+    // Values that are there but are not positive numbers: counted per field and reported,
+    // since the default then stands in for the data.
+    let unusable = std::cell::RefCell::new(std::collections::BTreeMap::<String, usize>::new());
+    let number = |r: &AttributeRule, a| {
+        let raw = r.value(a)?;
+        let n = raw
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v > 0.0);
+        if n.is_none() {
+            let field = r.field.clone().unwrap_or_default();
+            *unusable.borrow_mut().entry(field).or_default() += 1;
+        }
+        n
+    };
+    for f in &o.layer.features {
+        let Some((polys, z, base_id)) = record_polygons(o, f, &id_field, &mut data.skipped)? else {
+            continue;
+        };
+        let h = number(&height, &f.attrs)
+            .or_else(|| number(&storeys, &f.attrs).map(|s| s * fp.storey_height + 1.0))
+            .unwrap_or(fp.default_height);
+        let g = ground
+            .value(&f.attrs)
+            .and_then(|v| v.parse::<f64>().ok())
+            .filter(|v| v.is_finite())
+            .or(z)
+            .unwrap_or(0.0);
+        for (id, poly) in checked_parts(
+            o,
+            target,
+            polys,
+            &base_id,
+            f.record,
+            &mut seen,
+            &mut data.skipped,
+        ) {
+            data.footprints.push(Footprint {
+                id,
+                record: f.record,
+                outline: poly,
+                mtype: mtype.value(&f.attrs),
+                district: None,
+                height: h,
+                ground: g,
+            });
+        }
+    }
+    for (field, n) in unusable.into_inner() {
+        data.warnings.push(format!(
+            "{}: {n} footprint(s) have a `{field}` that is not a positive number; their \
+             height came from the next source (height, storeys x storey_height, default_height)",
+            o.file
+        ));
+    }
+    Ok(())
+}
+
+/// Gives every lot and footprint without a district the district holding its centroid.
+pub(super) fn assign_districts(
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    use geo::{BoundingRect, Centroid, Contains};
+    let dp = &params.layers.districts;
+    let field = o.required_field(&dp.id_field, "district id", "layers.districts.id_field")?;
+    let mut polys = Vec::new();
+    for f in &o.layer.features {
+        let (parts, _) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "record {} is a {kind}; the districts layer must hold polygons",
+                f.record
+            ),
+        })?;
+        let id = f.attrs.get(&field).cloned().unwrap_or_default();
+        for mut p in parts {
+            if map_polygon(&mut p, &mut |c| to_target(o, target, c)).is_ok() && !id.is_empty() {
+                if let Some(bb) = p.bounding_rect() {
+                    polys.push((bb, p, id.clone()));
+                }
+            }
+        }
+    }
+    let find = |poly: &geo_types::Polygon<f64>| -> Option<String> {
+        let c = poly.centroid()?;
+        polys
+            .iter()
+            .find(|(bb, p, _)| bb.contains(&c) && p.contains(&c))
+            .map(|(_, _, id)| id.clone())
+    };
+    let mut outside = 0;
+    for lot in data.lots.iter_mut().filter(|l| l.district.is_none()) {
+        lot.district = find(&lot.outline);
+        outside += lot.district.is_none() as usize;
+    }
+    for f in data.footprints.iter_mut().filter(|f| f.district.is_none()) {
+        f.district = find(&f.outline);
+        outside += f.district.is_none() as usize;
+    }
+    if outside > 0 {
+        data.warnings.push(format!(
+            "{}: {outside} lot(s) or footprint(s) lie in no district polygon and have no district",
+            o.file
+        ));
+    }
+    Ok(())
+}
+
+/// A record's polygons, lowest Z and id. A shape that is not a polygon stops the build (the
+/// layer is the wrong one); a record without an id is skipped (`None`).
+type RecordPolygons = (Vec<geo_types::Polygon<f64>>, Option<f64>, String);
+
+pub(super) fn record_polygons(
+    o: &Opened,
+    f: &shp::Feature,
+    id_field: &str,
+    skipped: &mut Vec<Skipped>,
+) -> Result<Option<RecordPolygons>, InputError> {
+    let (polys, z) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
+        file: o.file.clone(),
+        message: match kind {
+            "multipatch" => format!(
+                "record {} is a MultiPatch (3D surfaces); edo-city builds from 2D polygons: \
+                 export the {} as Polygon/PolygonZ",
+                f.record, o.role
+            ),
+            _ => format!(
+                "record {} is a {kind}; the {} layer must hold polygons",
+                f.record, o.role
+            ),
+        },
+    })?;
+    let id = f.attrs.get(id_field).cloned().unwrap_or_default();
+    if id.is_empty() {
+        skipped.push(Skipped {
+            layer: o.role.into(),
+            file: o.file.clone(),
+            id: format!("record {}", f.record),
+            reason: format!("no value in the id field `{id_field}`"),
+        });
+        return Ok(None);
+    }
+    Ok(Some((polys, z, id)))
+}
+
+/// The usable parts of one record's polygons, each with its id: a multipart record becomes one
+/// feature per part, ids suffixed `-<n>` so every id stays unique and traceable to its record.
+/// Each part is reprojected, then checked (the area check is in metres); a bad part or a
+/// repeated id is skipped with the reason.
+pub(super) fn checked_parts(
+    o: &Opened,
+    target: &Option<Crs>,
+    polys: Vec<geo_types::Polygon<f64>>,
+    base_id: &str,
+    record: usize,
+    seen: &mut HashSet<String>,
+    skipped: &mut Vec<Skipped>,
+) -> Vec<(String, geo_types::Polygon<f64>)> {
+    let multi = polys.len() > 1;
+    let mut out = Vec::with_capacity(polys.len());
+    for (part, mut poly) in polys.into_iter().enumerate() {
+        let id = if multi {
+            format!("{base_id}-{}", part + 1)
+        } else {
+            base_id.to_string()
+        };
+        let reason = map_polygon(&mut poly, &mut |c| to_target(o, target, c))
+            .and_then(|_| check_polygon(&poly))
+            .err()
+            .or_else(|| {
+                (!seen.insert(id.clone())).then(|| {
+                    format!("duplicate id: record {record} repeats an earlier feature's id")
+                })
+            });
+        match reason {
+            Some(reason) => skipped.push(Skipped {
+                layer: o.role.into(),
+                file: o.file.clone(),
+                id,
+                reason,
+            }),
+            None => out.push((id, poly)),
+        }
+    }
+    out
+}

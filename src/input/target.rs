@@ -1,0 +1,147 @@
+//! Which CRS the output is in, and what each layer's coordinates are taken to be in: the
+//! parameter file's `crs`, else the lots' own `.prj`, else the UTM zone of their centre; a
+//! layer without a `.prj`, or whose numbers look like degrees under one that says metres, is
+//! assumed with a warning.
+
+use geo_types::Coord;
+
+use super::crs::{self, Crs};
+use super::geometry::{self, lines_of, polygons_of};
+use super::{InputError, Opened};
+use crate::params::Params;
+
+/// Every coordinate of a layer, for choosing a CRS and spotting degrees.
+pub(super) fn layer_coords(o: &Opened) -> Vec<Coord<f64>> {
+    let mut out = Vec::new();
+    for f in &o.layer.features {
+        if let Ok((polys, _)) = polygons_of(&f.shape) {
+            for p in polys {
+                out.extend(p.exterior().0.iter().copied());
+            }
+        } else if let Ok(lines) = lines_of(&f.shape) {
+            for l in lines {
+                out.extend(l.0);
+            }
+        } else if let Ok(points) = geometry::points_of(&f.shape) {
+            out.extend(points);
+        }
+    }
+    out
+}
+
+/// Warns when a layer said to be in projected metres (by its `.prj` or by `crs`) has every
+/// coordinate within +-180 / +-90, as longitude/latitude degrees would be: a town that small
+/// around a CRS's origin is rare, a `.prj` copied from the wrong file is not.
+pub(super) fn degrees_in_metres(o: &Opened, params: &Params, warnings: &mut Vec<String>) {
+    let said = match &o.layer.prj {
+        Some(wkt) => Crs::from_wkt(wkt).ok(),
+        None => Crs::from_user(&params.crs).ok(),
+    };
+    let Some(said) = said.filter(|c| !c.is_geographic()) else {
+        return;
+    };
+    let coords = layer_coords(o);
+    if !coords.is_empty() && crs::looks_like_degrees(coords) {
+        let source = match o.layer.prj {
+            Some(_) => "its .prj".to_string(),
+            None => format!("`crs` = {}", params.crs),
+        };
+        warnings.push(format!(
+            "{}: every coordinate lies within +-180 / +-90, like longitude/latitude in degrees, \
+             but {source} says projected metres ({}); if they are degrees, replace the .prj \
+             with a WGS84 one or remove it",
+            o.file, said.definition
+        ));
+    }
+}
+
+/// Chooses the output CRS and the CRS of every layer, with warnings for what was assumed.
+pub(super) fn resolve_crs(
+    params: &Params,
+    layers: &mut [&mut Opened],
+    warnings: &mut Vec<String>,
+) -> Result<Option<Crs>, InputError> {
+    let mut target = None;
+    if !params.crs.trim().is_empty() {
+        let c = Crs::from_user(&params.crs)
+            .map_err(|m| InputError::Missing(format!("parameter `crs`: {m}")))?;
+        if c.is_geographic() {
+            return Err(InputError::Missing(format!(
+                "parameter `crs` = `{}` is geographic (degrees); the output needs a projected CRS in metres",
+                params.crs
+            )));
+        }
+        target = Some(c);
+    }
+    for o in layers.iter_mut() {
+        if o.layer.prj.is_some() || !params.crs.trim().is_empty() {
+            degrees_in_metres(o, params, warnings);
+        }
+        o.src = match &o.layer.prj {
+            Some(wkt) => Some(Crs::from_wkt(wkt).map_err(|m| InputError::Layer {
+                file: o.file.replace(".shp", ".prj"),
+                message: format!("{m}; fix the .prj or remove it and set `crs`"),
+            })?),
+            None if !params.crs.trim().is_empty() => {
+                warnings.push(format!(
+                    "{}: no .prj; its coordinates are taken to be in `crs` = {}",
+                    o.file, params.crs
+                ));
+                Crs::from_user(&params.crs).ok()
+            }
+            None if crs::looks_like_degrees(layer_coords(o)) => {
+                warnings.push(format!(
+                    "{}: no .prj, and every coordinate looks like longitude/latitude in degrees; \
+                     read as WGS84 degrees (add a .prj or set `crs` if that is wrong)",
+                    o.file
+                ));
+                Crs::from_user("EPSG:4326").ok()
+            }
+            None => {
+                warnings.push(format!(
+                    "{}: no .prj; its coordinates are taken as projected metres in the output CRS",
+                    o.file
+                ));
+                None
+            }
+        };
+    }
+    if target.is_none() {
+        // The first layer (lots, else footprints, streets, blocks) decides.
+        if let Some(o) = layers.first() {
+            target = match &o.src {
+                Some(c) if !c.is_geographic() => {
+                    Crs::from_wkt(o.layer.prj.as_deref().unwrap_or(""))
+                        .ok()
+                        .or_else(|| Crs::from_user(&c.definition).ok())
+                }
+                Some(_) => {
+                    let pts = layer_coords(o);
+                    let n = pts.len().max(1) as f64;
+                    let lon = pts.iter().map(|c| c.x).sum::<f64>() / n;
+                    let lat = pts.iter().map(|c| c.y).sum::<f64>() / n;
+                    let utm = Crs::utm_for(lon, lat);
+                    warnings.push(format!(
+                        "{} is in longitude/latitude; the city is built in {} (set `crs` to choose)",
+                        o.file, utm.definition
+                    ));
+                    Some(utm)
+                }
+                None => None,
+            };
+        }
+    }
+    Ok(target)
+}
+
+/// Reprojects a layer's feature geometry as it is converted.
+pub(super) fn to_target(
+    o: &Opened,
+    target: &Option<Crs>,
+    coords: &mut [Coord<f64>],
+) -> Result<(), String> {
+    match (&o.src, target) {
+        (Some(src), Some(dst)) if o.reproject => crs::reproject(coords, src, dst),
+        _ => Ok(()),
+    }
+}
