@@ -107,12 +107,16 @@ pub fn check_polygon(poly: &Polygon<f64>) -> Result<(), String> {
             .chain(poly.interiors().iter().flat_map(|r| r.0.iter()))
     };
     if all().any(|c| !c.x.is_finite() || !c.y.is_finite()) {
-        return Err("a coordinate is not a finite number".into());
+        return Err(
+            "a coordinate is not a finite number (NaN or infinite): the geometry is damaged; \
+             redraw the feature or export the layer again"
+                .into(),
+        );
     }
     if all().any(|c| !crate::model::sane(*c)) {
         return Err(format!(
             "a coordinate lies {:.0e} m or more from the CRS's origin (the Earth is 4e7 m \
-             round): the geometry is damaged",
+             round): the geometry is damaged; redraw the feature or export the layer again",
             crate::model::FAR
         ));
     }
@@ -123,7 +127,8 @@ pub fn check_polygon(poly: &Polygon<f64>) -> Result<(), String> {
         .collect();
     if distinct.len() < 3 {
         return Err(format!(
-            "the outline has {} distinct vertices; a polygon needs at least 3",
+            "the outline has {} distinct vertices; a polygon needs at least 3: redraw it or \
+             delete it",
             distinct.len()
         ));
     }
@@ -135,7 +140,9 @@ pub fn check_polygon(poly: &Polygon<f64>) -> Result<(), String> {
             ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)).abs() < 1e-6
         });
         return Err(match flat {
-            true => "the outline has no area".into(),
+            true => "the outline has no area (under 1 mm2: its vertices lie on one line, or \
+                     its numbers are not metres); redraw it or delete it"
+                .into(),
             false => "the outline crosses itself and its loops enclose no net area (a bow \
                       tie); redraw it as a simple polygon"
                 .into(),

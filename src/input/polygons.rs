@@ -292,7 +292,7 @@ pub(super) fn record_polygons(
             layer: o.role.into(),
             file: o.file.clone(),
             id: format!("record {}", f.record),
-            reason: format!("no value in the id field `{id_field}`"),
+            reason: format!("no value in the id field `{id_field}`: give the feature an id"),
         });
         return Ok(None);
     }
@@ -325,7 +325,10 @@ pub(super) fn checked_parts(
             .err()
             .or_else(|| {
                 (!seen.insert(id.clone())).then(|| {
-                    format!("duplicate id: record {record} repeats an earlier feature's id")
+                    format!(
+                        "duplicate id: record {record} repeats an earlier feature's id; the \
+                         first was built, give this one an id of its own"
+                    )
                 })
             });
         match reason {
