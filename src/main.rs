@@ -4,13 +4,11 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Duration;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use edo_city::build::{build, shards, BuildOptions, BuildOutcome, NoProgress, Progress, Selection};
+use edo_city::build::{build, shards, BuildOptions, NoProgress, Selection};
 use edo_city::params::Params;
 
 /// `println!` that returns the error instead of panicking: a reader that stops early
@@ -21,6 +19,11 @@ macro_rules! say {
         writeln!(std::io::stdout(), $($arg)*)?
     }};
 }
+
+mod cli;
+
+use cli::progress::Bars;
+use cli::summary::{print_check, print_summary};
 
 #[derive(Parser)]
 #[command(
@@ -209,102 +212,6 @@ fn closed_pipe(e: &anyhow::Error) -> bool {
         c.downcast_ref::<std::io::Error>()
             .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
     })
-}
-
-/// A proj string cut to what tells CRSs apart in a table: `tmerc lat_0=36 lon_0=136`.
-fn short_crs(def: &str) -> String {
-    let keep = [
-        "+proj=", "+zone=", "+south", "+lat_0=", "+lon_0=", "+datum=",
-    ];
-    let parts: Vec<&str> = def
-        .split_whitespace()
-        .filter(|t| keep.iter().any(|k| t.starts_with(k)))
-        .map(|t| t.trim_start_matches("+proj=").trim_start_matches('+'))
-        .collect();
-    if parts.is_empty() {
-        def.to_string()
-    } else {
-        parts.join(" ")
-    }
-}
-
-/// The table `edo-city check` prints.
-fn print_check(r: &edo_city::output::report::Report) -> std::io::Result<()> {
-    say!("input {}", r.input);
-    say!(
-        "CRS   {}",
-        if r.crs.is_empty() {
-            "unknown (no .prj)"
-        } else {
-            &r.crs
-        }
-    );
-    say!(
-        "\n{:<12} {:>9}  {:<30} {:<28} {:<7} file",
-        "layer",
-        "features",
-        "text encoding",
-        "CRS",
-        "reproj."
-    );
-    for l in &r.layers {
-        say!(
-            "{:<12} {:>9}  {:<30} {:<28} {:<7} {}",
-            l.role,
-            l.features,
-            l.encoding,
-            short_crs(&l.crs),
-            if l.reprojected { "yes" } else { "no" },
-            l.file
-        );
-    }
-    let c = &r.counts;
-    say!(
-        "\nlots {} ({}), machiya {}, footprints {} of {}, tiles {}, frontage fallback {}",
-        c.lots,
-        c.lots_by_use
-            .iter()
-            .map(|(k, v)| format!("{k} {v}"))
-            .collect::<Vec<_>>()
-            .join(", "),
-        c.machiya,
-        c.footprints,
-        c.footprints_read,
-        c.tiles,
-        c.frontage_fallback
-    );
-    if c.people + c.trees > 0 {
-        say!("people {}, trees {}", c.people, c.trees);
-    }
-    for t in &r.tables {
-        say!(
-            "table {}: {} rows, {} matched, {} without a lot ({}), {} lots without a row",
-            t.file,
-            t.rows,
-            t.matched,
-            t.rows_without_feature,
-            t.rows_without_feature_ids.join(", "),
-            t.features_without_row
-        );
-    }
-    if r.skipped.is_empty() && r.warnings.is_empty() {
-        say!("\nno problems: every feature would be built");
-        return Ok(());
-    }
-    say!("\nproblems:");
-    for w in &r.warnings {
-        say!("  warning: {w}");
-    }
-    for s in r.skipped.iter().take(50) {
-        say!("  skip {} {} ({}): {}", s.layer, s.id, s.file, s.reason);
-    }
-    if r.skipped.len() > 50 {
-        say!(
-            "  ... {} more skipped features (--json lists all)",
-            r.skipped.len() - 50
-        );
-    }
-    Ok(())
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -526,214 +433,6 @@ fn parse_shard(s: &str) -> Result<(usize, usize), String> {
         return Err(format!("`{s}`: need 1 <= I <= N"));
     }
     Ok((i, n))
-}
-
-fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<()> {
-    let r = &o.report;
-    let c = &r.counts;
-    say!(
-        "edo-city: built {} into {}",
-        opts.input.display(),
-        opts.out.display()
-    );
-    say!(
-        "  lots       {:>7}  ({})",
-        c.lots,
-        c.lots_by_use
-            .iter()
-            .map(|(k, v)| format!("{k} {v}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    say!(
-        "  machiya    {:>7}  (type from data {}, drawn from type_mix {})",
-        c.machiya,
-        c.type_given,
-        c.type_drawn
-    );
-    for (t, n) in &c.by_type {
-        let share = 100.0 * *n as f64 / c.machiya.max(1) as f64;
-        say!("    {t:<18} {n:>7}  {share:5.1} %");
-    }
-    if c.footprints_read > 0 {
-        say!(
-            "  footprints {:>7}  of {} read ({})",
-            c.footprints,
-            c.footprints_read,
-            c.footprints_by_type
-                .iter()
-                .map(|(k, v)| format!("{k} {v}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    say!(
-        "  frontage fallback {:>3}  (no vertex pair passed the Fig.4 test)",
-        c.frontage_fallback
-    );
-    print_table2(r, opts.params.kura.enabled, opts.params.kura.collision)?;
-    if c.fence_segments + c.gates > 0 {
-        say!(
-            "  fences     {:>7}  segments, {} gates; walls: {}",
-            c.fence_segments,
-            c.gates,
-            c.wall_metres
-                .iter()
-                .map(|(t, m)| format!("{t} {m:.0} m"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    print_billboards(r)?;
-    say!(
-        "  tiles      {:>7}  ({} written now, {:.1} MB)",
-        c.tiles,
-        o.tiles_written,
-        o.bytes_written as f64 / 1e6
-    );
-    for t in &r.tables {
-        say!(
-            "  table {}: {} rows, {} matched, {} rows without a lot, {} lots without a row",
-            t.file,
-            t.rows,
-            t.matched,
-            t.rows_without_feature,
-            t.features_without_row
-        );
-    }
-    if c.skipped > 0 {
-        say!("  skipped    {:>7}  (details in report.json):", c.skipped);
-        for (reason, n) in &r.skipped_by_reason {
-            say!("    {n:>5}  {reason}");
-        }
-    }
-    for w in r.warnings.iter().take(10) {
-        say!("  warning: {w}");
-    }
-    if r.warnings.len() > 10 {
-        say!(
-            "  ... {} more warnings in report.json",
-            r.warnings.len() - 10
-        );
-    }
-    say!("  in {:.2} s", o.timings.total.as_secs_f64());
-    Ok(())
-}
-
-/// The paper's Table 2 beside this build's figures.
-/// People and trees: how many, from where, and per district when there are districts.
-fn print_billboards(r: &edo_city::output::report::Report) -> std::io::Result<()> {
-    let c = &r.counts;
-    for (name, n, by_district, drawn) in [
-        ("people", c.people, &c.people_by_district, "people.per_100m"),
-        ("trees", c.trees, &c.trees_by_district, "trees.per_ha"),
-    ] {
-        if n == 0 {
-            continue;
-        }
-        let source = match r.layers.iter().find(|l| l.role == name) {
-            Some(l) => format!("points of {}", l.file),
-            None => format!("drawn at {drawn}"),
-        };
-        let districts = if by_district.keys().any(|d| !d.is_empty()) {
-            let list: Vec<String> = by_district
-                .iter()
-                .map(|(d, n)| format!("{} {n}", if d.is_empty() { "(none)" } else { d }))
-                .collect();
-            format!("; by district: {}", list.join(", "))
-        } else {
-            String::new()
-        };
-        say!("  {name:<10} {n:>7}  ({source}{districts})");
-    }
-    Ok(())
-}
-
-fn print_table2(
-    r: &edo_city::output::report::Report,
-    enabled: bool,
-    avoid: bool,
-) -> std::io::Result<()> {
-    let (t, p) = (&r.table2.all, &r.table2.paper);
-    if !enabled {
-        say!("  kura             0  (kura.enabled = false)");
-        return Ok(());
-    }
-    say!(
-        "  kura       {:>7}  built ({} avoidance); Table 2:",
-        r.counts.kura,
-        if avoid { "with" } else { "without" }
-    );
-    say!("                          this build          paper (all Kyoto)");
-    say!(
-        "    machiya              {:>7}             {:>7}",
-        t.machiya,
-        p.machiya
-    );
-    say!(
-        "    kura candidates      {:>7}  {:5.1} %",
-        t.kura_candidates,
-        100.0 * t.kura_candidates as f64 / t.machiya.max(1) as f64
-    );
-    say!(
-        "    without avoidance    {:>7}  {:5.1} %    {:>7}  {:5.1} %",
-        t.kura_without_avoidance,
-        100.0 * t.ratio_without,
-        p.kura_without_avoidance,
-        100.0 * p.ratio_without
-    );
-    say!(
-        "    with avoidance       {:>7}  {:5.1} %    {:>7}  {:5.1} %   (painting: {} / {} = {:.1} %)",
-        t.kura_with_avoidance,
-        100.0 * t.ratio_with,
-        p.kura_with_avoidance,
-        100.0 * p.ratio_with,
-        p.painting_kura,
-        p.painting_machiya,
-        100.0 * p.painting_ratio
-    );
-    Ok(())
-}
-
-/// indicatif bars, one per stage, drawn on stderr only when it is a terminal.
-struct Bars {
-    bar: ProgressBar,
-}
-
-impl Bars {
-    fn new(hidden: bool) -> Bars {
-        let bar = ProgressBar::new(0);
-        if hidden {
-            bar.set_draw_target(ProgressDrawTarget::hidden());
-        }
-        Bars { bar }
-    }
-}
-
-impl Progress for Bars {
-    fn start(&self, stage: &str, total: u64) {
-        self.bar.reset();
-        self.bar.set_length(total);
-        let style = if total == 0 {
-            ProgressStyle::with_template("{spinner} {msg} {elapsed}")
-        } else {
-            ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} {elapsed} eta {eta}")
-        };
-        if let Ok(s) = style {
-            self.bar.set_style(s.progress_chars("=> "));
-        }
-        self.bar.set_message(stage.to_string());
-        if total == 0 {
-            self.bar.enable_steady_tick(Duration::from_millis(100));
-        }
-    }
-    fn inc(&self, n: u64) {
-        self.bar.inc(n);
-    }
-    fn finish(&self) {
-        self.bar.disable_steady_tick();
-        self.bar.finish_and_clear();
-    }
 }
 
 /// `edo-city template`: list the templates, or build one alone.
