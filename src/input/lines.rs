@@ -20,13 +20,8 @@ pub(super) fn read_fence_lines(
     let fp = &params.layers.fences;
     let id_field = resolve_field(&fp.id_field, &o.layer.fields, o.layer.text_encoding);
     for f in &o.layer.features {
-        let lines = lines_of(&f.shape).map_err(|kind| InputError::Layer {
-            file: o.file.clone(),
-            message: format!(
-                "record {} is a {kind}; the fences layer must hold polylines",
-                f.record
-            ),
-        })?;
+        let lines =
+            lines_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polylines"))?;
         let id = id_field
             .and_then(|k| f.attrs.get(k))
             .map(|v| v.trim().to_string())
@@ -73,13 +68,8 @@ pub(super) fn read_streets(
     let mut bad_width = 0usize;
     let mut streets = Vec::new();
     for f in &o.layer.features {
-        let lines = lines_of(&f.shape).map_err(|kind| InputError::Layer {
-            file: o.file.clone(),
-            message: format!(
-                "record {} is a {kind}; the streets layer must hold polylines",
-                f.record
-            ),
-        })?;
+        let lines =
+            lines_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polylines"))?;
         let width = match width_field
             .and_then(|wf| f.attrs.get(wf))
             .map(|w| w.parse::<f64>())

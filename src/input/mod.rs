@@ -57,6 +57,18 @@ struct Opened {
 }
 
 impl Opened {
+    /// The error for record `record` whose shape is a `kind` where this layer must hold
+    /// `wanted` (polygons, polylines, points).
+    fn wrong_shape(&self, record: usize, kind: &str, wanted: &str) -> InputError {
+        InputError::Layer {
+            file: self.file.clone(),
+            message: format!(
+                "record {record} is a {kind}; the {} layer must hold {wanted}",
+                self.role
+            ),
+        }
+    }
+
     /// The layer's field that `wanted` names (see [`resolve_field`]), or an error listing the
     /// layer's fields and the parameter `key` that sets the name.
     fn required_field(&self, wanted: &str, what: &str, key: &str) -> Result<String, InputError> {
@@ -254,13 +266,8 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
     }
     if let Some(o) = &blocks {
         for f in &o.layer.features {
-            let (polys, _) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
-                file: o.file.clone(),
-                message: format!(
-                    "record {} is a {kind}; the blocks layer must hold polygons",
-                    f.record
-                ),
-            })?;
+            let (polys, _) =
+                polygons_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polygons"))?;
             for mut p in polys {
                 map_polygon(&mut p, &mut |c| to_target(o, &target, c)).map_err(|m| {
                     InputError::Layer {

@@ -27,13 +27,7 @@ pub(super) fn read_points(
     );
     let mut out = Vec::new();
     for f in &o.layer.features {
-        let points = points_of(&f.shape).map_err(|kind| InputError::Layer {
-            file: o.file.clone(),
-            message: format!(
-                "record {} is a {kind}; the {} layer must hold points",
-                f.record, o.role
-            ),
-        })?;
+        let points = points_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "points"))?;
         let value = |k: Option<&str>| {
             k.and_then(|k| f.attrs.get(k))
                 .map(|v| v.trim().to_string())

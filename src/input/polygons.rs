@@ -221,13 +221,8 @@ pub(super) fn assign_districts(
     let field = o.required_field(&dp.id_field, "district id", "layers.districts.id_field")?;
     let mut polys = Vec::new();
     for f in &o.layer.features {
-        let (parts, _) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
-            file: o.file.clone(),
-            message: format!(
-                "record {} is a {kind}; the districts layer must hold polygons",
-                f.record
-            ),
-        })?;
+        let (parts, _) =
+            polygons_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polygons"))?;
         let id = f.attrs.get(&field).cloned().unwrap_or_default();
         for mut p in parts {
             if map_polygon(&mut p, &mut |c| to_target(o, target, c)).is_ok() && !id.is_empty() {
@@ -272,19 +267,16 @@ pub(super) fn record_polygons(
     id_field: &str,
     skipped: &mut Vec<Skipped>,
 ) -> Result<Option<RecordPolygons>, InputError> {
-    let (polys, z) = polygons_of(&f.shape).map_err(|kind| InputError::Layer {
-        file: o.file.clone(),
-        message: match kind {
-            "multipatch" => format!(
+    let (polys, z) = polygons_of(&f.shape).map_err(|kind| match kind {
+        "multipatch" => InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
                 "record {} is a MultiPatch (3D surfaces); edo-city builds from 2D polygons: \
                  export the {} as Polygon/PolygonZ",
                 f.record, o.role
             ),
-            _ => format!(
-                "record {} is a {kind}; the {} layer must hold polygons",
-                f.record, o.role
-            ),
         },
+        _ => o.wrong_shape(f.record, kind, "polygons"),
     })?;
     let id = f.attrs.get(id_field).cloned().unwrap_or_default();
     if id.is_empty() {
