@@ -171,57 +171,37 @@ fn reduce_all(data: &mut Dataset, tol: f64) {
 /// 600 MB tile. It is skipped with the way out instead. Blocks and streets are only looked
 /// up, never built, so they are kept whatever their size.
 fn skip_too_detailed(data: &mut Dataset, max: usize) {
-    let file_of = |data: &Dataset, role: &str| {
+    let file_of = |role: &str| {
         data.layers
             .iter()
             .find(|l| l.role == role)
             .map_or_else(String::new, |l| l.file.clone())
     };
-    let reason = |n: usize| {
-        format!(
-            "{n} vertices after simplification, more than `simplify.max_vertices` ({max}); \
-             simplify the outline in the GIS (QGIS: Vector > Geometry Tools > Simplify) or \
-             raise the limit"
-        )
-    };
+    let files = [file_of("lots"), file_of("footprints"), file_of("fences")];
     let mut skipped = Vec::new();
-    let file = file_of(data, "lots");
-    data.lots.retain(|l| {
-        let n = polygon_vertices(&l.outline);
+    let mut over = |layer: &str, file: &str, id: &str, n: usize| {
         let keep = n <= max;
         if !keep {
-            skipped.push(skip("lots", &file, &l.id, reason(n)));
+            skipped.push(Skipped {
+                layer: layer.into(),
+                file: file.into(),
+                id: id.into(),
+                reason: format!(
+                    "{n} vertices after simplification, more than `simplify.max_vertices` \
+                     ({max}); simplify the outline in the GIS (QGIS: Vector > Geometry Tools > \
+                     Simplify) or raise the limit"
+                ),
+            });
         }
         keep
-    });
-    let file = file_of(data, "footprints");
-    data.footprints.retain(|f| {
-        let n = polygon_vertices(&f.outline);
-        let keep = n <= max;
-        if !keep {
-            skipped.push(skip("footprints", &file, &f.id, reason(n)));
-        }
-        keep
-    });
-    let file = file_of(data, "fences");
-    data.fence_lines.retain(|f| {
-        let n = f.line.0.len();
-        let keep = n <= max;
-        if !keep {
-            skipped.push(skip("fences", &file, &f.id, reason(n)));
-        }
-        keep
-    });
+    };
+    data.lots
+        .retain(|l| over("lots", &files[0], &l.id, polygon_vertices(&l.outline)));
+    data.footprints
+        .retain(|f| over("footprints", &files[1], &f.id, polygon_vertices(&f.outline)));
+    data.fence_lines
+        .retain(|f| over("fences", &files[2], &f.id, f.line.0.len()));
     data.skipped.extend(skipped);
-}
-
-fn skip(layer: &str, file: &str, id: &str, reason: String) -> Skipped {
-    Skipped {
-        layer: layer.into(),
-        file: file.into(),
-        id: id.into(),
-        reason,
-    }
 }
 
 #[cfg(test)]
