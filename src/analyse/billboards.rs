@@ -78,7 +78,7 @@ impl<'a> Surroundings<'a> {
                 .map(|l| segment(l.start, l.end))
                 .collect();
         }
-        segs.retain(|s| s.a.iter().chain(&s.b).all(|x| x.abs() < FAR) && s.a != s.b);
+        segs.retain(|s| sane(s.a.into()) && sane(s.b.into()) && s.a != s.b);
         Surroundings {
             lots: RTree::bulk_load(points),
             info,

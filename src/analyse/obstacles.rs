@@ -13,7 +13,7 @@ use rstar::{RTree, AABB};
 
 use super::kura::{house_end, local_ring, Frame};
 use super::street::segment_distance_2;
-use crate::model::{PlannedFence, PlannedMachiya, FAR};
+use crate::model::{sane, PlannedFence, PlannedMachiya};
 use crate::params::Params;
 use crate::templates::Catalog;
 
@@ -100,7 +100,7 @@ fn envelope(o: &Obstacle) -> Option<Rectangle<[f64; 2]>> {
             [a[0].max(b[0]) + WALL_HALF, a[1].max(b[1]) + WALL_HALF],
         ),
     };
-    (lo.iter().chain(&hi).all(|x| x.abs() < FAR)).then(|| Rectangle::from_corners(lo, hi))
+    (sane(lo.into()) && sane(hi.into())).then(|| Rectangle::from_corners(lo, hi))
 }
 
 fn hits(o: &Obstacle, p: Coord<f64>, clearance: f64) -> bool {
