@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{build_ok, copy_fixture, fixture, load_tile, read_json, synth};
+use common::{build_objects, build_ok, copy_fixture, fixture, read_json, synth};
 use edo_city::model::{BillboardKind, LotUse, Plan, PlannedBillboard};
 use edo_city::params::Params;
 use geo::{BoundingRect, Contains, ConvexHull};
@@ -37,33 +37,26 @@ fn segment_distance(p: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> f64 {
 /// Ground outlines of every building object (machiya_, footprint_, kura_) of a build: the
 /// convex hull of its vertices at its lowest height (synth lots are convex).
 fn building_bases(out: &Path) -> Vec<(String, Polygon<f64>)> {
-    let m = read_json(&out.join("manifest.json"));
-    let origin = [
-        m["origin"][0].as_f64().unwrap(),
-        m["origin"][1].as_f64().unwrap(),
-    ];
     let mut bases = Vec::new();
-    for t in m["tiles"].as_array().unwrap() {
-        for o in load_tile(&out.join(t["obj"]["path"].as_str().unwrap()), origin) {
-            let building = ["machiya_", "footprint_", "kura_"]
-                .iter()
-                .any(|p| o.name.starts_with(p));
-            if !building {
-                continue;
-            }
-            let low = o
-                .vertices
-                .iter()
-                .map(|v| v[2])
-                .fold(f64::INFINITY, f64::min);
-            let base: MultiPoint<f64> = o
-                .vertices
-                .iter()
-                .filter(|v| v[2] < low + 0.01)
-                .map(|v| Point::new(v[0], v[1]))
-                .collect();
-            bases.push((o.name.clone(), base.convex_hull()));
+    for o in build_objects(out) {
+        let building = ["machiya_", "footprint_", "kura_"]
+            .iter()
+            .any(|p| o.name.starts_with(p));
+        if !building {
+            continue;
         }
+        let low = o
+            .vertices
+            .iter()
+            .map(|v| v[2])
+            .fold(f64::INFINITY, f64::min);
+        let base: MultiPoint<f64> = o
+            .vertices
+            .iter()
+            .filter(|v| v[2] < low + 0.01)
+            .map(|v| Point::new(v[0], v[1]))
+            .collect();
+        bases.push((o.name.clone(), base.convex_hull()));
     }
     bases
 }
@@ -378,27 +371,20 @@ fn point_layers_replace_the_generated_billboards() {
         "{skipped:?}"
     );
     // The given heights: the tree's picture is 9.5 m tall, the person 1.25 m.
-    let m = read_json(&out.join("manifest.json"));
-    let origin = [
-        m["origin"][0].as_f64().unwrap(),
-        m["origin"][1].as_f64().unwrap(),
-    ];
     let mut heights = Vec::new();
-    for t in m["tiles"].as_array().unwrap() {
-        for o in load_tile(&out.join(t["obj"]["path"].as_str().unwrap()), origin) {
-            if o.name == "people" || o.name == "trees" {
-                let lo = o
-                    .vertices
-                    .iter()
-                    .map(|v| v[2])
-                    .fold(f64::INFINITY, f64::min);
-                let hi = o
-                    .vertices
-                    .iter()
-                    .map(|v| v[2])
-                    .fold(f64::NEG_INFINITY, f64::max);
-                heights.push((o.name.clone(), ((hi - lo) * 1000.0).round() / 1000.0));
-            }
+    for o in build_objects(&out) {
+        if o.name == "people" || o.name == "trees" {
+            let lo = o
+                .vertices
+                .iter()
+                .map(|v| v[2])
+                .fold(f64::INFINITY, f64::min);
+            let hi = o
+                .vertices
+                .iter()
+                .map(|v| v[2])
+                .fold(f64::NEG_INFINITY, f64::max);
+            heights.push((o.name.clone(), ((hi - lo) * 1000.0).round() / 1000.0));
         }
     }
     heights.sort_by(|a, b| a.0.cmp(&b.0));

@@ -5,7 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{build_ok, distance_to_lot, edo_city, load_tile, read_json, synth};
+use common::{build_objects, build_ok, distance_to_lot, edo_city, read_json, synth};
 use edo_city::synth::{write_blocks, write_lots, SynthLot};
 use geo_types::{Coord, LineString, Polygon};
 
@@ -48,17 +48,10 @@ fn polygon(ring: &[[f64; 2]]) -> Polygon<f64> {
 
 /// kura_<id> objects of a build and their vertices (map metres).
 fn kura_objects(out: &Path) -> Vec<(String, Vec<[f64; 3]>)> {
-    let m = read_json(&out.join("manifest.json"));
-    let origin = [
-        m["origin"][0].as_f64().unwrap(),
-        m["origin"][1].as_f64().unwrap(),
-    ];
     let mut out_objects = Vec::new();
-    for t in m["tiles"].as_array().unwrap() {
-        for o in load_tile(&out.join(t["obj"]["path"].as_str().unwrap()), origin) {
-            if let Some(id) = o.name.strip_prefix("kura_") {
-                out_objects.push((id.to_string(), o.vertices));
-            }
+    for o in build_objects(out) {
+        if let Some(id) = o.name.strip_prefix("kura_") {
+            out_objects.push((id.to_string(), o.vertices));
         }
     }
     out_objects

@@ -114,6 +114,21 @@ pub struct ObjObject {
     pub materials: Vec<String>,
 }
 
+/// Every object of every tile a build in `out` wrote (through [`load_tile`]), in map metres.
+pub fn build_objects(out: &Path) -> Vec<ObjObject> {
+    let m = read_json(&out.join("manifest.json"));
+    let origin = [
+        m["origin"][0].as_f64().unwrap(),
+        m["origin"][1].as_f64().unwrap(),
+    ];
+    m["tiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|t| load_tile(&out.join(t["obj"]["path"].as_str().unwrap()), origin))
+        .collect()
+}
+
 /// Loads a tile with tobj, checks indices, UVs, materials and textures; returns its objects.
 pub fn load_tile(obj: &Path, origin: [f64; 2]) -> Vec<ObjObject> {
     let opts = tobj::LoadOptions {
