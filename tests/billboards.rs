@@ -7,10 +7,11 @@ mod common;
 use std::path::Path;
 
 use common::{build_objects, build_ok, copy_fixture, fixture, read_json, synth};
+use edo_city::analyse::street::segment_distance_2;
 use edo_city::model::{BillboardKind, LotUse, Plan, PlannedBillboard};
 use edo_city::params::Params;
 use geo::{BoundingRect, Contains, ConvexHull};
-use geo_types::{Coord, MultiPoint, Point, Polygon};
+use geo_types::{MultiPoint, Point, Polygon};
 
 fn plan_of(dir: &Path, params: &Params) -> (edo_city::model::Dataset, Plan) {
     let data = edo_city::input::read_dataset(dir, params).expect("reads");
@@ -25,13 +26,6 @@ fn billboards(plan: &Plan, kind: BillboardKind) -> Vec<&PlannedBillboard> {
         .flatten()
         .filter(|b| b.kind == kind)
         .collect()
-}
-
-fn segment_distance(p: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> f64 {
-    let d = b - a;
-    let t = (((p - a).x * d.x + (p - a).y * d.y) / (d.x * d.x + d.y * d.y)).clamp(0.0, 1.0);
-    let q = a + d * t;
-    (p.x - q.x).hypot(p.y - q.y)
 }
 
 /// Ground outlines of every building object (machiya_, footprint_, kura_) of a build: the
@@ -80,7 +74,8 @@ fn people_stand_in_the_streets_facing_along_them_and_no_billboard_stands_in_a_bu
             .iter()
             .flat_map(|s| s.line.lines().map(move |l| (s, l)))
             .map(|(s, l)| {
-                let d = segment_distance(p.at, l.start, l.end) - s.width / 2.0;
+                let d = segment_distance_2(p.at.into(), l.start.into(), l.end.into()).sqrt()
+                    - s.width / 2.0;
                 (d, (l.end.y - l.start.y).atan2(l.end.x - l.start.x))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0))
