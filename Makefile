@@ -48,7 +48,7 @@ bad-input:
 
 ## Regenerate the example data (lots.csv is written by hand on top of it).
 fixtures:
-	$(CARGO) run --release -- synth fixtures/kyoto-small --lots 400 --seed 9
+	$(CARGO) run --release -- synth fixtures/kyoto-small --lots 400 --seed 9 --force
 
 clean:
 	rm -rf out target

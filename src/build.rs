@@ -208,9 +208,20 @@ pub fn read_and_analyse(
     Ok((data, plan, read, t.elapsed()))
 }
 
+/// The most shards a city may be split into (`--shard I/N`).
+pub const MAX_SHARDS: usize = 10_000;
+/// The most worker threads a build starts (`-j`).
+pub const MAX_THREADS: usize = 1024;
+
 /// Runs the pipeline.
 pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcome, BuildError> {
     let t0 = Instant::now();
+    if opts.threads > MAX_THREADS {
+        return Err(BuildError::Config(format!(
+            "-j {}: at most {MAX_THREADS} worker threads (0 = one per core, which is fastest)",
+            opts.threads
+        )));
+    }
     let catalog = load_catalog(&opts.params, opts.templates.as_deref())?;
     let textures = output::texture_library(&opts.params.textures).map_err(BuildError::Config)?;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -249,8 +260,40 @@ fn run(
     timings.analyse = analysed;
     timings.kura = plan.kura_time;
     timings.billboards = plan.billboards_time;
-    // After reading (a mistyped input is reported as that), before writing anything.
-    shards::check_out_dir(opts)?;
+    // After reading (a mistyped input is reported as that), before writing anything: one
+    // run at a time in the directory, and never a second hypothesis in it.
+    let existed = opts.out.exists();
+    std::fs::create_dir_all(&opts.out).map_err(|e| write_err(&opts.out, e))?;
+    let lock = output::lock::OutLock::acquire(&opts.out).map_err(|e| {
+        BuildError::Config(e.to_string())
+    })?;
+    let written = shards::check_out_dir(opts)
+        .and_then(|()| shards::refuse_empty(opts, &plan))
+        .and_then(|()| write_city(opts, catalog, texture_set, progress, data, plan, timings, t0));
+    drop(lock);
+    if written.is_err() && !existed {
+        // Leave no directory behind that the user did not have before (only empty ones go).
+        for dir in [opts.out.join("tiles"), opts.out.join("textures"), opts.out.clone()] {
+            let _ = std::fs::remove_dir(dir);
+        }
+    }
+    written
+}
+
+/// Generates and writes the tiles, the plan, the manifest and the report of an analysed city
+/// into a locked output directory.
+#[allow(clippy::too_many_arguments)]
+fn write_city(
+    opts: &BuildOptions,
+    catalog: &Catalog,
+    texture_set: &[output::Texture],
+    progress: &dyn Progress,
+    data: Dataset,
+    plan: Plan,
+    mut timings: Timings,
+    t0: Instant,
+) -> Result<BuildOutcome, BuildError> {
+    let params = &opts.params;
 
     let t = Instant::now();
     let selected = shards::select(&plan, &opts.selection)?;
@@ -421,7 +464,11 @@ pub fn check(
 /// Draws the plan of an earlier build (its manifest names the input and the parameters);
 /// with `tile`, only that tile at full resolution.
 pub fn draw_plan_of(out: &Path, tile: Option<&str>) -> Result<Vec<u8>, BuildError> {
-    let manifest = shards::previous_manifest(out)?;
+    draw_plan_from(&shards::previous_manifest(out)?, tile)
+}
+
+/// Draws the plan of the build a manifest describes (see [`draw_plan_of`]).
+pub fn draw_plan_from(manifest: &report::Manifest, tile: Option<&str>) -> Result<Vec<u8>, BuildError> {
     let params = &manifest.params;
     let templates = manifest.input.templates.as_ref().map(PathBuf::from);
     let catalog = load_catalog(params, templates.as_deref())?;
@@ -512,6 +559,14 @@ fn kura_view(params: &Params) -> Option<bool> {
     params.kura.enabled.then_some(params.kura.collision)
 }
 
+/// `path` made absolute, so that a manifest names its input wherever `merge`, `plan` or a
+/// later `--tiles` run is started from.
+pub fn absolute(path: &Path) -> PathBuf {
+    std::fs::canonicalize(path)
+        .or_else(|_| std::path::absolute(path))
+        .unwrap_or_else(|_| path.to_path_buf())
+}
+
 /// The input-wide part of the report.
 fn input_summary(
     input: &Path,
@@ -520,7 +575,7 @@ fn input_summary(
     plan: &Plan,
 ) -> report::InputSummary {
     let mut s = report::InputSummary {
-        input: input.display().to_string(),
+        input: absolute(input).display().to_string(),
         templates: templates.map(|t| t.display().to_string()),
         crs: data.crs.clone(),
         layers: data.layers.clone(),
@@ -539,5 +594,13 @@ fn input_summary(
     }
     s.skipped.extend(plan.skipped.iter().cloned());
     s.warnings.extend(plan.warnings.iter().cloned());
+    s.ledgers = output::accounting::ledgers(data);
+    // A skip that names only its feature gets its record, so the ledger closes after the
+    // manifest's round trip too (`--tiles`, `merge`).
+    for skip in s.skipped.iter_mut().filter(|k| k.record.is_none()) {
+        if let Some(l) = s.ledgers.iter().find(|l| l.role == skip.layer && l.file == skip.file) {
+            skip.record = l.ids.get(&skip.id).copied();
+        }
+    }
     s
 }

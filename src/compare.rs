@@ -49,6 +49,24 @@ pub struct Comparison {
     /// The paper's Table 2 for both builds.
     pub table2: Vec<Row>,
     pub tiles: TileDiff,
+    /// Why the two builds' tiles are not the same places (another tile size, tile origin or
+    /// CRS), when they are not: then a tile id names other ground in each.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grids_differ: Option<String>,
+}
+
+/// Why two builds' tile grids differ, if they do.
+fn grids_differ(a: &Manifest, b: &Manifest) -> Option<String> {
+    if a.params.tile_size != b.params.tile_size {
+        return Some(format!(
+            "the builds have other tile sizes ({} and {} m)",
+            a.params.tile_size, b.params.tile_size
+        ));
+    }
+    if a.params.tile_origin != b.params.tile_origin {
+        return Some("the builds have other tile origins".into());
+    }
+    (a.crs != b.crs).then(|| "the builds are in other CRSs".into())
 }
 
 /// Leaf values of a JSON value by dotted key.
@@ -191,6 +209,7 @@ pub fn compare(dir_a: &Path, dir_b: &Path) -> Result<Comparison, BuildError> {
             .collect()
         },
         tiles,
+        grids_differ: grids_differ(&ma, &mb),
     })
 }
 
@@ -234,14 +253,31 @@ pub fn render(c: &Comparison) -> String {
         list(&t.only_a),
         list(&t.only_b)
     );
+    if let Some(why) = &c.grids_differ {
+        let _ = writeln!(
+            s,
+            "note: {why}: a tile id names other ground in each, so the tile lines compare \
+             files, not places"
+        );
+    }
     s
 }
+
+/// The widest difference map, in tiles a side (8 pixels each at most: 12,000 pixels).
+const MAX_MAP_CELLS: i64 = 1500;
 
 /// A map of the tile grid: unchanged tiles grey, changed orange, only in A blue, only in B
 /// green, with their ids. Tiles named in the data (not `col_row`) are left out.
 pub fn difference_map(c: &Comparison, dir_a: &Path) -> Result<Vec<u8>, BuildError> {
     let m = shards::previous_manifest(dir_a)?;
     let (size, origin) = (m.params.tile_size, m.params.tile_origin);
+    // One grid for both builds, or the map would draw tiles of two grids as one.
+    if let Some(why) = &c.grids_differ {
+        return Err(BuildError::Config(format!(
+            "no difference map: {why}, so their tiles are not the same places; compare the \
+             counts (without --plan), or build both with one grid"
+        )));
+    }
     let mut cells: Vec<(i64, i64, &String, [u8; 3])> = Vec::new();
     let same: Vec<String> = m
         .tiles
@@ -272,7 +308,15 @@ pub fn difference_map(c: &Comparison, dir_a: &Path) -> Result<Vec<u8>, BuildErro
         cells.iter().map(|x| x.1).min().unwrap_or(0),
         cells.iter().map(|x| x.1).max().unwrap_or(0),
     );
-    let cell = (1200 / ((c1 - c0 + 1).max(r1 - r0 + 1)) as u32).clamp(8, 200);
+    let (cols, rows) = (c1 - c0 + 1, r1 - r0 + 1);
+    if cols.max(rows) > MAX_MAP_CELLS {
+        return Err(BuildError::Config(format!(
+            "no difference map: the tiles span {cols} x {rows} cells of the grid, more than \
+             {MAX_MAP_CELLS} a side (tiles far apart, or ids given in the data); compare the \
+             counts (without --plan)"
+        )));
+    }
+    let cell = (1200 / (cols.max(rows)) as u32).clamp(8, 200);
     let (w, h) = (
         ((c1 - c0 + 1) as u32) * cell,
         ((r1 - r0 + 1) as u32) * cell + 40,

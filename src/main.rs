@@ -138,6 +138,10 @@ enum Command {
         /// Seed of the town's layout.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Write into a directory that already holds files (files of the same names are
+        /// replaced; the others stay, and a lots.csv there is joined by `build`).
+        #[arg(long)]
+        force: bool,
     },
     /// Print the default parameter file (documented key by key).
     Params,
@@ -270,11 +274,14 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Synth { dir, lots, seed } => {
-            if lots == 0 {
-                anyhow::bail!("--lots must be at least 1");
-            }
-            let s = edo_city::synth::write_town(&dir, lots, seed).map_err(anyhow::Error::msg)?;
+        Command::Synth {
+            dir,
+            lots,
+            seed,
+            force,
+        } => {
+            let s = edo_city::synth::write_town(&dir, lots, seed, force)
+                .map_err(anyhow::Error::msg)?;
             say!(
                 "wrote {}: {} lots ({} machiya), {} blocks, {} streets",
                 dir.display(),
@@ -429,8 +436,9 @@ fn parse_shard(s: &str) -> Result<(usize, usize), String> {
             .parse()
             .map_err(|_| format!("`{n}` is not a number"))?,
     );
-    if n == 0 || i == 0 || i > n {
-        return Err(format!("`{s}`: need 1 <= I <= N"));
+    let max = edo_city::build::MAX_SHARDS;
+    if n == 0 || i == 0 || i > n || n > max {
+        return Err(format!("`{s}`: need 1 <= I <= N <= {max}"));
     }
     Ok((i, n))
 }

@@ -149,6 +149,10 @@ pub struct Skipped {
     pub layer: String,
     pub file: String,
     pub id: String,
+    /// The record number in the file (from 0, as the FID of QGIS and ArcGIS), where the
+    /// feature came from one. Kept apart from `reason` so skips group by their cause.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub record: Option<usize>,
     pub reason: String,
 }
 
@@ -176,6 +180,10 @@ pub struct Dataset {
     pub skipped: Vec<Skipped>,
     pub warnings: Vec<String>,
     pub joins: Vec<TableJoin>,
+    /// For the layers whose features keep no record number (blocks, streets, districts,
+    /// street widths): the records that gave at least one usable feature, by role. The
+    /// report's ledger checks every other record was skipped with a reason.
+    pub records: BTreeMap<String, std::collections::BTreeSet<usize>>,
 }
 
 /// How an attribute table matched its layer.

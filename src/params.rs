@@ -408,26 +408,45 @@ impl Params {
             message,
         };
         let k = &self.kura;
-        let positive = [
-            ("fence.gate_width", self.fence.gate_width),
-            ("kura.width", k.width),
-            ("kura.depth", k.depth),
-            ("kura.min_width", k.min_width),
-            ("kura.min_depth", k.min_depth),
-            ("tile_size", self.tile_size),
-            ("frontage.min_length", self.frontage.min_length),
-            ("machiya.depth", self.machiya.depth),
+        let fp = &self.layers.footprints;
+        // Every number a user sets, with the range it must lie in: (key, value, low, high),
+        // low exclusive where 0 itself is meaningless (a size), inclusive where 0 switches a
+        // thing off. The upper bounds are far past any city and keep a typo (1e9 for 1.9)
+        // from allocating the machine away.
+        let sizes = [
+            ("fence.gate_width", self.fence.gate_width, 100.0),
+            ("kura.width", k.width, 100.0),
+            ("kura.depth", k.depth, 100.0),
+            ("kura.min_width", k.min_width, 100.0),
+            ("kura.min_depth", k.min_depth, 100.0),
+            ("tile_size", self.tile_size, 1e6),
+            ("frontage.min_length", self.frontage.min_length, 1000.0),
+            ("machiya.depth", self.machiya.depth, 1000.0),
             (
                 "layers.streets.default_width",
                 self.layers.streets.default_width,
+                crate::input::MAX_STREET_WIDTH,
+            ),
+            ("layers.footprints.storey_height", fp.storey_height, 100.0),
+            ("layers.footprints.default_height", fp.default_height, 1000.0),
+            (
+                "layers.street_widths.max_distance",
+                self.layers.street_widths.max_distance,
+                1e5,
             ),
         ];
-        for (key, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
+        for (key, value, high) in sizes {
+            if !(value.is_finite() && value > 0.0 && value <= high) {
                 return Err(bad(format!(
-                    "`{key}` must be a positive number, got {value}"
+                    "`{key}` must be a positive number up to {high}, got {value}"
                 )));
             }
+        }
+        if self.tile_size < 1.0 {
+            return Err(bad(format!(
+                "`tile_size` must be at least 1 (metres), got {}",
+                self.tile_size
+            )));
         }
         for (key, value) in [
             ("kura.min_frontage", k.min_frontage),
@@ -437,10 +456,34 @@ impl Params {
             ("kura.side_margin", k.side_margin),
             ("kura.overlap_tolerance", k.overlap_tolerance),
             ("simplify.tolerance", self.simplify.tolerance),
+            ("machiya.min_depth", self.machiya.min_depth),
         ] {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(bad(format!("`{key}` must be 0 or more, got {value}")));
+            if !(value.is_finite() && (0.0..=1000.0).contains(&value)) {
+                return Err(bad(format!(
+                    "`{key}` must be a number from 0 to 1000, got {value}"
+                )));
             }
+        }
+        // Points of the plane: finite, and nearer the CRS's origin than damaged data lies.
+        let far = crate::model::FAR;
+        for (key, point) in [
+            ("tile_origin", Some(self.tile_origin)),
+            ("origin", self.origin),
+        ] {
+            if let Some([x, y]) = point {
+                if !(x.is_finite() && y.is_finite() && x.abs() < far && y.abs() < far) {
+                    return Err(bad(format!(
+                        "`{key}` must be two finite numbers within {far:e} m of the CRS's \
+                         origin, got [{x}, {y}]"
+                    )));
+                }
+            }
+        }
+        if self.simplify.max_vertices == 0 || self.simplify.max_vertices > 100_000_000 {
+            return Err(bad(format!(
+                "`simplify.max_vertices` must be from 1 to 100000000, got {}",
+                self.simplify.max_vertices
+            )));
         }
         if k.min_width > k.width || k.min_depth > k.depth {
             return Err(bad(
@@ -448,29 +491,11 @@ impl Params {
                     .into(),
             ));
         }
-        if !(self.machiya.min_depth.is_finite() && self.machiya.min_depth >= 0.0) {
-            return Err(bad("`machiya.min_depth` must be 0 or more".into()));
-        }
         let angle = self.frontage.max_angle_deg;
         if !(angle > 0.0 && angle <= 180.0) {
             return Err(bad(format!(
                 "`frontage.max_angle_deg` must be in (0, 180], got {angle}"
             )));
-        }
-        let fp = &self.layers.footprints;
-        for (key, value) in [
-            ("layers.footprints.storey_height", fp.storey_height),
-            ("layers.footprints.default_height", fp.default_height),
-            (
-                "layers.street_widths.max_distance",
-                self.layers.street_widths.max_distance,
-            ),
-        ] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(bad(format!(
-                    "`{key}` must be a positive number, got {value}"
-                )));
-            }
         }
         for key in self
             .layers
@@ -490,8 +515,11 @@ impl Params {
                 return Err(bad(format!("`{key}` lists no machiya type")));
             }
             for (name, w) in mix {
-                if !(w.is_finite() && *w >= 0.0) {
-                    return Err(bad(format!("`{key}.{name}` must be 0 or more, got {w}")));
+                // Bounded so that the sum of the weights stays finite.
+                if !(w.is_finite() && (0.0..=1e9).contains(w)) {
+                    return Err(bad(format!(
+                        "`{key}.{name}` must be a weight from 0 to 1e9, got {w}"
+                    )));
                 }
             }
             if mix.values().sum::<f64>() <= 0.0 {
@@ -504,14 +532,18 @@ impl Params {
             if let Some(mix) = &d.type_mix {
                 check_mix(&format!("district.{id}.type_mix"), mix)?;
             }
-            for (key, v) in [
-                ("people_per_100m", d.people_per_100m),
-                ("trees_per_ha", d.trees_per_ha),
-                ("trees_per_ha_machiya", d.trees_per_ha_machiya),
+            for (key, v, high) in [
+                ("people_per_100m", d.people_per_100m, billboards::MAX_PER_100M),
+                ("trees_per_ha", d.trees_per_ha, billboards::MAX_PER_HA),
+                (
+                    "trees_per_ha_machiya",
+                    d.trees_per_ha_machiya,
+                    billboards::MAX_PER_HA,
+                ),
             ] {
-                if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+                if let Some(v) = v.filter(|v| !(v.is_finite() && (0.0..=high).contains(v))) {
                     return Err(bad(format!(
-                        "`district.{id}.{key}` must be 0 or more, got {v}"
+                        "`district.{id}.{key}` must be from 0 to {high}, got {v}"
                     )));
                 }
             }

@@ -265,7 +265,39 @@ fn block_lots(
 }
 
 /// Writes `lots.shp`, `blocks.shp`, `streets.shp` (with `.cpg` and `.prj`) into `dir`.
-pub fn write_town(dir: &Path, lots_wanted: usize, seed: u64) -> Result<SynthSummary, String> {
+/// The largest town `synth` makes (ten times the largest benchmark).
+pub const MAX_LOTS: usize = 10_000_000;
+
+/// Writes a town of `lots_wanted` lots into `dir`. A directory that already holds files is
+/// refused unless `force`: synth would overwrite a user's shapefiles, and a `lots.csv` left
+/// there would be joined onto the synthetic lots.
+pub fn write_town(
+    dir: &Path,
+    lots_wanted: usize,
+    seed: u64,
+    force: bool,
+) -> Result<SynthSummary, String> {
+    if lots_wanted == 0 || lots_wanted > MAX_LOTS {
+        return Err(format!(
+            "--lots must be from 1 to {MAX_LOTS}, got {lots_wanted}"
+        ));
+    }
+    if !force {
+        if let Ok(mut entries) = std::fs::read_dir(dir) {
+            if let Some(e) = entries.next() {
+                let name = e.map(|e| e.file_name().to_string_lossy().into_owned());
+                return Err(format!(
+                    "{} is not empty (it holds {}): synth would overwrite its files, and a \
+                     lots.csv there would be joined onto the synthetic lots; give an empty or \
+                     new directory, or --force",
+                    dir.display(),
+                    name.unwrap_or_default()
+                ));
+            }
+        } else if dir.exists() {
+            return Err(format!("{} is not a directory", dir.display()));
+        }
+    }
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let Town {
         lots,
@@ -287,7 +319,27 @@ fn shp_err(path: &Path) -> impl Fn(shapefile::Error) -> String + '_ {
     move |e| format!("cannot write {}: {e}", path.display())
 }
 
+/// The date written into every DBF header we make (bytes 1-3: years since 1900, month, day).
+/// The dbase crate stamps the day of writing; a fixed date makes the same town the same bytes
+/// on any day (the committed fixtures and the corpus of broken inputs are compared byte for
+/// byte with what their scripts make).
+pub const DBF_DATE: [u8; 3] = [100, 1, 1];
+
+/// Overwrites the last-update date of the DBF at `path` with [`DBF_DATE`]. A file too short
+/// to hold a header is left as it is.
+pub fn stamp_dbf_date(path: &Path) -> std::io::Result<()> {
+    use std::io::{Seek, SeekFrom, Write};
+    let mut f = std::fs::OpenOptions::new().write(true).open(path)?;
+    if f.metadata()?.len() >= 32 {
+        f.seek(SeekFrom::Start(1))?;
+        f.write_all(&DBF_DATE)?;
+    }
+    Ok(())
+}
+
 fn sidecars(path: &Path, cpg: &str) -> Result<(), String> {
+    let dbf = path.with_extension("dbf");
+    stamp_dbf_date(&dbf).map_err(|e| format!("cannot write {}: {e}", dbf.display()))?;
     let w = |ext: &str, text: &str| {
         std::fs::write(path.with_extension(ext), text)
             .map_err(|e| format!("cannot write {}: {e}", path.with_extension(ext).display()))

@@ -251,7 +251,7 @@ fn a_density_beyond_the_tile_cap_is_capped_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
     let crowd = params_file(
         dir.path(),
-        "[people]\nper_100m = 100000.0\nmin_spacing = 0.0\nmax_points_per_tile = 40\n",
+        "[people]\nper_100m = 1000.0\nmin_spacing = 0.0\nmax_points_per_tile = 40\n",
     );
     let out = dir.path().join("out");
     let r = build_ok(

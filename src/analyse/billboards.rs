@@ -548,6 +548,7 @@ fn from_points(
                 layer: k.layer.into(),
                 file: k.file.into(),
                 id: f.id.clone(),
+                record: Some(f.record),
                 reason: format!("the point lies {FAR} m or more from the CRS's origin"),
             });
             continue;
@@ -557,6 +558,7 @@ fn from_points(
                 layer: k.layer.into(),
                 file: k.file.into(),
                 id: f.id.clone(),
+                record: Some(f.record),
                 reason: "the point lies inside a building, kura or fence".into(),
             });
             continue;

@@ -154,6 +154,7 @@ fn plan_lot(
             layer: "lots".into(),
             file: lots_file.to_string(),
             id: lot.id.clone(),
+            record: Some(lot.record),
             reason,
         })
     };
@@ -277,6 +278,7 @@ fn plan_footprint(
             layer: "footprints".into(),
             file: fp.file.clone(),
             id: f.id.clone(),
+            record: Some(f.record),
             reason: "the outline has no centroid".into(),
         });
     };

@@ -71,10 +71,14 @@ fn first_difference(a: &serde_json::Value, b: &serde_json::Value, path: &str) ->
 
 /// Refuses to write into a directory built from another input or other parameters.
 pub fn check_out_dir(opts: &BuildOptions) -> Result<(), BuildError> {
-    if opts.force {
+    // `--tiles` keeps the earlier build's other tiles: with other parameters the manifest
+    // would stamp them on tiles they did not make, so `--force` does not cover it.
+    let tiles = matches!(opts.selection, Selection::Tiles(_));
+    if opts.force && !tiles {
         return Ok(());
     }
     let current = serde_json::to_value(&opts.params).expect("parameters serialise");
+    let input = super::absolute(&opts.input);
     for path in manifests_in(&opts.out) {
         let Ok(bytes) = std::fs::read(&path) else {
             continue;
@@ -84,20 +88,45 @@ pub fn check_out_dir(opts: &BuildOptions) -> Result<(), BuildError> {
             .map(|k| format!("the parameter `{k}` differs"))
             .or_else(|| {
                 let old_input = old["input"]["input"].as_str().unwrap_or_default();
-                (old_input != opts.input.display().to_string())
+                (super::absolute(Path::new(old_input)) != input)
                     .then(|| format!("it was built from {old_input}"))
             });
         if let Some(why) = diff {
-            return Err(BuildError::Config(format!(
-                "{} holds another build ({} in {}): give --force to replace it, or build this \
-                 hypothesis into another --out",
-                opts.out.display(),
-                why,
-                path.file_name().unwrap_or_default().to_string_lossy()
-            )));
+            let name = path.file_name().unwrap_or_default().to_string_lossy();
+            return Err(BuildError::Config(match tiles {
+                false => format!(
+                    "{} holds another build ({why} in {name}): give --force to replace it, or \
+                     build this hypothesis into another --out",
+                    opts.out.display(),
+                ),
+                true => format!(
+                    "{} holds another build ({why} in {name}): --tiles only rewrites tiles of \
+                     a build with the same input and parameters, even with --force; build the \
+                     whole city (without --tiles) to replace it",
+                    opts.out.display(),
+                ),
+            }));
         }
     }
     Ok(())
+}
+
+/// A run that would build nothing (no lots or footprints were read) never replaces an
+/// earlier build: its tiles would all be removed as stale.
+pub fn refuse_empty(opts: &BuildOptions, plan: &Plan) -> Result<(), BuildError> {
+    if !plan.tiles.is_empty() {
+        return Ok(());
+    }
+    match manifests_in(&opts.out).first() {
+        Some(found) => Err(BuildError::Config(format!(
+            "nothing to build (no lots or footprints were read), and {} holds an earlier build \
+             ({}): it was left as it was; check the input and `layers.*.file`, or build into \
+             another --out",
+            opts.out.display(),
+            found.file_name().unwrap_or_default().to_string_lossy()
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// The manifest of the earlier full build that `--tiles` updates.
@@ -146,6 +175,13 @@ pub fn select(plan: &Plan, selection: &Selection) -> Result<HashSet<String>, Bui
     match selection {
         Selection::All => Ok(plan.tiles.keys().cloned().collect()),
         Selection::Tiles(ids) => {
+            if ids.is_empty() || ids.iter().any(|id| id.trim().is_empty()) {
+                return Err(BuildError::Config(format!(
+                    "--tiles {}: a tile id is empty (two commas in a row, or one at an end); \
+                     give ids such as 1108_760,1109_760",
+                    ids.join(",")
+                )));
+            }
             let unknown: Vec<&String> = ids
                 .iter()
                 .filter(|id| !plan.tiles.contains_key(*id))
@@ -160,9 +196,10 @@ pub fn select(plan: &Plan, selection: &Selection) -> Result<HashSet<String>, Bui
             Ok(ids.iter().cloned().collect())
         }
         Selection::Shard { index, count } => {
-            if *count == 0 || *index == 0 || index > count {
+            if *count == 0 || *index == 0 || index > count || *count > super::MAX_SHARDS {
                 return Err(BuildError::Config(format!(
-                    "--shard {index}/{count}: give I/N with 1 <= I <= N"
+                    "--shard {index}/{count}: give I/N with 1 <= I <= N <= {}",
+                    super::MAX_SHARDS
                 )));
             }
             Ok(shard_of_tiles(plan, *count)
@@ -247,18 +284,32 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
         )));
     };
     let count = first.shard.map(|s| s[1]).unwrap_or(0);
+    if count == 0 || count > super::MAX_SHARDS {
+        return Err(BuildError::Config(format!(
+            "{}: a shard count of {count} is not within 1..={}; the manifest is damaged: run \
+             the shards again",
+            shards[0].1.display(),
+            super::MAX_SHARDS
+        )));
+    }
     let mut seen = vec![false; count];
     for (_, path, m) in &shards {
-        let same = m.params == first.params && m.input == first.input && m.origin == first.origin;
-        if !same || m.shard.map(|s| s[1]) != Some(count) {
+        if let Some(why) = difference(first, m) {
             return Err(BuildError::Config(format!(
-                "{} belongs to another build than {} (parameters, input or shard count differ)",
+                "{} belongs to another build than {} ({why}): merge the shards of one build",
                 path.display(),
-                dirs[0].display()
+                shards[0].1.display()
             )));
         }
-        if let Some([i, _]) = m.shard {
-            seen[i - 1] = true;
+        match m.shard {
+            Some([i, _]) if (1..=count).contains(&i) => seen[i - 1] = true,
+            _ => {
+                return Err(BuildError::Config(format!(
+                    "{}: its shard number is not within 1..={count}; the manifest is damaged: \
+                     run that shard again",
+                    path.display()
+                )))
+            }
         }
     }
     let missing: Vec<String> = (1..=count)
@@ -271,35 +322,89 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
             missing.join(", ")
         )));
     }
+    let _lock = crate::output::lock::OutLock::acquire(target)
+        .map_err(|e| BuildError::Config(e.to_string()))?;
+    // Every file is checked against its shard's manifest before anything is written: a
+    // truncated or missing tile stops the merge with the target as it was.
     let mut tiles: BTreeMap<String, report::ManifestTile> = BTreeMap::new();
-    for (dir, _, m) in &shards {
+    let mut copies: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    for (dir, path, m) in &shards {
+        let shard = m.shard.map(|[i, n]| format!("{i}/{n}")).unwrap_or_default();
         for t in &m.tiles {
-            if dir != target {
-                for f in [&t.obj.path, &t.mtl.path] {
-                    let to = target.join(f);
-                    std::fs::copy(dir.join(f), &to).map_err(|e| write_err(&to, e))?;
+            for f in [&t.obj, &t.mtl] {
+                let from = dir.join(&f.path);
+                let bytes = std::fs::read(&from).map_err(|e| {
+                    BuildError::Config(format!(
+                        "shard {shard}'s tile file {} cannot be read ({e}); {} lists it: run \
+                         that shard again, then merge",
+                        from.display(),
+                        path.display()
+                    ))
+                })?;
+                if bytes.len() as u64 != f.bytes || crate::output::sha256_hex(&bytes) != f.sha256 {
+                    return Err(BuildError::Config(format!(
+                        "shard {shard}'s tile file {} is not what {} lists ({} bytes, {} \
+                         expected, or another sha256): it was cut short or changed; run that \
+                         shard again, then merge",
+                        from.display(),
+                        path.display(),
+                        bytes.len(),
+                        f.bytes
+                    )));
+                }
+                if dir != target {
+                    copies.push((target.join(&f.path), bytes));
                 }
             }
             tiles.insert(t.id.clone(), t.clone());
         }
     }
+    for (to, bytes) in &copies {
+        if let Some(parent) = to.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| write_err(parent, e))?;
+        }
+        write_atomic(to, bytes).map_err(|e| write_err(to, e))?;
+    }
     let mut merged = first.clone();
     merged.shard = None;
     merged.tiles = tiles.into_values().collect();
-    // The first shard wrote the texture set its parameters chose into `target/textures`.
-    let rep = write_manifest_and_report(target, &merged)?;
-    // The whole city's plan, as a full build draws it (shards leave it to the merge).
+    // The whole city's plan, as a full build draws it (shards leave it to the merge); drawn
+    // before the manifest, which is written last, so a failing plan leaves no merged manifest.
     if draw_plan {
-        let png = super::draw_plan_of(target, None)?;
+        let png = super::draw_plan_from(&merged, None)?;
         let path = target.join("plan.png");
         write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
     }
+    // The first shard wrote the texture set its parameters chose into `target/textures`.
+    let rep = write_manifest_and_report(target, &merged)?;
     for (_, path, m) in &shards {
         let _ = std::fs::remove_file(path);
         let (_, report_name) = names(m.shard);
         let _ = std::fs::remove_file(path.with_file_name(report_name));
     }
     Ok(rep)
+}
+
+/// What makes shard manifest `m` part of another build than `first`: the shard count, the
+/// first differing parameter, the input, or the origin. The input's path may differ (shards
+/// run on other machines); what was read from it may not.
+fn difference(first: &Manifest, m: &Manifest) -> Option<String> {
+    if m.shard.map(|s| s[1]) != first.shard.map(|s| s[1]) {
+        return Some("the shard count differs".into());
+    }
+    let a = serde_json::to_value(&first.params).expect("parameters serialise");
+    let b = serde_json::to_value(&m.params).expect("parameters serialise");
+    if let Some(k) = first_difference(&a, &b, "") {
+        return Some(format!("the parameter `{k}` differs"));
+    }
+    let strip = |s: &report::InputSummary| report::InputSummary {
+        input: String::new(),
+        ..s.clone()
+    };
+    if strip(&first.input) != strip(&m.input) {
+        return Some("what was read from the input differs".into());
+    }
+    (first.origin != m.origin).then(|| "the origin differs".into())
 }
 
 /// One line of `edo-city tiles`.

@@ -49,6 +49,7 @@ pub fn build(
                     layer: kind.layer().into(),
                     file: file.clone(),
                     id: b.id.clone(),
+                    record: None,
                     reason,
                 }),
             }

@@ -105,6 +105,7 @@ pub fn generate_tile(
             layer: skipped.into(),
             file: file.clone(),
             id: m.id.clone(),
+            record: Some(m.record),
             reason,
         };
         let mesh = match result {
@@ -230,6 +231,7 @@ fn build_fences(
                     files.lots.clone()
                 },
                 id: first.id.clone(),
+                record: Some(first.record),
                 reason: format!("its fence: {reason}"),
             }),
         }

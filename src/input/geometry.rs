@@ -4,7 +4,7 @@
 use std::collections::BTreeSet;
 
 use geo::{orient::Direction, Area, Orient};
-use geo_types::{Coord, LineString, MultiPolygon, Polygon};
+use geo_types::{Coord, LineString, Polygon};
 use shapefile::Shape;
 
 /// The kind of a shape, for messages ("record 3 is a point; ...").
@@ -19,12 +19,32 @@ pub fn shape_kind(shape: &Shape) -> &'static str {
     }
 }
 
-/// Polygons of a shape, exterior rings counter-clockwise, with the lowest Z of a PolygonZ.
+/// The polygons of one shape, as [`polygons_of`] reads them.
+#[derive(Debug, Default)]
+pub struct ShapePolygons {
+    /// Exterior rings counter-clockwise, holes clockwise (geo's convention).
+    pub polygons: Vec<Polygon<f64>>,
+    /// The lowest Z of a PolygonZ.
+    pub lowest_z: Option<f64>,
+    /// Rings wound against the shapefile standard (an outer ring counter-clockwise, a hole
+    /// clockwise), read by where they lie all the same: the caller counts them in a warning.
+    pub against_winding: usize,
+}
+
+/// Polygons of a shape, with the lowest Z of a PolygonZ. Rings are sorted into outers and
+/// holes as GDAL and QGIS read shapefiles: rings wound as outers are outers; a ring wound as a
+/// hole is the hole of the smallest outer around it, or an outer ring when it lies in none.
+/// A feature whose largest ring is counter-clockwise was written with the opposite winding
+/// (many non-ESRI tools do), so its windings are read the other way round. The shapefile
+/// crate would call such rings orphaned holes and the feature would vanish.
 /// `Err` names the shape kind when the shape is not a polygon.
-pub fn polygons_of(shape: &Shape) -> Result<(Vec<Polygon<f64>>, Option<f64>), &'static str> {
-    let (mp, z): (Result<MultiPolygon<f64>, _>, Option<f64>) = match shape {
-        Shape::Polygon(p) => (MultiPolygon::try_from(p.clone()), None),
-        Shape::PolygonM(p) => (MultiPolygon::try_from(p.clone()), None),
+pub fn polygons_of(shape: &Shape) -> Result<ShapePolygons, &'static str> {
+    fn rings<P: Copy>(r: &[shapefile::PolygonRing<P>], xy: impl Fn(P) -> Coord<f64>) -> Vec<Vec<Coord<f64>>> {
+        r.iter().map(|ring| ring.points().iter().map(|p| xy(*p)).collect()).collect()
+    }
+    let (rings, lowest_z) = match shape {
+        Shape::Polygon(p) => (rings(p.rings(), |q| Coord { x: q.x, y: q.y }), None),
+        Shape::PolygonM(p) => (rings(p.rings(), |q| Coord { x: q.x, y: q.y }), None),
         Shape::PolygonZ(p) => {
             let z = p
                 .rings()
@@ -34,36 +54,111 @@ pub fn polygons_of(shape: &Shape) -> Result<(Vec<Polygon<f64>>, Option<f64>), &'
                 .filter(|z| z.is_finite())
                 .fold(f64::INFINITY, f64::min);
             (
-                MultiPolygon::try_from(p.clone()),
+                rings(p.rings(), |q| Coord { x: q.x, y: q.y }),
                 z.is_finite().then_some(z),
             )
         }
-        Shape::NullShape => return Ok((Vec::new(), None)),
+        Shape::NullShape => return Ok(ShapePolygons::default()),
         other => return Err(shape_kind(other)),
     };
-    // geo's orient compares coordinates with partial_cmp().unwrap(): a NaN would panic. Rings
-    // with a non-finite coordinate go through unoriented; check_polygon skips them.
-    let finite = |p: &Polygon<f64>| {
-        p.exterior()
-            .0
+    let (polygons, against_winding) = organise_rings(rings);
+    Ok(ShapePolygons {
+        polygons,
+        lowest_z,
+        against_winding,
+    })
+}
+
+/// Sorts rings into polygons (see [`polygons_of`]); returns them with the number of rings
+/// wound against the shapefile standard. Outer rings keep the order they were read in, so
+/// the parts of a multipart feature keep their numbers.
+fn organise_rings(rings: Vec<Vec<Coord<f64>>>) -> (Vec<Polygon<f64>>, usize) {
+    use geo::coordinate_position::{CoordPos, CoordinatePosition};
+    use geo::BoundingRect;
+    let finite = |r: &[Coord<f64>]| r.iter().all(|c| c.x.is_finite() && c.y.is_finite());
+    let signed: Vec<f64> = rings.iter().map(|r| shoelace(r)).collect();
+    let n = rings.len();
+    // The standard winds outers clockwise (a negative shoelace area); a feature whose largest
+    // ring winds the other way is read with both windings swapped.
+    let largest = (0..n).max_by(|&a, &b| signed[a].abs().total_cmp(&signed[b].abs()).then(b.cmp(&a)));
+    let reversed = largest.is_some_and(|i| signed[i] > 0.0);
+    // A ring with a non-finite coordinate is an outer ring of its own; check_polygon skips
+    // it. A ring with no area has no winding: it is a hole where it lies in an outer ring
+    // (where it changes nothing) and an outer ring, skipped as having no area, where not.
+    let wound_outer: Vec<bool> = (0..n)
+        .map(|i| !finite(&rings[i]) || (signed[i] != 0.0 && ((signed[i] < 0.0) != reversed)))
+        .collect();
+    let mut holder: Vec<Option<usize>> = vec![None; n];
+    if wound_outer.iter().any(|o| !o) {
+        let boxes: Vec<_> = rings
             .iter()
-            .chain(p.interiors().iter().flat_map(|r| r.0.iter()))
-            .all(|c| c.x.is_finite() && c.y.is_finite())
-    };
-    let polys = mp
-        .map(|m| {
-            m.0.into_iter()
-                .map(|p| {
-                    if finite(&p) {
-                        p.orient(Direction::Default)
-                    } else {
-                        p
-                    }
+            .map(|r| finite(r).then(|| LineString(r.clone()).bounding_rect()).flatten())
+            .collect();
+        for i in (0..n).filter(|&i| !wound_outer[i]) {
+            let Some(bi) = boxes[i] else { continue };
+            holder[i] = (0..n)
+                .filter(|&j| wound_outer[j] && j != i)
+                .filter(|&j| {
+                    let Some(bj) = boxes[j] else { return false };
+                    let in_box = bj.min().x <= bi.min().x
+                        && bj.min().y <= bi.min().y
+                        && bj.max().x >= bi.max().x
+                        && bj.max().y >= bi.max().y;
+                    let shell = Polygon::new(LineString(rings[j].clone()), vec![]);
+                    in_box
+                        && rings[i]
+                            .iter()
+                            .map(|c| shell.coordinate_position(c))
+                            .find(|p| *p != CoordPos::OnBoundary)
+                            == Some(CoordPos::Inside)
                 })
-                .collect()
+                .min_by(|&a, &b| signed[a].abs().total_cmp(&signed[b].abs()).then(a.cmp(&b)));
+        }
+    }
+    let is_outer = |i: usize| wound_outer[i] || holder[i].is_none();
+    let against_winding = match reversed {
+        true => n,
+        false => (0..n)
+            .filter(|&i| !wound_outer[i] && holder[i].is_none() && signed[i] != 0.0)
+            .count(),
+    };
+    let mut slot = vec![usize::MAX; n];
+    let mut polygons: Vec<Polygon<f64>> = Vec::new();
+    for i in (0..n).filter(|&i| is_outer(i)) {
+        slot[i] = polygons.len();
+        polygons.push(Polygon::new(LineString(rings[i].clone()), vec![]));
+    }
+    for i in (0..n).filter(|&i| !is_outer(i)) {
+        if let Some(j) = holder[i] {
+            polygons[slot[j]].interiors_push(LineString(rings[i].clone()));
+        }
+    }
+    // geo's orient compares coordinates with partial_cmp().unwrap(): a NaN would panic, so
+    // a polygon with a non-finite coordinate goes through unoriented.
+    let polygons = polygons
+        .into_iter()
+        .map(|p| {
+            let ok = finite(&p.exterior().0) && p.interiors().iter().all(|r| finite(&r.0));
+            if ok {
+                p.orient(Direction::Default)
+            } else {
+                p
+            }
         })
-        .unwrap_or_default();
-    Ok((polys, z))
+        .collect();
+    (polygons, against_winding)
+}
+
+/// Twice the signed area of a ring, positive when counter-clockwise (y up).
+fn shoelace(ring: &[Coord<f64>]) -> f64 {
+    let closing = match (ring.first(), ring.last()) {
+        (Some(a), Some(b)) => b.x * a.y - a.x * b.y,
+        _ => 0.0,
+    };
+    ring.windows(2)
+        .map(|w| w[0].x * w[1].y - w[1].x * w[0].y)
+        .sum::<f64>()
+        + closing
 }
 
 /// Lines of a shape (each part one line).
@@ -168,4 +263,79 @@ pub fn map_polygon(poly: &mut Polygon<f64>, f: &mut CoordsFn) -> Result<(), Stri
         }
     });
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed square ring, clockwise (the shapefile's outer winding) or not.
+    fn square(x: f64, y: f64, size: f64, clockwise: bool) -> Vec<Coord<f64>> {
+        let mut r = vec![
+            Coord { x, y },
+            Coord { x: x + size, y },
+            Coord {
+                x: x + size,
+                y: y + size,
+            },
+            Coord { x, y: y + size },
+        ];
+        if clockwise {
+            r.reverse();
+        }
+        r.push(r[0]);
+        r
+    }
+
+    #[test]
+    fn standard_winding_gives_an_outer_with_its_hole() {
+        let (p, against) =
+            organise_rings(vec![square(0.0, 0.0, 10.0, true), square(2.0, 2.0, 2.0, false)]);
+        assert_eq!(p.len(), 1);
+        assert_eq!(p[0].interiors().len(), 1);
+        assert_eq!(against, 0);
+    }
+
+    #[test]
+    fn a_counter_clockwise_outer_is_read_and_counted() {
+        let (p, against) = organise_rings(vec![square(0.0, 0.0, 10.0, false)]);
+        assert_eq!(p.len(), 1);
+        assert!((p[0].unsigned_area() - 100.0).abs() < 1e-9);
+        assert_eq!(against, 1);
+    }
+
+    #[test]
+    fn a_feature_wound_the_other_way_keeps_its_hole() {
+        let (p, against) =
+            organise_rings(vec![square(0.0, 0.0, 10.0, false), square(2.0, 2.0, 2.0, true)]);
+        assert_eq!(p.len(), 1, "one polygon with a courtyard, not two overlapping ones");
+        assert_eq!(p[0].interiors().len(), 1);
+        assert!((p[0].unsigned_area() - 96.0).abs() < 1e-9);
+        assert_eq!(against, 2);
+    }
+
+    #[test]
+    fn a_hole_outside_every_outer_is_an_outer_and_holes_find_their_own_outer() {
+        // Two parts; the second part's hole is written first, after the first part.
+        let (p, against) = organise_rings(vec![
+            square(0.0, 0.0, 10.0, true),
+            square(22.0, 2.0, 2.0, false),
+            square(20.0, 0.0, 10.0, true),
+            square(50.0, 0.0, 1.0, false),
+        ]);
+        assert_eq!(p.len(), 3);
+        assert_eq!(p[0].interiors().len(), 0);
+        assert_eq!(p[1].interiors().len(), 1, "the hole went to the ring around it");
+        assert_eq!(p[2].interiors().len(), 0);
+        assert_eq!(against, 1);
+    }
+
+    #[test]
+    fn exteriors_come_out_counter_clockwise_for_geo() {
+        use geo::Winding;
+        for clockwise in [true, false] {
+            let (p, _) = organise_rings(vec![square(0.0, 0.0, 1.0, clockwise)]);
+            assert!(p[0].exterior().is_ccw());
+        }
+    }
 }

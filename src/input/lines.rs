@@ -10,6 +10,10 @@ use super::{widths, InputError, Opened};
 use crate::model::{Dataset, FenceLine, Skipped, Street};
 use crate::params::Params;
 
+/// The widest street taken from the data, metres (the widest avenues are about 100 m; a
+/// larger number is a unit error or damaged data).
+pub const MAX_STREET_WIDTH: f64 = 200.0;
+
 /// Free-standing fence lines: each part of each polyline, with the feature's attributes.
 pub(super) fn read_fence_lines(
     params: &Params,
@@ -27,6 +31,10 @@ pub(super) fn read_fence_lines(
             .map(|v| v.trim().to_string())
             .filter(|v| !v.is_empty())
             .unwrap_or_else(|| (f.record + 1).to_string());
+        if lines.is_empty() {
+            data.skipped.push(super::null_shape(o, f.record, "the line"));
+            continue;
+        }
         let parts = lines.len();
         for (k, mut line) in lines.into_iter().enumerate() {
             let ok = line.0.len() >= 2
@@ -37,6 +45,7 @@ pub(super) fn read_fence_lines(
                     layer: "fences".into(),
                     file: o.file.clone(),
                     id: id.clone(),
+                    record: Some(f.record),
                     reason: "a line with fewer than 2 usable points".into(),
                 });
                 continue;
@@ -70,22 +79,29 @@ pub(super) fn read_streets(
     for f in &o.layer.features {
         let lines =
             lines_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polylines"))?;
+        if lines.is_empty() {
+            data.skipped.push(super::null_shape(o, f.record, "the centreline"));
+            continue;
+        }
         let width = match width_field
             .and_then(|wf| f.attrs.get(wf))
             .map(|w| w.parse::<f64>())
         {
-            Some(Ok(w)) if w.is_finite() && w > 0.0 => w,
+            Some(Ok(w)) if w.is_finite() && w > 0.0 && w <= MAX_STREET_WIDTH => w,
             Some(_) => {
                 bad_width += 1;
                 sp.default_width
             }
             None => sp.default_width,
         };
+        let mut usable = false;
         for mut line in lines {
             if line.0.len() >= 2
                 && line.0.iter().all(|c| c.x.is_finite() && c.y.is_finite())
                 && to_target(o, target, &mut line.0).is_ok()
+                && line.0.iter().all(|c| crate::model::sane(*c))
             {
+                usable = true;
                 streets.push(Street {
                     id: f.record.to_string(),
                     line,
@@ -93,10 +109,28 @@ pub(super) fn read_streets(
                 });
             }
         }
+        if usable {
+            data.records
+                .entry(o.role.into())
+                .or_default()
+                .insert(f.record);
+        } else {
+            data.skipped.push(Skipped {
+                layer: o.role.into(),
+                file: o.file.clone(),
+                id: format!("record {}", f.record),
+                record: Some(f.record),
+                reason: "the centreline has fewer than 2 usable points (or a coordinate that is \
+                         not a finite number within 1e8 m of the CRS's origin): redraw it or \
+                         delete it"
+                    .into(),
+            });
+        }
     }
     if bad_width > 0 {
         data.warnings.push(format!(
-            "{}: {bad_width} street(s) have no usable `{}`; they get the default width {} m",
+            "{}: {bad_width} street(s) have a `{}` that is not a number of metres above 0 and \
+             up to {MAX_STREET_WIDTH}; they get the default width {} m",
             o.file, sp.width_field, sp.default_width
         ));
     }
@@ -106,16 +140,40 @@ pub(super) fn read_streets(
             wl.required_field(&wp.width_field, "width", "layers.street_widths.width_field")?;
         let mut lines: Vec<(LineString<f64>, f64)> = Vec::new();
         for f in &wl.layer.features {
-            let Some(w) = f.attrs.get(&field).and_then(|v| v.parse::<f64>().ok()) else {
-                continue;
+            let w = f.attrs.get(&field).and_then(|v| v.trim().parse::<f64>().ok());
+            let reason = match w {
+                Some(w) if w.is_finite() && w > 0.0 && w <= MAX_STREET_WIDTH => None,
+                _ => Some(format!(
+                    "`{field}` is not a number of metres above 0 and up to {MAX_STREET_WIDTH}: \
+                     correct it or delete the line"
+                )),
             };
-            if !(w.is_finite() && w > 0.0) {
-                continue;
-            }
-            for mut line in lines_of(&f.shape).unwrap_or_default() {
-                if to_target(wl, target, &mut line.0).is_ok() {
-                    lines.push((line, w));
+            let mut usable = false;
+            if reason.is_none() {
+                for mut line in lines_of(&f.shape).unwrap_or_default() {
+                    if line.0.len() >= 2 && to_target(wl, target, &mut line.0).is_ok() {
+                        usable = true;
+                        lines.push((line, w.unwrap_or_default()));
+                    }
                 }
+            }
+            if usable {
+                data.records
+                    .entry(wl.role.into())
+                    .or_default()
+                    .insert(f.record);
+            } else {
+                data.skipped.push(Skipped {
+                    layer: wl.role.into(),
+                    file: wl.file.clone(),
+                    id: format!("record {}", f.record),
+                    record: Some(f.record),
+                    reason: reason.unwrap_or_else(|| {
+                        "the line has fewer than 2 usable points (or a null shape): redraw it \
+                         or delete it"
+                            .into()
+                    }),
+                });
             }
         }
         let (pieces, matched) = widths::apply_widths(streets, &lines, wp.max_distance);

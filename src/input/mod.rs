@@ -20,6 +20,7 @@ mod lines;
 mod polygons;
 mod target;
 
+pub use lines::MAX_STREET_WIDTH;
 use lines::{read_fence_lines, read_streets};
 use polygons::{assign_districts, read_footprints, read_lots};
 use target::{resolve_crs, to_target};
@@ -54,9 +55,30 @@ struct Opened {
     /// a fifth of the read stage).
     reproject: bool,
     file: String,
+    /// Rings read so far that are wound against the shapefile standard (see
+    /// [`geometry::ShapePolygons::against_winding`]), for one warning per layer.
+    against_winding: std::cell::Cell<usize>,
 }
 
 impl Opened {
+    /// Counts rings wound against the standard.
+    fn count_winding(&self, n: usize) {
+        self.against_winding.set(self.against_winding.get() + n);
+    }
+
+    /// The warning for the rings wound against the standard, if any.
+    fn winding_warning(&self) -> Option<String> {
+        let n = self.against_winding.get();
+        (n > 0).then(|| {
+            format!(
+                "{}: {n} ring(s) are wound against the shapefile standard (outer rings \
+                 counter-clockwise or holes clockwise, as many non-ESRI tools write them); they \
+                 were read by where they lie, as GDAL and QGIS read them",
+                self.file
+            )
+        })
+    }
+
     /// The error for record `record` whose shape is a `kind` where this layer must hold
     /// `wanted` (polygons, polylines, points).
     fn wrong_shape(&self, record: usize, kind: &str, wanted: &str) -> InputError {
@@ -114,6 +136,7 @@ fn open(
         layer,
         src: None,
         reproject: false,
+        against_winding: Default::default(),
     }))
 }
 
@@ -230,6 +253,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         &streets,
         &blocks,
         &widths,
+        &districts,
         &fences,
         &people,
         &trees,
@@ -266,9 +290,13 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
     }
     if let Some(o) = &blocks {
         for f in &o.layer.features {
-            let (polys, _) =
+            let read =
                 polygons_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polygons"))?;
-            for mut p in polys {
+            o.count_winding(read.against_winding);
+            if read.polygons.is_empty() {
+                data.skipped.push(null_shape(o, f.record, "its outline"));
+            }
+            for mut p in read.polygons {
                 map_polygon(&mut p, &mut |c| to_target(o, &target, c)).map_err(|m| {
                     InputError::Layer {
                         file: o.file.clone(),
@@ -276,6 +304,10 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
                     }
                 })?;
                 data.blocks.push(p);
+                data.records
+                    .entry(o.role.into())
+                    .or_default()
+                    .insert(f.record);
             }
         }
     }
@@ -318,8 +350,36 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         }
     }
     data.dem = read_dem(dir, params, &target, &dl.dem.file)?;
+    for o in [
+        &lots,
+        &footprints,
+        &streets,
+        &blocks,
+        &widths,
+        &districts,
+        &fences,
+    ]
+    .into_iter()
+    .flatten()
+    {
+        data.warnings.extend(o.winding_warning());
+    }
     simplify::generalise(&mut data, &params.simplify);
     Ok(data)
+}
+
+/// The skip entry for a record of `o` whose shape is null (no geometry, only attributes).
+fn null_shape(o: &Opened, record: usize, what: &str) -> Skipped {
+    Skipped {
+        layer: o.role.into(),
+        file: o.file.clone(),
+        id: format!("record {record}"),
+        record: Some(record),
+        reason: format!(
+            "null shape: the record has attributes but no geometry; draw {what} or delete the \
+             record"
+        ),
+    }
 }
 
 /// The rule for one attribute of a layer: its field (if the layer has it), constant, values.
@@ -446,6 +506,7 @@ fn join(
                     layer: format!("{layer} table"),
                     file: table.file.clone(),
                     id: id.clone(),
+                    record: None,
                     reason: format!("no {} has this id; the row was not used", singular(layer)),
                 });
                 if out.rows_without_feature_ids.len() < 20 {

@@ -67,6 +67,7 @@ pub(super) fn read_points(
                     layer: o.role.into(),
                     file: o.file.clone(),
                     id,
+                    record: Some(f.record),
                     reason: "the point has no usable coordinates".into(),
                 });
                 continue;

@@ -221,15 +221,39 @@ pub(super) fn assign_districts(
     let field = o.required_field(&dp.id_field, "district id", "layers.districts.id_field")?;
     let mut polys = Vec::new();
     for f in &o.layer.features {
-        let (parts, _) =
+        let read =
             polygons_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polygons"))?;
+        o.count_winding(read.against_winding);
+        let parts = read.polygons;
         let id = f.attrs.get(&field).cloned().unwrap_or_default();
+        let mut usable = false;
         for mut p in parts {
             if map_polygon(&mut p, &mut |c| to_target(o, target, c)).is_ok() && !id.is_empty() {
                 if let Some(bb) = p.bounding_rect() {
+                    usable = true;
                     polys.push((bb, p, id.clone()));
                 }
             }
+        }
+        if usable {
+            data.records
+                .entry(o.role.into())
+                .or_default()
+                .insert(f.record);
+        } else {
+            data.skipped.push(Skipped {
+                layer: o.role.into(),
+                file: o.file.clone(),
+                id: format!("record {}", f.record),
+                record: Some(f.record),
+                reason: match id.is_empty() {
+                    true => format!("no value in the district id field `{field}`: give the \
+                                     district an id"),
+                    false => "null shape or no usable outline: draw the district or delete the \
+                              record"
+                        .into(),
+                },
+            });
         }
     }
     let find = |poly: &geo_types::Polygon<f64>| -> Option<String> {
@@ -267,7 +291,7 @@ pub(super) fn record_polygons(
     id_field: &str,
     skipped: &mut Vec<Skipped>,
 ) -> Result<Option<RecordPolygons>, InputError> {
-    let (polys, z) = polygons_of(&f.shape).map_err(|kind| match kind {
+    let read = polygons_of(&f.shape).map_err(|kind| match kind {
         "multipatch" => InputError::Layer {
             file: o.file.clone(),
             message: format!(
@@ -278,12 +302,28 @@ pub(super) fn record_polygons(
         },
         _ => o.wrong_shape(f.record, kind, "polygons"),
     })?;
+    o.count_winding(read.against_winding);
+    let (polys, z) = (read.polygons, read.lowest_z);
+    if matches!(f.shape, shapefile::Shape::NullShape) {
+        let id = f.attrs.get(id_field).cloned().unwrap_or_default();
+        skipped.push(Skipped {
+            layer: o.role.into(),
+            file: o.file.clone(),
+            id: if id.is_empty() { format!("record {}", f.record) } else { id },
+            record: Some(f.record),
+            reason: "null shape: the record has attributes but no geometry; draw its outline \
+                     or delete the record"
+                .into(),
+        });
+        return Ok(None);
+    }
     let id = f.attrs.get(id_field).cloned().unwrap_or_default();
     if id.is_empty() {
         skipped.push(Skipped {
             layer: o.role.into(),
             file: o.file.clone(),
             id: format!("record {}", f.record),
+            record: Some(f.record),
             reason: format!("no value in the id field `{id_field}`: give the feature an id"),
         });
         return Ok(None);
@@ -318,8 +358,8 @@ pub(super) fn checked_parts(
             .or_else(|| {
                 (!seen.insert(id.clone())).then(|| {
                     format!(
-                        "duplicate id: record {record} repeats an earlier feature's id; the \
-                         first was built, give this one an id of its own"
+                        "duplicate id: the record repeats an earlier feature's id; the first \
+                         was built, give this one an id of its own"
                     )
                 })
             });
@@ -328,6 +368,7 @@ pub(super) fn checked_parts(
                 layer: o.role.into(),
                 file: o.file.clone(),
                 id,
+                record: Some(record),
                 reason,
             }),
             None => out.push((id, poly)),

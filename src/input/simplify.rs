@@ -186,6 +186,7 @@ fn skip_too_detailed(data: &mut Dataset, max: usize) {
                 layer: layer.into(),
                 file: file.into(),
                 id: id.into(),
+                record: None,
                 reason: format!(
                     "{n} vertices after simplification, more than `simplify.max_vertices` \
                      ({max}); simplify the outline in the GIS (QGIS: Vector > Geometry Tools > \

@@ -14,8 +14,8 @@ use crate::params::Params;
 pub(super) fn layer_coords(o: &Opened) -> Vec<Coord<f64>> {
     let mut out = Vec::new();
     for f in &o.layer.features {
-        if let Ok((polys, _)) = polygons_of(&f.shape) {
-            for p in polys {
+        if let Ok(read) = polygons_of(&f.shape) {
+            for p in read.polygons {
                 out.extend(p.exterior().0.iter().copied());
             }
         } else if let Ok(lines) = lines_of(&f.shape) {

@@ -3,7 +3,9 @@
 //! Every file goes through [`atomic::write_atomic`]; `manifest.json` is written last, so a
 //! manifest always describes complete tiles.
 
+pub mod accounting;
 pub mod atomic;
+pub mod lock;
 pub mod mtl;
 pub mod obj;
 pub mod plan;

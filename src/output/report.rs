@@ -138,6 +138,9 @@ pub struct Report {
     pub skipped_by_reason: BTreeMap<String, usize>,
     pub tables: Vec<TableJoin>,
     pub warnings: Vec<String>,
+    /// Per layer: records read, built, skipped, and unaccounted (always 0; see
+    /// [`super::accounting`]).
+    pub accounting: Vec<super::accounting::Account>,
     pub tiles: Vec<TileReport>,
 }
 
@@ -166,6 +169,9 @@ pub struct InputSummary {
     pub skipped: Vec<Skipped>,
     pub tables: Vec<TableJoin>,
     pub warnings: Vec<String>,
+    /// What each layer's records became in reading and analysis, closed in the report.
+    #[serde(default)]
+    pub ledgers: Vec<super::accounting::Ledger>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -279,6 +285,7 @@ pub fn assemble_report(m: &Manifest) -> Report {
     c.type_drawn = c.machiya.saturating_sub(c.type_given);
     c.tiles = m.tiles.len();
     c.skipped = r.skipped.len();
+    r.accounting = super::accounting::close(&i.ledgers, &r.skipped, &mut r.warnings);
     for s in &r.skipped {
         *r.skipped_by_reason
             .entry(reason_class(&s.reason))

@@ -66,18 +66,26 @@ pub struct TreesParams {
     pub max_points_per_tile: usize,
 }
 
+/// The densest crowd a parameter may ask for: a person every 10 cm of street.
+pub const MAX_PER_100M: f64 = 1000.0;
+/// The densest wood: a tree per square metre.
+pub const MAX_PER_HA: f64 = 10_000.0;
+/// The most billboards one tile may hold (`max_points_per_tile`).
+pub const MAX_POINTS_PER_TILE: usize = 1_000_000;
+
 impl PeopleParams {
     pub(super) fn validate(&self) -> Result<(), String> {
         common(
             "people",
             &[
-                ("per_100m", self.per_100m),
-                ("edge_margin", self.edge_margin),
-                ("min_spacing", self.min_spacing),
-                ("clearance", self.clearance),
+                ("per_100m", self.per_100m, MAX_PER_100M),
+                ("edge_margin", self.edge_margin, 100.0),
+                ("min_spacing", self.min_spacing, 100.0),
+                ("clearance", self.clearance, 100.0),
             ],
             self.height,
             &self.textures,
+            self.max_points_per_tile,
         )?;
         if !(0.0..=180.0).contains(&self.max_turn_deg) {
             return Err(format!(
@@ -94,34 +102,42 @@ impl TreesParams {
         common(
             "trees",
             &[
-                ("per_ha", self.per_ha),
-                ("per_ha_machiya", self.per_ha_machiya),
-                ("min_spacing", self.min_spacing),
-                ("clearance", self.clearance),
+                ("per_ha", self.per_ha, MAX_PER_HA),
+                ("per_ha_machiya", self.per_ha_machiya, MAX_PER_HA),
+                ("min_spacing", self.min_spacing, 100.0),
+                ("clearance", self.clearance, 100.0),
             ],
             self.height,
             &self.textures,
+            self.max_points_per_tile,
         )
     }
 }
 
-/// Densities and distances are 0 or more, the height range is positive and ordered, and
-/// there is a texture to draw from.
+/// Densities and distances are from 0 to their bound, the height range is positive, ordered
+/// and under 100 m, the per-tile cap bounded, and there is a texture to draw from.
 fn common(
     table: &str,
-    non_negative: &[(&str, f64)],
+    bounded: &[(&str, f64, f64)],
     height: [f64; 2],
     textures: &[String],
+    max_points_per_tile: usize,
 ) -> Result<(), String> {
-    for (key, v) in non_negative {
-        if !(v.is_finite() && *v >= 0.0) {
-            return Err(format!("`{table}.{key}` must be 0 or more, got {v}"));
+    for (key, v, high) in bounded {
+        if !(v.is_finite() && (0.0..=*high).contains(v)) {
+            return Err(format!("`{table}.{key}` must be from 0 to {high}, got {v}"));
         }
     }
     let [lo, hi] = height;
-    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= hi) {
+    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= hi && hi <= 100.0) {
         return Err(format!(
-            "`{table}.height` must be [low, high] with 0 < low <= high, got [{lo}, {hi}]"
+            "`{table}.height` must be [low, high] with 0 < low <= high <= 100, got [{lo}, {hi}]"
+        ));
+    }
+    if max_points_per_tile > MAX_POINTS_PER_TILE {
+        return Err(format!(
+            "`{table}.max_points_per_tile` must be at most {MAX_POINTS_PER_TILE}, got \
+             {max_points_per_tile}"
         ));
     }
     if textures.is_empty() {

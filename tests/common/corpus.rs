@@ -62,6 +62,7 @@ fn write_lots(dir: &Path, lots: &[(String, &str, Vec<PolygonRing<Point>>)]) {
             .unwrap();
     }
     drop(w);
+    edo_city::synth::stamp_dbf_date(&dir.join("lots.dbf")).unwrap();
     std::fs::write(dir.join("lots.cpg"), "UTF-8").unwrap();
     std::fs::write(dir.join("lots.prj"), PRJ).unwrap();
 }
@@ -88,6 +89,7 @@ fn write_street(dir: &Path) {
     ]);
     w.write_shape_and_record(&line, &rec).unwrap();
     drop(w);
+    edo_city::synth::stamp_dbf_date(&dir.join("streets.dbf")).unwrap();
     std::fs::write(dir.join("streets.cpg"), "UTF-8").unwrap();
     std::fs::write(dir.join("streets.prj"), PRJ).unwrap();
 }
@@ -121,6 +123,7 @@ fn points(dir: &Path, file: &str, pts: &[(&str, [f64; 2])]) {
             .unwrap();
     }
     drop(w);
+    edo_city::synth::stamp_dbf_date(&dir.join(file).with_extension("dbf")).unwrap();
     std::fs::write(dir.join(file).with_extension("prj"), PRJ).unwrap();
 }
 
@@ -330,6 +333,7 @@ pub fn cases() -> Vec<Case> {
                     w.write_shape_and_record(&poly, &rec).unwrap();
                 }
                 drop(w);
+                edo_city::synth::stamp_dbf_date(&d.join("lots.dbf")).unwrap();
                 // No code page in the DBF header either (byte 29), as old files have it.
                 let dbf = d.join("lots.dbf");
                 let mut b = std::fs::read(&dbf).unwrap();
