@@ -2,7 +2,7 @@
 
 CARGO ?= cargo
 
-.PHONY: run test lint bench real textures fixtures clean pictures bad-input
+.PHONY: run test test-future lint bench real textures fixtures clean pictures bad-input
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
@@ -13,21 +13,28 @@ test:
 	$(CARGO) test --all-targets
 	$(CARGO) test --doc
 
+## The suite again under faketime a year ahead and on a leap day (needs faketime:
+## scripts/ci-deps.sh installs it); CI runs it after `make test`.
+test-future:
+	bash scripts/test-future.sh
+
 ## Formatting and lints, as CI runs them.
 lint:
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --all-targets -- -D warnings
 
 REAL ?= ../shared/data/real
+# The release binary, wherever cargo puts it (CARGO_TARGET_DIR is honoured).
+BIN ?= $(or $(CARGO_TARGET_DIR),target)/release/edo-city
 
 ## Build every real data set of $(REAL) with its example parameter file into out/real/.
 real:
 	$(CARGO) build --release
-	target/release/edo-city build $(REAL)/chino_plateau_devpermit --params params/examples/chino.toml --out out/real/chino
-	target/release/edo-city build $(REAL)/osaka_plateau --params params/examples/osaka.toml --out out/real/osaka
-	target/release/edo-city build $(REAL)/osaka_plateau --params params/examples/osaka-lonlat.toml --out out/real/osaka-lonlat
-	target/release/edo-city build $(REAL)/kyoto_plateau_related --params params/examples/kyoto.toml --out out/real/kyoto
-	target/release/edo-city build $(REAL)/swellendam_osm --params params/examples/swellendam.toml --out out/real/swellendam
+	$(BIN) build $(REAL)/chino_plateau_devpermit --params params/examples/chino.toml --out out/real/chino
+	$(BIN) build $(REAL)/osaka_plateau --params params/examples/osaka.toml --out out/real/osaka
+	$(BIN) build $(REAL)/osaka_plateau --params params/examples/osaka-lonlat.toml --out out/real/osaka-lonlat
+	$(BIN) build $(REAL)/kyoto_plateau_related --params params/examples/kyoto.toml --out out/real/kyoto
+	$(BIN) build $(REAL)/swellendam_osm --params params/examples/swellendam.toml --out out/real/swellendam
 
 ## Whole-Kyoto scale: 30,052 synthetic lots, three builds, per-stage timings.
 bench:

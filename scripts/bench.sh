@@ -9,7 +9,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cargo build --release --quiet --example raw_write
 cargo build --release --quiet
-bin=target/release/edo-city
+bin=${CARGO_TARGET_DIR:-target}/release/edo-city
 echo "machine: $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB; $(rustc --version)"
 
 # build LOTS RUN: one timed build into $work/out-LOTS, one result line.

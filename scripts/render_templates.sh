@@ -4,7 +4,7 @@
 # Needs f3d and xvfb-run (Debian: apt install f3d xvfb); the pictures are committed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bin=target/release/edo-city
+bin=${CARGO_TARGET_DIR:-target}/release/edo-city
 cargo build --release --quiet
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

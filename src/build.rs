@@ -298,7 +298,10 @@ fn write_city(
     let t = Instant::now();
     let selected = shards::select(&plan, &opts.selection)?;
     let previous = match &opts.selection {
-        Selection::Tiles(_) => Some(shards::previous_manifest(&opts.out)?),
+        Selection::Tiles(_) => Some(shards::previous_manifest(
+            &opts.out,
+            "--tiles rewrites tiles of an earlier full build",
+        )?),
         _ => None,
     };
     let tiles_dir = opts.out.join("tiles");
@@ -464,7 +467,10 @@ pub fn check(
 /// Draws the plan of an earlier build (its manifest names the input and the parameters);
 /// with `tile`, only that tile at full resolution.
 pub fn draw_plan_of(out: &Path, tile: Option<&str>) -> Result<Vec<u8>, BuildError> {
-    draw_plan_from(&shards::previous_manifest(out)?, tile)
+    draw_plan_from(
+        &shards::previous_manifest(out, "`edo-city plan` draws a finished build")?,
+        tile,
+    )
 }
 
 /// Draws the plan of the build a manifest describes (see [`draw_plan_of`]).

@@ -104,7 +104,7 @@ fn rows(a: &BTreeMap<String, usize>, b: &BTreeMap<String, usize>) -> Vec<Row> {
 }
 
 fn load(dir: &Path) -> Result<(Manifest, Report), BuildError> {
-    let m = shards::previous_manifest(dir)?;
+    let m = shards::previous_manifest(dir, "`edo-city compare` compares two finished builds")?;
     let r = assemble_report(&m);
     Ok((m, r))
 }
@@ -269,7 +269,7 @@ const MAX_MAP_CELLS: i64 = 1500;
 /// A map of the tile grid: unchanged tiles grey, changed orange, only in A blue, only in B
 /// green, with their ids. Tiles named in the data (not `col_row`) are left out.
 pub fn difference_map(c: &Comparison, dir_a: &Path) -> Result<Vec<u8>, BuildError> {
-    let m = shards::previous_manifest(dir_a)?;
+    let m = shards::previous_manifest(dir_a, "`edo-city compare --plan` maps two finished builds")?;
     let (size, origin) = (m.params.tile_size, m.params.tile_origin);
     // One grid for both builds, or the map would draw tiles of two grids as one.
     if let Some(why) = &c.grids_differ {

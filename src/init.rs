@@ -20,24 +20,50 @@ pub struct Found {
     pub crs: String,
 }
 
-fn find_shapefiles(dir: &Path) -> Vec<PathBuf> {
+/// `word` as one word for a POSIX shell: quoted when it holds anything but letters, digits
+/// and `_ . / - + , :`, so a printed command can be pasted as it is.
+pub fn shell_word(word: &str) -> String {
+    let plain = !word.is_empty()
+        && word
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_./-+,:".contains(c));
+    match plain {
+        true => word.to_string(),
+        false => format!("'{}'", word.replace('\'', "'\\''")),
+    }
+}
+
+/// How deep `init` looks below the directory (data sets nest a few folders at most).
+const MAX_DEPTH: usize = 8;
+
+/// The shapefiles under `dir`, sorted. Symbolic links to directories are not followed (a
+/// link to `/` would walk the whole file system, a link to `..` loop), and neither is a
+/// folder deeper than [`MAX_DEPTH`]; the links left out are returned, for the user to see.
+fn find_shapefiles(dir: &Path) -> (Vec<PathBuf>, Vec<PathBuf>) {
     let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
+    let mut links = Vec::new();
+    let mut stack = vec![(dir.to_path_buf(), 0usize)];
+    while let Some((d, depth)) = stack.pop() {
         let Ok(entries) = std::fs::read_dir(&d) else {
             continue;
         };
         for e in entries.flatten() {
             let p = e.path();
-            if p.is_dir() {
-                stack.push(p);
+            let Ok(kind) = e.file_type() else { continue };
+            if kind.is_symlink() && p.is_dir() {
+                links.push(p);
+            } else if kind.is_dir() {
+                if depth < MAX_DEPTH {
+                    stack.push((p, depth + 1));
+                }
             } else if p.extension().is_some_and(|x| x.eq_ignore_ascii_case("shp")) {
                 out.push(p);
             }
         }
     }
     out.sort();
-    out
+    links.sort();
+    (out, links)
 }
 
 /// Reads what `init` needs of every shapefile under `dir`; unreadable ones are listed with
@@ -45,7 +71,15 @@ fn find_shapefiles(dir: &Path) -> Vec<PathBuf> {
 pub fn inspect(dir: &Path) -> (Vec<Found>, Vec<String>) {
     let mut found = Vec::new();
     let mut problems = Vec::new();
-    for path in find_shapefiles(dir) {
+    let (paths, links) = find_shapefiles(dir);
+    for link in links {
+        problems.push(format!(
+            "{}: a link to a directory, not followed (give its target as a directory of its \
+             own, or copy the layers in)",
+            link.strip_prefix(dir).unwrap_or(&link).display()
+        ));
+    }
+    for path in paths {
         let rel = path
             .strip_prefix(dir)
             .unwrap_or(&path)
@@ -160,10 +194,10 @@ pub fn params_text(dir: &Path) -> String {
         s,
         "# edo-city parameters for {}, written by `edo-city init`.\n\
          # These are guesses from layer and field names: check every one, then build with\n\
-         #   edo-city build {} --params <this file> --out out --plan\n\
+         #   edo-city build {} --params <this file> --out out\n\
          # and look at out/plan.png. Keys left out keep the defaults of `edo-city params`.\n",
         dir.display(),
-        dir.display()
+        shell_word(&dir.display().to_string())
     );
     let quote = |v: &str| format!("{v:?}");
     let _ = writeln!(s, "[layers.lots]");

@@ -398,11 +398,12 @@ fn run(cli: Cli) -> Result<()> {
                 }
                 edo_city::output::atomic::write_atomic(&output, text.as_bytes())
                     .with_context(|| format!("cannot write {}", output.display()))?;
+                let word = |p: &std::path::Path| edo_city::init::shell_word(&p.display().to_string());
                 say!(
-                    "wrote {}: check the guesses, then edo-city build {} --params {} --plan",
+                    "wrote {}: check the guesses, then run\n  edo-city build {} --params {} --out out\nand look at out/plan.png",
                     output.display(),
-                    dir.display(),
-                    output.display()
+                    word(&dir),
+                    word(&output)
                 );
             }
             Ok(())

@@ -14,6 +14,12 @@ use serde::{Deserialize, Serialize};
 /// indexes.
 pub const FAR: f64 = 1e8;
 
+/// The lowest and highest ground an elevation may give, metres (the shore of the Dead Sea
+/// lies at -430 m, the top of Everest at 8,849 m). Outside them a number is damaged data or a
+/// no-data value nobody declared (GDAL's float32 -3.4e38): DEM cells are then no-data, lots
+/// and footprints are skipped.
+pub const ELEVATION_RANGE: std::ops::RangeInclusive<f64> = -1000.0..=9000.0;
+
 /// Whether a point is nearer than [`FAR`] to the CRS's origin.
 pub fn sane(c: Coord<f64>) -> bool {
     c.x.abs() < FAR && c.y.abs() < FAR
@@ -150,7 +156,8 @@ pub struct Skipped {
     pub file: String,
     pub id: String,
     /// The record number in the file (from 0, as the FID of QGIS and ArcGIS), where the
-    /// feature came from one. Kept apart from `reason` so skips group by their cause.
+    /// feature came from one; for a row of an attribute table, its row as the spreadsheet
+    /// numbers it (the header is row 1). Kept apart from `reason` so skips group by cause.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub record: Option<usize>,
     pub reason: String,

@@ -296,7 +296,9 @@ fn run_case(case: &Path) {
             toml::from_str(&std::fs::read_to_string(case.join("expect.toml")).unwrap()).unwrap();
         let work = tempfile::tempdir().unwrap();
         for (rel, bytes) in tree(case) {
-            std::fs::write(work.path().join(rel), bytes).unwrap();
+            let to = work.path().join(rel);
+            std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+            std::fs::write(to, bytes).unwrap();
         }
         let out_name = expect.out.clone().unwrap_or_else(|| "out".into());
         let out = work.path().join(&out_name);
@@ -349,6 +351,10 @@ fn run_case(case: &Path) {
                         "{name}: no skip {} {} `{}`: {skipped:#?}",
                         s.layer, s.id, s.reason
                     );
+                }
+                // Every record read is built or listed as skipped.
+                for a in r["accounting"].as_array().unwrap() {
+                    assert_eq!(a["unaccounted"], 0, "{name}: {a}");
                 }
                 if let Some(m) = &expect.message {
                     let said = r["warnings"].to_string() + &r["skipped"].to_string();

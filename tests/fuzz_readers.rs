@@ -9,7 +9,7 @@ use std::io::{Read, Write};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
-use common::fixture;
+use common::{fixture, rezip};
 use edo_city::input::table::{read_csv, read_xlsx};
 use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg64;
@@ -149,27 +149,6 @@ fn workbook(path: &Path) {
         sheet.write(r, 2, 6.5 + r as f64 / 10.0).unwrap();
     }
     book.save(path).unwrap();
-}
-
-/// The workbook's entries, with `damaged` (an entry's name) passed through `f`, zipped again.
-fn rezip(good: &[u8], damaged: &str, f: impl FnOnce(&[u8]) -> Vec<u8>) -> Vec<u8> {
-    let mut zin = zip::ZipArchive::new(std::io::Cursor::new(good)).unwrap();
-    let mut out = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
-    let mut f = Some(f);
-    for i in 0..zin.len() {
-        let mut entry = zin.by_index(i).unwrap();
-        let name = entry.name().unwrap().to_string();
-        let mut bytes = Vec::new();
-        entry.read_to_end(&mut bytes).unwrap();
-        if name == damaged {
-            bytes = (f.take().unwrap())(&bytes);
-        }
-        let options = zip::write::SimpleFileOptions::default()
-            .compression_method(zip::CompressionMethod::Deflated);
-        out.start_file(name, options).unwrap();
-        out.write_all(&bytes).unwrap();
-    }
-    out.finish().unwrap().into_inner()
 }
 
 #[test]

@@ -188,17 +188,34 @@ fn segments(
     out
 }
 
-/// The height attribute, for the template's `height`.
+/// The highest wall a `height` attribute may ask for, metres (castle walls stand 30 m).
+pub const MAX_WALL_HEIGHT: f64 = 100.0;
+
+/// The height attribute, for the template's `height`. A value that is not a height (not a
+/// number, not above 0, over [`MAX_WALL_HEIGHT`]) gives a warning naming the feature, and
+/// the template's own height stands.
 fn height_attr(
     attrs: &std::collections::BTreeMap<String, String>,
     params: &Params,
+    what: &str,
+    warnings: &mut Vec<String>,
 ) -> Vec<(String, f64)> {
-    attr(attrs, &params.fence.height_field)
-        .and_then(|v| v.parse::<f64>().ok())
-        .filter(|h| h.is_finite() && *h > 0.0)
-        .map(|h| ("height".to_string(), h))
-        .into_iter()
-        .collect()
+    let Some(raw) = attr(attrs, &params.fence.height_field) else {
+        return Vec::new();
+    };
+    match raw.trim().parse::<f64>() {
+        Ok(h) if h.is_finite() && h > 0.0 && h <= MAX_WALL_HEIGHT => {
+            vec![("height".to_string(), h)]
+        }
+        _ => {
+            warnings.push(format!(
+                "{what}: `{}` = `{raw}` is not a wall height in metres (above 0, up to \
+                 {MAX_WALL_HEIGHT}); its wall has the template's height",
+                params.fence.height_field
+            ));
+            Vec::new()
+        }
+    }
 }
 
 /// The gate of a walled outline or line, or a warning.
@@ -242,7 +259,7 @@ pub fn plan_lot_fences(
         ground: lot.ground,
         district: lot.district.clone(),
         tile: tiling::tile_id(centroid, params.tile_size, params.tile_origin),
-        attrs: height_attr(&lot.attrs, params),
+        attrs: height_attr(&lot.attrs, params, &what, &mut warnings),
     };
     let mut out = segments(&w, &ring, true, gate, params, &mut warnings);
     let lot_edges = LotEdges::new(&lot.outline);
@@ -310,7 +327,7 @@ pub fn plan_line_fences(
         ground: 0.0,
         district: None,
         tile: tiling::tile_id(centre, params.tile_size, params.tile_origin),
-        attrs: height_attr(&f.attrs, params),
+        attrs: height_attr(&f.attrs, params, &what, &mut warnings),
     };
     let out = segments(&w, &pts, closed, gate, params, &mut warnings);
     (out, warnings)

@@ -130,12 +130,17 @@ pub fn refuse_empty(opts: &BuildOptions, plan: &Plan) -> Result<(), BuildError> 
 }
 
 /// The manifest of the earlier full build that `--tiles` updates.
-pub fn previous_manifest(out: &Path) -> Result<Manifest, BuildError> {
+/// The manifest of the finished build in `out`; `needs` says, for the error, what wants it
+/// (e.g. "--tiles rewrites tiles of an earlier full build").
+pub fn previous_manifest(out: &Path, needs: &str) -> Result<Manifest, BuildError> {
     let path = out.join("manifest.json");
     if !path.exists() {
+        let hint = match manifests_in(out).is_empty() {
+            true => "build the whole city into it first".to_string(),
+            false => "it holds shard outputs: run `edo-city merge` on them first".to_string(),
+        };
         return Err(BuildError::Config(format!(
-            "--tiles rewrites tiles of an earlier full build, but {} has no manifest.json: build \
-             the whole city into it first",
+            "{needs}, but {} holds no finished build (no manifest.json): {hint}",
             out.display()
         )));
     }

@@ -23,6 +23,9 @@ pub struct Dem {
     pub yll: f64,
     pub cell: f64,
     z: Vec<f64>,
+    /// Cells whose value no ground has (outside [`crate::model::ELEVATION_RANGE`]), read as
+    /// no-data: an undeclared no-data value, or damage.
+    pub implausible: usize,
 }
 
 /// An elevation, and whether the point lay outside the grid.
@@ -181,10 +184,34 @@ impl Dem {
                 "a grid of {ncols} x {nrows} cells of {cell} m is empty"
             )));
         }
+        if !(xll.is_finite() && yll.is_finite() && xll.abs() < crate::model::FAR && yll.abs() < crate::model::FAR) {
+            return Err(bad(format!(
+                "the grid's corner ({xll}, {yll}) is not a place within 1e8 m of the CRS's \
+                 origin: the header or the georeferencing is damaged"
+            )));
+        }
+        // Numbers no ground has (an undeclared no-data value such as -3.4e38) are no-data.
+        let mut implausible = 0usize;
+        let z: Vec<f64> = z
+            .into_iter()
+            .map(|v| {
+                if v.is_nan() || crate::model::ELEVATION_RANGE.contains(&v) {
+                    v
+                } else {
+                    implausible += 1;
+                    f64::NAN
+                }
+            })
+            .collect();
         if z.iter().all(|v| v.is_nan()) {
-            return Err(bad("every cell is NODATA".into()));
+            return Err(bad(format!(
+                "every cell is NODATA (or outside {}..{} m)",
+                crate::model::ELEVATION_RANGE.start(),
+                crate::model::ELEVATION_RANGE.end()
+            )));
         }
         Ok(Dem {
+            implausible,
             file,
             ncols,
             nrows,

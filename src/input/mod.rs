@@ -262,10 +262,21 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
     .flatten()
     {
         data.warnings.extend(o.layer.warnings.iter().cloned());
+        for &record in &o.layer.deleted {
+            data.skipped.push(Skipped {
+                layer: o.role.into(),
+                file: o.file.clone(),
+                id: format!("record {record}"),
+                record: Some(record),
+                reason: "the DBF marks the record as deleted (an edit that was never packed): \
+                         it is not built; undelete it, or save the layer as a new file to drop it"
+                    .into(),
+            });
+        }
         data.layers.push(LayerInfo {
             role: o.role.into(),
             file: o.file.clone(),
-            features: o.layer.features.len(),
+            features: o.layer.records,
             encoding: o.layer.encoding.clone(),
             crs: o
                 .src
@@ -349,7 +360,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             )?);
         }
     }
-    data.dem = read_dem(dir, params, &target, &dl.dem.file)?;
+    data.dem = read_dem(dir, params, &target, &dl.dem.file, &mut data.warnings)?;
     for o in [
         &lots,
         &footprints,
@@ -417,6 +428,7 @@ fn read_dem(
     params: &Params,
     target: &Option<Crs>,
     default_file: &str,
+    warnings: &mut Vec<String>,
 ) -> Result<Option<dem::Dem>, InputError> {
     let file = params.layers.dem.file.trim();
     if file.is_empty() {
@@ -454,7 +466,19 @@ fn read_dem(
             });
         }
     }
-    Ok(Some(dem::Dem::read(&path)?))
+    let dem = dem::Dem::read(&path)?;
+    if dem.implausible > 0 {
+        warnings.push(format!(
+            "{}: {} cell(s) hold a number no ground has (outside {}..{} m, such as an \
+             undeclared no-data value like -3.4e38); they are read as NODATA: declare the \
+             value (NODATA_value, or GDAL's no-data tag) to silence this",
+            dem.file,
+            dem.implausible,
+            crate::model::ELEVATION_RANGE.start(),
+            crate::model::ELEVATION_RANGE.end()
+        ));
+    }
+    Ok(Some(dem))
 }
 
 /// "lot" for "lots": how a feature of the layer is called in messages.
@@ -466,7 +490,7 @@ fn singular(layer: &str) -> &str {
 /// with no lot is skipped and reported.
 fn join(
     lots: &mut [Lot],
-    table: table::Table,
+    mut table: table::Table,
     layer: &str,
     skipped: &mut Vec<Skipped>,
 ) -> TableJoin {
@@ -489,7 +513,7 @@ fn join(
         rows_without_feature_ids: Vec::new(),
         features_without_row: 0,
     };
-    for (id, values) in table.rows {
+    for (id, values) in std::mem::take(&mut table.rows) {
         match index.get(&id) {
             Some(targets) => {
                 out.matched += 1;
@@ -514,6 +538,16 @@ fn join(
                 }
             }
         }
+    }
+    out.rows += table.unusable.len();
+    for (row, id, reason) in table.unusable {
+        skipped.push(Skipped {
+            layer: format!("{layer} table"),
+            file: table.file.clone(),
+            id,
+            record: Some(row),
+            reason,
+        });
     }
     out.features_without_row = matched_lots.iter().filter(|m| !**m).count();
     out

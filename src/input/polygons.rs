@@ -89,7 +89,8 @@ pub(super) fn read_lots(
             });
         }
     }
-    if let Some(t) = table {
+    if let Some(mut t) = table {
+        data.warnings.append(&mut t.warnings);
         data.joins
             .push(join(&mut lots, t, "lots", &mut data.skipped));
     }
@@ -107,6 +108,19 @@ pub(super) fn read_lots(
         }
         lot.attrs.remove("\u{0}base_id");
     }
+    lots.retain(|lot| match ground_problem(lot.ground) {
+        None => true,
+        Some(reason) => {
+            data.skipped.push(Skipped {
+                layer: o.role.into(),
+                file: o.file.clone(),
+                id: lot.id.clone(),
+                record: Some(lot.record),
+                reason,
+            });
+            false
+        }
+    });
     if bad_ground > 0 {
         data.warnings.push(format!(
             "{}: {bad_ground} lot(s) have a `{}` that is not a number; they stand on the \
@@ -117,6 +131,10 @@ pub(super) fn read_lots(
     data.lots = lots;
     Ok(())
 }
+
+/// The tallest building a footprint's `height` may give, metres (the tallest tower stands
+/// 828 m).
+pub const MAX_BUILDING_HEIGHT: f64 = 1000.0;
 
 pub(super) fn read_footprints(
     params: &Params,
@@ -154,12 +172,13 @@ pub(super) fn read_footprints(
     // Values that are there but are not positive numbers: counted per field and reported,
     // since the default then stands in for the data.
     let unusable = std::cell::RefCell::new(std::collections::BTreeMap::<String, usize>::new());
-    let number = |r: &AttributeRule, a| {
+    // Up to `max`: a footprint 1e9 m high is damaged data, not a building.
+    let number = |r: &AttributeRule, a, max: f64| {
         let raw = r.value(a)?;
         let n = raw
             .parse::<f64>()
             .ok()
-            .filter(|v| v.is_finite() && *v > 0.0);
+            .filter(|v| v.is_finite() && *v > 0.0 && *v <= max);
         if n.is_none() {
             let field = r.field.clone().unwrap_or_default();
             *unusable.borrow_mut().entry(field).or_default() += 1;
@@ -170,8 +189,8 @@ pub(super) fn read_footprints(
         let Some((polys, z, base_id)) = record_polygons(o, f, &id_field, &mut data.skipped)? else {
             continue;
         };
-        let h = number(&height, &f.attrs)
-            .or_else(|| number(&storeys, &f.attrs).map(|s| s * fp.storey_height + 1.0))
+        let h = number(&height, &f.attrs, MAX_BUILDING_HEIGHT)
+            .or_else(|| number(&storeys, &f.attrs, 200.0).map(|s| s * fp.storey_height + 1.0))
             .unwrap_or(fp.default_height);
         let g = ground
             .value(&f.attrs)
@@ -188,6 +207,16 @@ pub(super) fn read_footprints(
             &mut seen,
             &mut data.skipped,
         ) {
+            if let Some(reason) = ground_problem(g) {
+                data.skipped.push(Skipped {
+                    layer: o.role.into(),
+                    file: o.file.clone(),
+                    id,
+                    record: Some(f.record),
+                    reason,
+                });
+                continue;
+            }
             data.footprints.push(Footprint {
                 id,
                 record: f.record,
@@ -201,12 +230,28 @@ pub(super) fn read_footprints(
     }
     for (field, n) in unusable.into_inner() {
         data.warnings.push(format!(
-            "{}: {n} footprint(s) have a `{field}` that is not a positive number; their \
-             height came from the next source (height, storeys x storey_height, default_height)",
+            "{}: {n} footprint(s) have a `{field}` that is not a positive number (heights up \
+             to {MAX_BUILDING_HEIGHT} m, storeys up to 200); their height came from the next \
+             source (height, storeys x storey_height, default_height)",
             o.file
         ));
     }
     Ok(())
+}
+
+/// Why a ground elevation cannot be a place's, if it cannot (see
+/// [`crate::model::ELEVATION_RANGE`]).
+fn ground_problem(ground: f64) -> Option<String> {
+    let range = crate::model::ELEVATION_RANGE;
+    (!range.contains(&ground)).then(|| {
+        format!(
+            "the ground elevation {ground} m (the `ground` field or the lowest Z) is outside \
+             {}..{} m: the Z values are damaged or in another unit; correct them, or map \
+             `ground` to a field that holds metres",
+            range.start(),
+            range.end()
+        )
+    })
 }
 
 /// Gives every lot and footprint without a district the district holding its centroid.

@@ -35,6 +35,46 @@ pub struct Layer {
     /// The `.prj` text, if present.
     pub prj: Option<String>,
     pub warnings: Vec<String>,
+    /// Records in the file, deleted ones included (the FIDs run 0..records).
+    pub records: usize,
+    /// Records the DBF marks as deleted: they have no feature and are reported skipped.
+    pub deleted: Vec<usize>,
+}
+
+/// The text of a sidecar file (`.cpg`, `.prj`): `None` when there is none, `Err` saying what
+/// is wrong when it is there but cannot be read (a directory, no permission, not text).
+fn sidecar(path: &Path) -> Result<Option<String>, String> {
+    match std::fs::read(path) {
+        Ok(bytes) => match String::from_utf8(bytes) {
+            Ok(text) => Ok(Some(text)),
+            Err(e) => match e.as_bytes().iter().any(|b| *b == 0 || *b > 0x7e && *b < 0xa0) {
+                true => Err(format!("{} is not a text file", path.display())),
+                // A Latin-1 WKT (a degree sign in a name, say) is still WKT.
+                false => Ok(Some(encoding_rs::WINDOWS_1252.decode(e.as_bytes()).0.into_owned())),
+            },
+        },
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(_) if path.is_dir() => Err(format!("{} is a directory, not a file", path.display())),
+        Err(e) => Err(format!("cannot read {}: {e}", path.display())),
+    }
+}
+
+/// The deletion flag of every record of a DBF, read from the file itself (byte 0 of each
+/// record is `*` for deleted, ` ` for live).
+fn deletion_flags(path: &Path) -> std::io::Result<Vec<bool>> {
+    let bytes = std::fs::read(path)?;
+    if bytes.len() < 12 {
+        return Ok(Vec::new());
+    }
+    let n = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]) as usize;
+    let header = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let len = u16::from_le_bytes([bytes[10], bytes[11]]) as usize;
+    if len == 0 {
+        return Ok(Vec::new());
+    }
+    Ok((0..n)
+        .map_while(|i| bytes.get(header + i * len).map(|b| *b == b'*'))
+        .collect())
 }
 
 /// Maps a code page name (from a `.cpg` or the parameter file) to an encoding.
@@ -93,7 +133,10 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
         _ => io("cannot open the .dbf", e),
     })?;
 
-    let cpg = std::fs::read_to_string(path.with_extension("cpg")).ok();
+    let cpg = sidecar(&path.with_extension("cpg")).unwrap_or_else(|why| {
+        warnings.push(format!("{why}; reading the DBF by its header"));
+        None
+    });
     let (encoding, encoding_name) = if !forced.trim().is_empty() {
         let enc = encoding_for(forced).ok_or_else(|| InputError::Layer {
             file: file.clone(),
@@ -126,11 +169,35 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
             message: format!("cannot read the DBF ({e}); {DAMAGED}"),
         })?;
     let fields: Vec<String> = dbf.fields().iter().map(|f| f.name().to_string()).collect();
+    for (i, name) in fields.iter().enumerate() {
+        if let Some(j) = fields[i + 1..].iter().position(|n| n == name) {
+            warnings.push(format!(
+                "{}: two fields are named `{name}` (fields {} and {}); only the later one's \
+                 values are read: rename one of them in the GIS",
+                dbf_path.display(),
+                i + 1,
+                i + j + 2
+            ));
+        }
+    }
     let records = dbf.read().map_err(|e| InputError::Layer {
         file: dbf_path.display().to_string(),
         message: format!("cannot read the DBF records ({e}); {DAMAGED}"),
     })?;
-    if records.len() != shapes.len() {
+    // dBASE marks a deleted record with '*' and keeps it until the table is packed; the
+    // dbase crate leaves such records out, so they are paired with their shapes here.
+    let flags = deletion_flags(&dbf_path).unwrap_or_default();
+    let deleted: Vec<usize> = flags
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| **d)
+        .map(|(i, _)| i)
+        .collect();
+    let deleted = match flags.len() == shapes.len() && records.len() + deleted.len() == shapes.len() {
+        true => deleted,
+        false => Vec::new(),
+    };
+    if records.len() + deleted.len() != shapes.len() {
         return Err(InputError::Layer {
             file: file.clone(),
             message: format!(
@@ -143,7 +210,12 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
 
     let mut garbled = 0usize;
     let mut features = Vec::with_capacity(shapes.len());
-    for (record, (shape, rec)) in shapes.into_iter().zip(records).enumerate() {
+    let is_deleted: std::collections::HashSet<usize> = deleted.iter().copied().collect();
+    let kept = shapes
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| !is_deleted.contains(i));
+    for ((record, shape), rec) in kept.zip(records) {
         let mut attrs = BTreeMap::new();
         for (name, value) in rec.into_iter() {
             let text = field_text(&value);
@@ -165,8 +237,16 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
              `encoding = \"shift_jis\"` for this layer in the parameter file"
         ));
     }
-    let prj = std::fs::read_to_string(path.with_extension("prj")).ok();
+    let prj = sidecar(&path.with_extension("prj")).map_err(|why| InputError::Layer {
+        file: file.clone(),
+        message: format!(
+            "{why}: the .prj says which coordinate system the layer is in; replace it with \
+             the layer's own .prj, or remove it and set `crs`"
+        ),
+    })?;
     Ok(Layer {
+        records: features.len() + deleted.len(),
+        deleted,
         path: path.to_path_buf(),
         features,
         encoding: encoding_name,

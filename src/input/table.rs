@@ -14,8 +14,95 @@ use super::InputError;
 #[derive(Debug, Clone, Default)]
 pub struct Table {
     pub file: String,
-    /// Rows in file order: (id, values).
+    /// Rows in file order: (id, values), each id once.
     pub rows: Vec<(String, BTreeMap<String, String>)>,
+    /// Rows not used, as the spreadsheet numbers them (the header is row 1), with the id
+    /// and why: a repeated id (the first row with it is used), an id that is a date.
+    pub unusable: Vec<(usize, String, String)>,
+    /// What the reader noticed and the user should know (ignored files, unnamed columns,
+    /// formulas without values).
+    pub warnings: Vec<String>,
+}
+
+impl Table {
+    /// A table from its header and rows (row numbers as the spreadsheet shows them): drops
+    /// rows without an id, keeps the first row of each id, and warns about columns without a
+    /// name that hold values.
+    fn assemble(
+        path: &Path,
+        headers: &[String],
+        id_col: usize,
+        rows: Vec<(usize, Vec<String>)>,
+    ) -> Result<Table, InputError> {
+        for (i, h) in headers.iter().enumerate() {
+            if h.is_empty() {
+                continue;
+            }
+            if let Some(j) = headers[i + 1..].iter().position(|x| x == h) {
+                return Err(table_error(
+                    path,
+                    format!(
+                        "columns {} and {} are both named `{h}`, so it is not clear which to \
+                         use: rename one of them",
+                        column_name(i),
+                        column_name(i + j + 1)
+                    ),
+                ));
+            }
+        }
+        let mut t = Table {
+            file: path.display().to_string(),
+            ..Table::default()
+        };
+        let unnamed: Vec<String> = (0..headers.len())
+            .filter(|&i| headers[i].is_empty())
+            .filter(|&i| rows.iter().any(|(_, v)| v.get(i).is_some_and(|x| !x.is_empty())))
+            .map(column_name)
+            .collect();
+        if !unnamed.is_empty() {
+            t.warnings.push(format!(
+                "{}: column(s) {} hold values but have no name in the header row (a merged \
+                 header cell?); their values are not used: give each column a name of its own",
+                t.file,
+                unnamed.join(", ")
+            ));
+        }
+        let mut first: std::collections::HashMap<String, usize> = Default::default();
+        for (n, values) in rows {
+            let (id, map) = make_row(headers, values, id_col);
+            if id.is_empty() {
+                continue;
+            }
+            match first.get(&id) {
+                Some(&row) => t.unusable.push((
+                    n,
+                    id,
+                    format!(
+                        "row {row} has the same id and was used; this row was not: merge the \
+                         two rows or correct the id"
+                    ),
+                )),
+                None => {
+                    first.insert(id.clone(), n);
+                    t.rows.push((id, map));
+                }
+            }
+        }
+        Ok(t)
+    }
+}
+
+/// A spreadsheet's name for column `i` (from 0): A, B, ..., Z, AA, ...
+fn column_name(i: usize) -> String {
+    let mut n = i + 1;
+    let mut out = Vec::new();
+    while n > 0 {
+        n -= 1;
+        out.push(b'A' + (n % 26) as u8);
+        n /= 26;
+    }
+    out.reverse();
+    String::from_utf8(out).unwrap_or_default()
 }
 
 /// Finds `<base>.csv` or `<base>.xlsx` in `dir`; `Ok(None)` when neither exists.
@@ -31,7 +118,16 @@ pub fn find_and_read(
     let csv = dir.join(format!("{base}.csv"));
     let xlsx = dir.join(format!("{base}.xlsx"));
     if csv.exists() {
-        read_csv(&csv, id_field).map(Some)
+        let mut t = read_csv(&csv, id_field)?;
+        if xlsx.exists() {
+            t.warnings.push(format!(
+                "both {} and {} are there; the CSV was joined and the workbook ignored: remove \
+                 or rename the one that is not current",
+                csv.display(),
+                xlsx.display()
+            ));
+        }
+        Ok(Some(t))
     } else if xlsx.exists() {
         read_xlsx(&xlsx, sheet, id_field).map(Some)
     } else {
@@ -67,13 +163,9 @@ pub fn read_csv(path: &Path, id_field: &str) -> Result<Table, InputError> {
     let mut rows = Vec::new();
     for (n, record) in reader.records().enumerate() {
         let record = record.map_err(|e| table_error(path, format!("row {}: {e}", n + 2)))?;
-        let values: Vec<String> = record.iter().map(|v| v.trim().to_string()).collect();
-        rows.push(make_row(&headers, values, id_col));
+        rows.push((n + 2, record.iter().map(|v| v.trim().to_string()).collect()));
     }
-    Ok(Table {
-        file: path.display().to_string(),
-        rows,
-    })
+    Table::assemble(path, &headers, id_col, rows)
 }
 
 /// Reads the named sheet (or the first) of an XLSX workbook, first row as header.
@@ -100,28 +192,75 @@ pub fn read_xlsx(path: &Path, sheet: &str, id_field: &str) -> Result<Table, Inpu
     let range = book
         .worksheet_range(&name)
         .map_err(|e| table_error(path, format!("sheet `{name}`: {e}")))?;
+    // Row numbers as the spreadsheet shows them: the range may start below row 1.
+    let top = range.start().map_or(0, |(r, _)| r as usize);
+    let left = range.start().map_or(0, |(_, c)| c as usize);
     let mut it = range.rows();
-    let headers: Vec<String> = match it.next() {
-        Some(h) => h.iter().map(|c| cell_text(c).trim().to_string()).collect(),
-        None => {
-            return Ok(Table {
-                file: path.display().to_string(),
-                rows: Vec::new(),
-            })
-        }
+    let Some(header) = it.next() else {
+        return Err(table_error(
+            path,
+            format!(
+                "sheet `{name}` is empty (the workbook has: {}); put the table on the first \
+                 sheet or name its sheet in `sheet`",
+                names.join(", ")
+            ),
+        ));
     };
-    let id_col = column(&headers, id_field, path)?;
-    let rows = it
-        .map(|r| {
-            let values = r.iter().map(|c| cell_text(c).trim().to_string()).collect();
-            make_row(&headers, values, id_col)
-        })
-        .filter(|(id, _)| !id.is_empty())
+    // Columns left of the range are empty in the spreadsheet; keep the letters right.
+    let headers: Vec<String> = std::iter::repeat_n(String::new(), left)
+        .chain(header.iter().map(|c| cell_text(c).trim().to_string()))
         .collect();
-    Ok(Table {
-        file: path.display().to_string(),
-        rows,
-    })
+    let id_col = column(&headers, id_field, path)?;
+    let mut rows = Vec::new();
+    let mut dates = Vec::new();
+    for (k, r) in it.enumerate() {
+        let n = top + k + 2;
+        let values: Vec<String> = std::iter::repeat_n(String::new(), left)
+            .chain(r.iter().map(|c| cell_text(c).trim().to_string()))
+            .collect();
+        if let Some(cell) = r.get(id_col.wrapping_sub(left)) {
+            if matches!(cell, Data::DateTime(_) | Data::DateTimeIso(_)) {
+                dates.push((n, values.get(id_col).cloned().unwrap_or_default()));
+                continue;
+            }
+        }
+        rows.push((n, values));
+    }
+    let mut t = Table::assemble(path, &headers, id_col, rows)?;
+    for (n, id) in dates {
+        t.unusable.push((
+            n,
+            id,
+            format!(
+                "the id is a date, not text (a spreadsheet reads ids such as 1-2 as dates): \
+                 format the `{id_field}` column as text and type the ids again"
+            ),
+        ));
+    }
+    // A formula saved without its value (written by a script, never opened in a
+    // spreadsheet program) reads as an empty cell.
+    if let Ok(formulas) = book.worksheet_formula(&name) {
+        let lost = formulas
+            .cells()
+            .filter(|(_, _, f)| !f.is_empty())
+            .filter(|(r, c, _)| {
+                let (r, c) = (
+                    formulas.start().map_or(0, |s| s.0) + *r as u32,
+                    formulas.start().map_or(0, |s| s.1) + *c as u32,
+                );
+                matches!(range.get_value((r, c)), None | Some(Data::Empty))
+            })
+            .count();
+        if lost > 0 {
+            t.warnings.push(format!(
+                "{}: {lost} formula cell(s) of sheet `{name}` have no saved value and read as \
+                 empty: open the workbook in Excel or LibreOffice and save it, so the values \
+                 are stored",
+                t.file
+            ));
+        }
+    }
+    Ok(t)
 }
 
 fn column(headers: &[String], id_field: &str, path: &Path) -> Result<usize, InputError> {

@@ -55,6 +55,32 @@ pub(super) fn degrees_in_metres(o: &Opened, params: &Params, warnings: &mut Vec<
     }
 }
 
+/// Refuses a layer said to be in longitude/latitude (by its `.prj`) whose coordinates go past
+/// +-180 / +-90: metres under a degrees `.prj` (one copied from another file) would fail to
+/// reproject feature by feature, and the layer would be lost in a list of skips.
+fn metres_in_degrees(o: &Opened) -> Result<(), InputError> {
+    let Some(src) = o.src.as_ref().filter(|c| c.is_geographic()) else {
+        return Ok(());
+    };
+    let outside = layer_coords(o)
+        .into_iter()
+        .filter(|c| c.x.is_finite() && c.y.is_finite())
+        .find(|c| c.x.abs() > 180.0 + 1e-9 || c.y.abs() > 90.0 + 1e-9);
+    match outside {
+        None => Ok(()),
+        Some(c) => Err(InputError::Layer {
+            file: o.file.clone(),
+            message: format!(
+                "its .prj says longitude/latitude degrees ({}) but a coordinate is ({}, {}), \
+                 far past +-180 / +-90: the numbers are projected metres and the .prj belongs \
+                 to another file; put the layer's own .prj beside it, or remove the .prj and \
+                 set `crs` to the CRS the numbers are in",
+                src.definition, c.x, c.y
+            ),
+        }),
+    }
+}
+
 /// Chooses the output CRS and the CRS of every layer, with warnings for what was assumed.
 pub(super) fn resolve_crs(
     params: &Params,
@@ -105,6 +131,7 @@ pub(super) fn resolve_crs(
                 None
             }
         };
+        metres_in_degrees(o)?;
     }
     if target.is_none() {
         // The first layer (lots, else footprints, streets, blocks) decides.

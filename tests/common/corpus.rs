@@ -11,7 +11,7 @@ use dbase::{FieldName, FieldValue, Record, TableWriterBuilder};
 use shapefile::{Point, Polygon, PolygonRing, Polyline};
 
 /// The good town's lots: id and ring (counter-clockwise).
-fn good_lots() -> Vec<(String, Vec<[f64; 2]>)> {
+pub(super) fn good_lots() -> Vec<(String, Vec<[f64; 2]>)> {
     (0..3)
         .map(|i| {
             let x = -22_000.0 + 10.0 * i as f64;
@@ -24,18 +24,18 @@ fn good_lots() -> Vec<(String, Vec<[f64; 2]>)> {
         .collect()
 }
 
-const PRJ: &str = "PROJCS[\"JGD2011 / Japan Plane Rectangular CS VI\",GEOGCS[\"JGD2011\",\
+pub(super) const PRJ: &str = "PROJCS[\"JGD2011 / Japan Plane Rectangular CS VI\",GEOGCS[\"JGD2011\",\
 DATUM[\"Japanese_Geodetic_Datum_2011\",SPHEROID[\"GRS 1980\",6378137,298.257222101]],\
 PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],\
 PARAMETER[\"latitude_of_origin\",36],PARAMETER[\"central_meridian\",136],\
 PARAMETER[\"scale_factor\",0.9999],PARAMETER[\"false_easting\",0],PARAMETER[\"false_northing\",0],\
 UNIT[\"metre\",1]]";
 
-fn name(n: &str) -> FieldName {
+pub(super) fn name(n: &str) -> FieldName {
     FieldName::try_from(n).unwrap()
 }
 
-fn ring(r: &[[f64; 2]]) -> Vec<Point> {
+pub(super) fn ring(r: &[[f64; 2]]) -> Vec<Point> {
     // Shapefile outer rings are clockwise: write ours reversed, closed.
     let mut pts: Vec<Point> = r.iter().rev().map(|p| Point::new(p[0], p[1])).collect();
     if let Some(first) = pts.first().copied() {
@@ -46,7 +46,7 @@ fn ring(r: &[[f64; 2]]) -> Vec<Point> {
 
 /// A lots layer: each feature an id (text), a `use`, and one or more rings (outer, then
 /// holes); `.cpg` UTF-8 and the zone VI `.prj`.
-fn write_lots(dir: &Path, lots: &[(String, &str, Vec<PolygonRing<Point>>)]) {
+pub(super) fn write_lots(dir: &Path, lots: &[(String, &str, Vec<PolygonRing<Point>>)]) {
     let table = TableWriterBuilder::new()
         .add_character_field(name("id"), 12)
         .add_character_field(name("use"), 10);
@@ -67,7 +67,7 @@ fn write_lots(dir: &Path, lots: &[(String, &str, Vec<PolygonRing<Point>>)]) {
     std::fs::write(dir.join("lots.prj"), PRJ).unwrap();
 }
 
-fn simple(
+pub(super) fn simple(
     lots: Vec<(String, Vec<[f64; 2]>)>,
 ) -> Vec<(String, &'static str, Vec<PolygonRing<Point>>)> {
     lots.into_iter()
@@ -75,7 +75,7 @@ fn simple(
         .collect()
 }
 
-fn write_street(dir: &Path) {
+pub(super) fn write_street(dir: &Path) {
     let table = TableWriterBuilder::new()
         .add_character_field(name("id"), 4)
         .add_numeric_field(name("width"), 6, 2);
@@ -95,20 +95,20 @@ fn write_street(dir: &Path) {
 }
 
 /// The good town plus one extra lot.
-fn town_with(dir: &Path, extra: (String, Vec<[f64; 2]>)) {
+pub(super) fn town_with(dir: &Path, extra: (String, Vec<[f64; 2]>)) {
     let mut lots = good_lots();
     lots.push(extra);
     write_lots(dir, &simple(lots));
     write_street(dir);
 }
 
-fn good_town(dir: &Path) {
+pub(super) fn good_town(dir: &Path) {
     write_lots(dir, &simple(good_lots()));
     write_street(dir);
 }
 
 /// A strip lot of the good town's shape at `x` metres east of the first.
-fn strip(x: f64) -> Vec<[f64; 2]> {
+pub(super) fn strip(x: f64) -> Vec<[f64; 2]> {
     let (x, y) = (-22_000.0 + x, -110_000.0);
     vec![[x, y], [x + 5.0, y], [x + 5.0, y + 25.0], [x, y + 25.0]]
 }
@@ -136,6 +136,13 @@ pub struct Case {
 
 /// Every case of the corpus.
 pub fn cases() -> Vec<Case> {
+    let mut all = base_cases();
+    all.extend(super::corpus_ledger::cases());
+    all
+}
+
+/// The first cases: damaged files, bad parameters, degenerate geometry.
+fn base_cases() -> Vec<Case> {
     vec![
         // ---- errors: exit code 2, nothing written -------------------------------------
         Case {

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod corpus;
+mod corpus_ledger;
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -279,4 +280,27 @@ pub fn old_and_new(town: &Path, work: &Path) -> OldAndNew {
         old_files: all_files(&old_ref),
         new_files: all_files(&new_ref),
     }
+}
+
+/// A zip archive's entries (an XLSX workbook's), with the entry named `entry` passed
+/// through `f`, zipped again: the way to damage or edit a workbook's XML past the checksums.
+pub fn rezip(good: &[u8], entry: &str, f: impl FnOnce(&[u8]) -> Vec<u8>) -> Vec<u8> {
+    use std::io::{Read, Write};
+    let mut zin = zip::ZipArchive::new(std::io::Cursor::new(good)).unwrap();
+    let mut out = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let mut f = Some(f);
+    for i in 0..zin.len() {
+        let mut e = zin.by_index(i).unwrap();
+        let name = e.name().unwrap().to_string();
+        let mut bytes = Vec::new();
+        e.read_to_end(&mut bytes).unwrap();
+        if name == entry {
+            bytes = (f.take().unwrap())(&bytes);
+        }
+        let options = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated);
+        out.start_file(name, options).unwrap();
+        out.write_all(&bytes).unwrap();
+    }
+    out.finish().unwrap().into_inner()
 }

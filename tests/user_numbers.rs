@@ -1,0 +1,141 @@
+//! Every size and number a user gives is checked before anything is allocated: random
+//! user-sized numbers (0, negative, tiny, huge, NaN, infinite, 2^64-1) for parameter keys,
+//! shard counts and thread counts go to the real binary under a memory limit; it builds or
+//! refuses with exit code 2, and never panics, aborts or runs out of memory (issue 17).
+
+mod common;
+
+use std::process::Command;
+
+use proptest::prelude::*;
+
+/// Numbers people type by mistake, and the edges of the types that hold them.
+const NUMBERS: &[&str] = &[
+    "0", "1", "-1", "-5", "0.5", "1e-300", "3", "40", "1e6", "1e9", "1e12", "1e300", "-1e300",
+    "nan", "inf", "-inf", "18446744073709551615", "9223372036854775807", "2.5e8",
+];
+
+/// Parameter keys that take a number (`table.key`), and whether the key is a point `[x, y]`.
+const KEYS: &[(&str, bool)] = &[
+    ("tile_size", false),
+    ("origin", true),
+    ("tile_origin", true),
+    ("people.per_100m", false),
+    ("people.max_points_per_tile", false),
+    ("people.min_spacing", false),
+    ("trees.per_ha", false),
+    ("trees.per_ha_machiya", false),
+    ("trees.max_points_per_tile", false),
+    ("fence.gate_width", false),
+    ("machiya.depth", false),
+    ("machiya.min_depth", false),
+    ("kura.width", false),
+    ("kura.gap", false),
+    ("simplify.tolerance", false),
+    ("simplify.max_vertices", false),
+    ("layers.streets.default_width", false),
+    ("type_mix.hiraya", false),
+    ("frontage.max_angle_deg", false),
+];
+
+/// The TOML of one key set to one number.
+fn toml_of(key: &str, point: bool, value: &str) -> String {
+    let v = if point {
+        format!("[{value}, {value}]")
+    } else {
+        value.to_string()
+    };
+    match key.rsplit_once('.') {
+        Some((table, k)) => format!("[{table}]\n{k} = {v}\n"),
+        None => format!("{key} = {v}\n"),
+    }
+}
+
+/// Runs `edo-city <args>` under an address-space limit (8 GiB: a build of the example town
+/// needs under 200 MB); returns the exit code (None when killed by a signal) and stderr.
+fn run_limited(args: &[String]) -> (Option<i32>, String) {
+    let bin = assert_cmd::cargo::cargo_bin("edo-city");
+    let mut line = format!("ulimit -v 8388608; exec '{}'", bin.display());
+    for a in args {
+        line.push_str(&format!(" '{}'", a.replace('\'', "'\\''")));
+    }
+    let o = Command::new("sh").arg("-c").arg(&line).output().unwrap();
+    (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+fn no_panic(code: Option<i32>, stderr: &str, what: &str) {
+    assert!(
+        matches!(code, Some(0) | Some(2)),
+        "{what}: exit {code:?} (a signal or an abort): {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{what}: {stderr}");
+    assert!(!stderr.contains("memory allocation"), "{what}: {stderr}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn any_number_for_a_parameter_builds_or_is_refused_naming_the_key(
+        k in 0..KEYS.len(),
+        n in 0..NUMBERS.len(),
+    ) {
+        let (key, point) = KEYS[k];
+        let value = NUMBERS[n];
+        let dir = tempfile::tempdir().unwrap();
+        let params = dir.path().join("p.toml");
+        std::fs::write(&params, toml_of(key, point, value)).unwrap();
+        let out = dir.path().join("out");
+        let args: Vec<String> = [
+            "build",
+            common::fixture("kyoto-small").to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+            "--no-plan",
+            "--params",
+            params.to_str().unwrap(),
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let (code, stderr) = run_limited(&args);
+        let what = format!("{key} = {value}");
+        no_panic(code, &stderr, &what);
+        if code == Some(2) {
+            let last = key.rsplit('.').next().unwrap();
+            prop_assert!(
+                stderr.contains(last) || stderr.contains("p.toml"),
+                "{}: the error names neither the key nor the file: {}", what, stderr
+            );
+        }
+    }
+
+    #[test]
+    fn any_shard_or_thread_count_builds_or_is_refused(
+        i in 0..NUMBERS.len(),
+        n in 0..NUMBERS.len(),
+        j in 0..NUMBERS.len(),
+    ) {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let input = common::fixture("kyoto-small");
+        let base = |extra: &[String]| {
+            let mut a: Vec<String> = vec![
+                "build".into(),
+                input.display().to_string(),
+                "--out".into(),
+                out.display().to_string(),
+                "--quiet".into(),
+                "--no-plan".into(),
+            ];
+            a.extend_from_slice(extra);
+            a
+        };
+        let shard = format!("{}/{}", NUMBERS[i], NUMBERS[n]);
+        let (code, stderr) = run_limited(&base(&["--shard".into(), shard.clone()]));
+        no_panic(code, &stderr, &format!("--shard {shard}"));
+        let (code, stderr) = run_limited(&base(&["-j".into(), NUMBERS[j].into()]));
+        no_panic(code, &stderr, &format!("-j {}", NUMBERS[j]));
+    }
+}
