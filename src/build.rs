@@ -264,16 +264,30 @@ fn run(
     // run at a time in the directory, and never a second hypothesis in it.
     let existed = opts.out.exists();
     std::fs::create_dir_all(&opts.out).map_err(|e| write_err(&opts.out, e))?;
-    let lock = output::lock::OutLock::acquire(&opts.out).map_err(|e| {
-        BuildError::Config(e.to_string())
-    })?;
+    let lock =
+        output::lock::OutLock::acquire(&opts.out).map_err(|e| BuildError::Config(e.to_string()))?;
     let written = shards::check_out_dir(opts)
         .and_then(|()| shards::refuse_empty(opts, &plan))
-        .and_then(|()| write_city(opts, catalog, texture_set, progress, data, plan, timings, t0));
+        .and_then(|()| {
+            write_city(
+                opts,
+                catalog,
+                texture_set,
+                progress,
+                data,
+                plan,
+                timings,
+                t0,
+            )
+        });
     drop(lock);
     if written.is_err() && !existed {
         // Leave no directory behind that the user did not have before (only empty ones go).
-        for dir in [opts.out.join("tiles"), opts.out.join("textures"), opts.out.clone()] {
+        for dir in [
+            opts.out.join("tiles"),
+            opts.out.join("textures"),
+            opts.out.clone(),
+        ] {
             let _ = std::fs::remove_dir(dir);
         }
     }
@@ -474,7 +488,10 @@ pub fn draw_plan_of(out: &Path, tile: Option<&str>) -> Result<Vec<u8>, BuildErro
 }
 
 /// Draws the plan of the build a manifest describes (see [`draw_plan_of`]).
-pub fn draw_plan_from(manifest: &report::Manifest, tile: Option<&str>) -> Result<Vec<u8>, BuildError> {
+pub fn draw_plan_from(
+    manifest: &report::Manifest,
+    tile: Option<&str>,
+) -> Result<Vec<u8>, BuildError> {
     let params = &manifest.params;
     let templates = manifest.input.templates.as_ref().map(PathBuf::from);
     let catalog = load_catalog(params, templates.as_deref())?;
@@ -604,7 +621,11 @@ fn input_summary(
     // A skip that names only its feature gets its record, so the ledger closes after the
     // manifest's round trip too (`--tiles`, `merge`).
     for skip in s.skipped.iter_mut().filter(|k| k.record.is_none()) {
-        if let Some(l) = s.ledgers.iter().find(|l| l.role == skip.layer && l.file == skip.file) {
+        if let Some(l) = s
+            .ledgers
+            .iter()
+            .find(|l| l.role == skip.layer && l.file == skip.file)
+        {
             skip.record = l.ids.get(&skip.id).copied();
         }
     }

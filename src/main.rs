@@ -280,8 +280,8 @@ fn run(cli: Cli) -> Result<()> {
             seed,
             force,
         } => {
-            let s = edo_city::synth::write_town(&dir, lots, seed, force)
-                .map_err(anyhow::Error::msg)?;
+            let s =
+                edo_city::synth::write_town(&dir, lots, seed, force).map_err(anyhow::Error::msg)?;
             say!(
                 "wrote {}: {} lots ({} machiya), {} blocks, {} streets",
                 dir.display(),
@@ -398,7 +398,8 @@ fn run(cli: Cli) -> Result<()> {
                 }
                 edo_city::output::atomic::write_atomic(&output, text.as_bytes())
                     .with_context(|| format!("cannot write {}", output.display()))?;
-                let word = |p: &std::path::Path| edo_city::init::shell_word(&p.display().to_string());
+                let word =
+                    |p: &std::path::Path| edo_city::init::shell_word(&p.display().to_string());
                 say!(
                     "wrote {}: check the guesses, then run\n  edo-city build {} --params {} --out out\nand look at out/plan.png",
                     output.display(),

@@ -428,7 +428,11 @@ impl Params {
                 crate::input::MAX_STREET_WIDTH,
             ),
             ("layers.footprints.storey_height", fp.storey_height, 100.0),
-            ("layers.footprints.default_height", fp.default_height, 1000.0),
+            (
+                "layers.footprints.default_height",
+                fp.default_height,
+                1000.0,
+            ),
             (
                 "layers.street_widths.max_distance",
                 self.layers.street_widths.max_distance,
@@ -533,7 +537,11 @@ impl Params {
                 check_mix(&format!("district.{id}.type_mix"), mix)?;
             }
             for (key, v, high) in [
-                ("people_per_100m", d.people_per_100m, billboards::MAX_PER_100M),
+                (
+                    "people_per_100m",
+                    d.people_per_100m,
+                    billboards::MAX_PER_100M,
+                ),
                 ("trees_per_ha", d.trees_per_ha, billboards::MAX_PER_HA),
                 (
                     "trees_per_ha_machiya",

@@ -86,7 +86,7 @@ pub fn make_town(lots_wanted: usize, seed: u64) -> Town {
     let blocks_needed = lots_wanted.div_ceil(60).max(1);
     let nx = (blocks_needed as f64).sqrt().ceil() as usize;
     let ny = blocks_needed.div_ceil(nx);
-    let width = |i: usize| if i % 4 == 0 { AVENUE } else { STREET };
+    let width = |i: usize| if i.is_multiple_of(4) { AVENUE } else { STREET };
     // Street centreline positions along each axis.
     let lines = |n: usize| {
         let mut pos = vec![0.0];

@@ -52,11 +52,7 @@ fn a_lock_file_left_by_a_killed_run_does_not_block() {
     let out = dir.path().join("out");
     std::fs::create_dir_all(&out).unwrap();
     // A killed run leaves its file (with its pid) but not its lock: the OS lock died with it.
-    std::fs::write(
-        out.join(edo_city::output::lock::LOCK_FILE),
-        "4194303",
-    )
-    .unwrap();
+    std::fs::write(out.join(edo_city::output::lock::LOCK_FILE), "4194303").unwrap();
     build_ok(&fixture("kyoto-small"), &out, &["--quiet", "--no-plan"]);
 }
 
@@ -72,7 +68,11 @@ fn two_hypotheses_started_together_never_mix_in_one_directory() {
         let _ = std::fs::remove_dir_all(&out);
         let spawn = |params: Option<&Path>| {
             let mut c = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
-            c.arg("build").arg(&town).arg("--out").arg(&out).args(["--quiet", "--no-plan"]);
+            c.arg("build")
+                .arg(&town)
+                .arg("--out")
+                .arg(&out)
+                .args(["--quiet", "--no-plan"]);
             if let Some(p) = params {
                 c.arg("--params").arg(p);
             }
@@ -143,7 +143,10 @@ fn merge_checks_every_shard_file_and_writes_nothing_when_one_is_cut_short() {
     let o = edo_city().arg("merge").arg(&a).arg(&b).output().unwrap();
     assert_eq!(o.status.code(), Some(2));
     let e = stderr_of(&o);
-    assert!(e.contains("cut short or changed") && e.contains(&tile), "{e}");
+    assert!(
+        e.contains("cut short or changed") && e.contains(&tile),
+        "{e}"
+    );
     assert!(!a.join("manifest.json").exists(), "no merged manifest");
     assert!(!a.join(&tile).exists(), "nothing copied");
 
@@ -151,7 +154,10 @@ fn merge_checks_every_shard_file_and_writes_nothing_when_one_is_cut_short() {
     std::fs::remove_file(b.join(&tile)).unwrap();
     let o = edo_city().arg("merge").arg(&a).arg(&b).output().unwrap();
     let e = stderr_of(&o);
-    assert!(e.contains("cannot be read") && e.contains("run that shard again"), "{e}");
+    assert!(
+        e.contains("cannot be read") && e.contains("run that shard again"),
+        "{e}"
+    );
 
     // Restored, the merge works, from another working directory too (the manifests name
     // the input by its absolute path).
@@ -166,7 +172,10 @@ fn merge_checks_every_shard_file_and_writes_nothing_when_one_is_cut_short() {
         .unwrap();
     assert!(o.status.success(), "{}", stderr_of(&o));
     assert!(a.join("plan.png").exists());
-    assert_eq!(read_json(&a.join("manifest.json"))["input"]["input"], town.canonicalize().unwrap().display().to_string());
+    assert_eq!(
+        read_json(&a.join("manifest.json"))["input"]["input"],
+        town.canonicalize().unwrap().display().to_string()
+    );
 }
 
 #[test]
@@ -232,7 +241,11 @@ fn an_empty_tile_id_is_named() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr_of(&o).contains("a tile id is empty"), "{}", stderr_of(&o));
+    assert!(
+        stderr_of(&o).contains("a tile id is empty"),
+        "{}",
+        stderr_of(&o)
+    );
 }
 
 #[test]
@@ -253,7 +266,11 @@ fn a_build_that_reads_no_lots_leaves_the_earlier_build_alone() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr_of(&o).contains("it was left as it was"), "{}", stderr_of(&o));
+    assert!(
+        stderr_of(&o).contains("it was left as it was"),
+        "{}",
+        stderr_of(&o)
+    );
     assert_eq!(all_files(&out), before);
 }
 
@@ -271,7 +288,10 @@ fn plan_and_compare_of_a_directory_without_a_build_say_so() {
         let o = edo_city().args(&args).output().unwrap();
         assert_eq!(o.status.code(), Some(2));
         let e = stderr_of(&o);
-        assert!(e.contains("holds no finished build") && !e.contains("--tiles"), "{e}");
+        assert!(
+            e.contains("holds no finished build") && !e.contains("--tiles"),
+            "{e}"
+        );
     }
 }
 
@@ -297,7 +317,11 @@ fn compare_plan_of_builds_on_other_grids_refuses_instead_of_a_huge_image() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr_of(&o).contains("other tile sizes"), "{}", stderr_of(&o));
+    assert!(
+        stderr_of(&o).contains("other tile sizes"),
+        "{}",
+        stderr_of(&o)
+    );
     assert!(!png.exists());
 }
 
@@ -331,7 +355,11 @@ fn synth_never_writes_over_a_users_directory() {
             .output()
             .unwrap();
         assert_eq!(o.status.code(), Some(2));
-        assert!(stderr_of(&o).contains("--lots must be from 1 to"), "{}", stderr_of(&o));
+        assert!(
+            stderr_of(&o).contains("--lots must be from 1 to"),
+            "{}",
+            stderr_of(&o)
+        );
     }
 }
 

@@ -39,11 +39,23 @@ fn example(name: &str) -> String {
 
 fn build_example(set: &str, name: &str, out: &Path) -> Option<serde_json::Value> {
     let dir = real(set)?;
-    Some(build_ok(
-        &dir,
-        out,
-        &["--quiet", "--params", &example(name)],
-    ))
+    let r = build_ok(&dir, out, &["--quiet", "--params", &example(name)]);
+    // Every record of every layer is built or listed as skipped.
+    for a in r["accounting"].as_array().unwrap() {
+        assert_eq!(a["unaccounted"], 0, "{set}: {a}");
+        assert_eq!(
+            a["read"].as_u64().unwrap(),
+            r["layers"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|l| l["file"] == a["file"])
+                .unwrap()["features"]
+                .as_u64()
+                .unwrap()
+        );
+    }
+    Some(r)
 }
 
 #[test]

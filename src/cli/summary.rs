@@ -33,18 +33,27 @@ pub fn print_check(r: &edo_city::output::report::Report) -> std::io::Result<()> 
         }
     );
     say!(
-        "\n{:<12} {:>9}  {:<30} {:<28} {:<7} file",
+        "\n{:<12} {:>9} {:>7} {:>7}  {:<30} {:<28} {:<7} file",
         "layer",
-        "features",
+        "records",
+        "built",
+        "skipped",
         "text encoding",
         "CRS",
         "reproj."
     );
     for l in &r.layers {
+        // The layer's ledger: every record built or skipped (see report.json `accounting`).
+        let a = r.accounting.iter().find(|a| a.file == l.file);
+        let n = |f: fn(&edo_city::output::accounting::Account) -> usize| {
+            a.map_or("-".to_string(), |a| f(a).to_string())
+        };
         say!(
-            "{:<12} {:>9}  {:<30} {:<28} {:<7} {}",
+            "{:<12} {:>9} {:>7} {:>7}  {:<30} {:<28} {:<7} {}",
             l.role,
             l.features,
+            n(|a| a.built),
+            n(|a| a.skipped),
             l.encoding,
             short_crs(&l.crs),
             if l.reprojected { "yes" } else { "no" },

@@ -184,7 +184,11 @@ impl Dem {
                 "a grid of {ncols} x {nrows} cells of {cell} m is empty"
             )));
         }
-        if !(xll.is_finite() && yll.is_finite() && xll.abs() < crate::model::FAR && yll.abs() < crate::model::FAR) {
+        if !(xll.is_finite()
+            && yll.is_finite()
+            && xll.abs() < crate::model::FAR
+            && yll.abs() < crate::model::FAR)
+        {
             return Err(bad(format!(
                 "the grid's corner ({xll}, {yll}) is not a place within 1e8 m of the CRS's \
                  origin: the header or the georeferencing is damaged"

@@ -39,8 +39,13 @@ pub struct ShapePolygons {
 /// crate would call such rings orphaned holes and the feature would vanish.
 /// `Err` names the shape kind when the shape is not a polygon.
 pub fn polygons_of(shape: &Shape) -> Result<ShapePolygons, &'static str> {
-    fn rings<P: Copy>(r: &[shapefile::PolygonRing<P>], xy: impl Fn(P) -> Coord<f64>) -> Vec<Vec<Coord<f64>>> {
-        r.iter().map(|ring| ring.points().iter().map(|p| xy(*p)).collect()).collect()
+    fn rings<P: Copy>(
+        r: &[shapefile::PolygonRing<P>],
+        xy: impl Fn(P) -> Coord<f64>,
+    ) -> Vec<Vec<Coord<f64>>> {
+        r.iter()
+            .map(|ring| ring.points().iter().map(|p| xy(*p)).collect())
+            .collect()
     }
     let (rings, lowest_z) = match shape {
         Shape::Polygon(p) => (rings(p.rings(), |q| Coord { x: q.x, y: q.y }), None),
@@ -80,7 +85,8 @@ fn organise_rings(rings: Vec<Vec<Coord<f64>>>) -> (Vec<Polygon<f64>>, usize) {
     let n = rings.len();
     // The standard winds outers clockwise (a negative shoelace area); a feature whose largest
     // ring winds the other way is read with both windings swapped.
-    let largest = (0..n).max_by(|&a, &b| signed[a].abs().total_cmp(&signed[b].abs()).then(b.cmp(&a)));
+    let largest =
+        (0..n).max_by(|&a, &b| signed[a].abs().total_cmp(&signed[b].abs()).then(b.cmp(&a)));
     let reversed = largest.is_some_and(|i| signed[i] > 0.0);
     // A ring with a non-finite coordinate is an outer ring of its own; check_polygon skips
     // it. A ring with no area has no winding: it is a hole where it lies in an outer ring
@@ -92,7 +98,11 @@ fn organise_rings(rings: Vec<Vec<Coord<f64>>>) -> (Vec<Polygon<f64>>, usize) {
     if wound_outer.iter().any(|o| !o) {
         let boxes: Vec<_> = rings
             .iter()
-            .map(|r| finite(r).then(|| LineString(r.clone()).bounding_rect()).flatten())
+            .map(|r| {
+                finite(r)
+                    .then(|| LineString(r.clone()).bounding_rect())
+                    .flatten()
+            })
             .collect();
         for i in (0..n).filter(|&i| !wound_outer[i]) {
             let Some(bi) = boxes[i] else { continue };
@@ -289,8 +299,10 @@ mod tests {
 
     #[test]
     fn standard_winding_gives_an_outer_with_its_hole() {
-        let (p, against) =
-            organise_rings(vec![square(0.0, 0.0, 10.0, true), square(2.0, 2.0, 2.0, false)]);
+        let (p, against) = organise_rings(vec![
+            square(0.0, 0.0, 10.0, true),
+            square(2.0, 2.0, 2.0, false),
+        ]);
         assert_eq!(p.len(), 1);
         assert_eq!(p[0].interiors().len(), 1);
         assert_eq!(against, 0);
@@ -306,9 +318,15 @@ mod tests {
 
     #[test]
     fn a_feature_wound_the_other_way_keeps_its_hole() {
-        let (p, against) =
-            organise_rings(vec![square(0.0, 0.0, 10.0, false), square(2.0, 2.0, 2.0, true)]);
-        assert_eq!(p.len(), 1, "one polygon with a courtyard, not two overlapping ones");
+        let (p, against) = organise_rings(vec![
+            square(0.0, 0.0, 10.0, false),
+            square(2.0, 2.0, 2.0, true),
+        ]);
+        assert_eq!(
+            p.len(),
+            1,
+            "one polygon with a courtyard, not two overlapping ones"
+        );
         assert_eq!(p[0].interiors().len(), 1);
         assert!((p[0].unsigned_area() - 96.0).abs() < 1e-9);
         assert_eq!(against, 2);
@@ -325,7 +343,11 @@ mod tests {
         ]);
         assert_eq!(p.len(), 3);
         assert_eq!(p[0].interiors().len(), 0);
-        assert_eq!(p[1].interiors().len(), 1, "the hole went to the ring around it");
+        assert_eq!(
+            p[1].interiors().len(),
+            1,
+            "the hole went to the ring around it"
+        );
         assert_eq!(p[2].interiors().len(), 0);
         assert_eq!(against, 1);
     }

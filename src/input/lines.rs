@@ -32,7 +32,8 @@ pub(super) fn read_fence_lines(
             .filter(|v| !v.is_empty())
             .unwrap_or_else(|| (f.record + 1).to_string());
         if lines.is_empty() {
-            data.skipped.push(super::null_shape(o, f.record, "the line"));
+            data.skipped
+                .push(super::null_shape(o, f.record, "the line"));
             continue;
         }
         let parts = lines.len();
@@ -80,7 +81,8 @@ pub(super) fn read_streets(
         let lines =
             lines_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polylines"))?;
         if lines.is_empty() {
-            data.skipped.push(super::null_shape(o, f.record, "the centreline"));
+            data.skipped
+                .push(super::null_shape(o, f.record, "the centreline"));
             continue;
         }
         let width = match width_field
@@ -140,7 +142,10 @@ pub(super) fn read_streets(
             wl.required_field(&wp.width_field, "width", "layers.street_widths.width_field")?;
         let mut lines: Vec<(LineString<f64>, f64)> = Vec::new();
         for f in &wl.layer.features {
-            let w = f.attrs.get(&field).and_then(|v| v.trim().parse::<f64>().ok());
+            let w = f
+                .attrs
+                .get(&field)
+                .and_then(|v| v.trim().parse::<f64>().ok());
             let reason = match w {
                 Some(w) if w.is_finite() && w > 0.0 && w <= MAX_STREET_WIDTH => None,
                 _ => Some(format!(

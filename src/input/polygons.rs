@@ -292,8 +292,10 @@ pub(super) fn assign_districts(
                 id: format!("record {}", f.record),
                 record: Some(f.record),
                 reason: match id.is_empty() {
-                    true => format!("no value in the district id field `{field}`: give the \
-                                     district an id"),
+                    true => format!(
+                        "no value in the district id field `{field}`: give the \
+                                     district an id"
+                    ),
                     false => "null shape or no usable outline: draw the district or delete the \
                               record"
                         .into(),
@@ -354,7 +356,11 @@ pub(super) fn record_polygons(
         skipped.push(Skipped {
             layer: o.role.into(),
             file: o.file.clone(),
-            id: if id.is_empty() { format!("record {}", f.record) } else { id },
+            id: if id.is_empty() {
+                format!("record {}", f.record)
+            } else {
+                id
+            },
             record: Some(f.record),
             reason: "null shape: the record has attributes but no geometry; draw its outline \
                      or delete the record"
@@ -402,10 +408,9 @@ pub(super) fn checked_parts(
             .err()
             .or_else(|| {
                 (!seen.insert(id.clone())).then(|| {
-                    format!(
-                        "duplicate id: the record repeats an earlier feature's id; the first \
-                         was built, give this one an id of its own"
-                    )
+                    "duplicate id: the record repeats an earlier feature's id; the first was \
+                     built, give this one an id of its own"
+                        .to_string()
                 })
             });
         match reason {

@@ -47,10 +47,19 @@ fn sidecar(path: &Path) -> Result<Option<String>, String> {
     match std::fs::read(path) {
         Ok(bytes) => match String::from_utf8(bytes) {
             Ok(text) => Ok(Some(text)),
-            Err(e) => match e.as_bytes().iter().any(|b| *b == 0 || *b > 0x7e && *b < 0xa0) {
+            Err(e) => match e
+                .as_bytes()
+                .iter()
+                .any(|b| *b == 0 || *b > 0x7e && *b < 0xa0)
+            {
                 true => Err(format!("{} is not a text file", path.display())),
                 // A Latin-1 WKT (a degree sign in a name, say) is still WKT.
-                false => Ok(Some(encoding_rs::WINDOWS_1252.decode(e.as_bytes()).0.into_owned())),
+                false => Ok(Some(
+                    encoding_rs::WINDOWS_1252
+                        .decode(e.as_bytes())
+                        .0
+                        .into_owned(),
+                )),
             },
         },
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
@@ -193,7 +202,8 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
         .filter(|(_, d)| **d)
         .map(|(i, _)| i)
         .collect();
-    let deleted = match flags.len() == shapes.len() && records.len() + deleted.len() == shapes.len() {
+    let deleted = match flags.len() == shapes.len() && records.len() + deleted.len() == shapes.len()
+    {
         true => deleted,
         false => Vec::new(),
     };

@@ -56,7 +56,10 @@ impl Table {
         };
         let unnamed: Vec<String> = (0..headers.len())
             .filter(|&i| headers[i].is_empty())
-            .filter(|&i| rows.iter().any(|(_, v)| v.get(i).is_some_and(|x| !x.is_empty())))
+            .filter(|&i| {
+                rows.iter()
+                    .any(|(_, v)| v.get(i).is_some_and(|x| !x.is_empty()))
+            })
             .map(column_name)
             .collect();
         if !unnamed.is_empty() {

@@ -53,7 +53,11 @@ pub fn ledgers(data: &Dataset) -> Vec<Ledger> {
         .iter()
         .map(|layer| {
             let features: Vec<(usize, &str)> = match layer.role.as_str() {
-                "lots" => data.lots.iter().map(|l| (l.record, l.id.as_str())).collect(),
+                "lots" => data
+                    .lots
+                    .iter()
+                    .map(|l| (l.record, l.id.as_str()))
+                    .collect(),
                 "footprints" => data
                     .footprints
                     .iter()
@@ -113,7 +117,10 @@ pub fn close(ledgers: &[Ledger], skipped: &[Skipped], warnings: &mut Vec<String>
         .map(|l| {
             // Distinct skipped features per record.
             let mut skipped_ids: BTreeMap<usize, BTreeSet<&str>> = BTreeMap::new();
-            for s in skipped.iter().filter(|s| s.layer == l.role && s.file == l.file) {
+            for s in skipped
+                .iter()
+                .filter(|s| s.layer == l.role && s.file == l.file)
+            {
                 if let Some(r) = s.record.or_else(|| l.ids.get(&s.id).copied()) {
                     skipped_ids.entry(r).or_default().insert(s.id.as_str());
                 }

@@ -33,10 +33,7 @@ pub enum LockError {
     )]
     Busy { dir: String, holder: String },
     #[error("cannot lock {path}: {cause}")]
-    Io {
-        path: String,
-        cause: std::io::Error,
-    },
+    Io { path: String, cause: std::io::Error },
 }
 
 impl OutLock {
@@ -124,7 +121,10 @@ mod tests {
         assert!(msg.contains("in use by another edo-city run"), "{msg}");
         assert!(msg.contains(&std::process::id().to_string()), "{msg}");
         drop(first);
-        assert!(!dir.path().join(LOCK_FILE).exists(), "the holder removes the file");
+        assert!(
+            !dir.path().join(LOCK_FILE).exists(),
+            "the holder removes the file"
+        );
         let again = OutLock::acquire(dir.path()).unwrap();
         assert!(again.path().ends_with(LOCK_FILE));
     }

@@ -24,7 +24,8 @@ pub(super) fn good_lots() -> Vec<(String, Vec<[f64; 2]>)> {
         .collect()
 }
 
-pub(super) const PRJ: &str = "PROJCS[\"JGD2011 / Japan Plane Rectangular CS VI\",GEOGCS[\"JGD2011\",\
+pub(super) const PRJ: &str =
+    "PROJCS[\"JGD2011 / Japan Plane Rectangular CS VI\",GEOGCS[\"JGD2011\",\
 DATUM[\"Japanese_Geodetic_Datum_2011\",SPHEROID[\"GRS 1980\",6378137,298.257222101]],\
 PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],\
 PARAMETER[\"latitude_of_origin\",36],PARAMETER[\"central_meridian\",136],\

@@ -326,4 +326,3 @@ pub fn cases() -> Vec<Case> {
         },
     ]
 }
-
