@@ -521,9 +521,9 @@ fn terrain_of<'a>(
     data: &'a Dataset,
     params: &Params,
     tile: &'a str,
-) -> Option<(&'a crate::input::dem::Dem, &'a str, [f64; 4])> {
+) -> Option<(&'a crate::model::dem::Dem, &'a str, [f64; 4])> {
     let dem = data.dem.as_ref().filter(|_| params.terrain)?;
-    let b = analyse::tiling::tile_bounds(tile, params.tile_size, params.tile_origin)?;
+    let b = crate::model::tile::tile_bounds(tile, params.tile_size, params.tile_origin)?;
     Some((dem, tile, b))
 }
 
@@ -552,11 +552,11 @@ fn check_billboards(catalog: &Catalog, params: &Params) -> Result<(), BuildError
         }
         if let Some(bad) = textures
             .iter()
-            .find(|n| generate::materials::find(n).is_none())
+            .find(|n| crate::materials::find(n).is_none())
         {
             return Err(BuildError::Config(format!(
                 "{table}.textures names `{bad}`, which is not in the texture library ({})",
-                generate::materials::names().join(", ")
+                crate::materials::names().join(", ")
             )));
         }
     }

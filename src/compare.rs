@@ -11,8 +11,8 @@ use std::path::Path;
 use serde::Serialize;
 use tiny_skia::{Color, Paint, Pixmap, Rect, Transform};
 
-use crate::analyse::tiling::parse_tile_id;
 use crate::build::{shards, BuildError};
+use crate::model::tile::parse_tile_id;
 use crate::output::report::{assemble_report, Manifest, Report};
 use crate::output::text::{draw_text, text_width};
 

@@ -1,6 +1,8 @@
 //! The `edo-city` command line: parses flags into validated options and calls the library.
 //! Everything the user sees (progress bars, the summary, error context) lives here.
 
+#![forbid(unsafe_code)]
+
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -48,7 +50,8 @@ enum Command {
         /// Parameter file (TOML); keys it leaves out keep the defaults of params/default.toml.
         #[arg(short, long)]
         params: Option<PathBuf>,
-        /// Directory of machiya type files (*.toml), replacing the shipped types.
+        /// Directory of template files (*.toml), added to the shipped ones; a file of a shipped
+        /// template's name replaces that template.
         #[arg(long)]
         templates: Option<PathBuf>,
         /// Worker threads (0 = one per core). The output does not depend on it.

@@ -425,7 +425,7 @@ impl Params {
             (
                 "layers.streets.default_width",
                 self.layers.streets.default_width,
-                crate::input::MAX_STREET_WIDTH,
+                crate::model::MAX_STREET_WIDTH,
             ),
             ("layers.footprints.storey_height", fp.storey_height, 100.0),
             (

@@ -7,7 +7,7 @@ mod common;
 use std::path::Path;
 
 use common::{build_objects, build_ok, copy_fixture, fixture, read_json, synth};
-use edo_city::analyse::street::segment_distance_2;
+use edo_city::geom::segment::segment_distance_2;
 use edo_city::model::{BillboardKind, LotUse, Plan, PlannedBillboard};
 use edo_city::params::Params;
 use geo::{BoundingRect, Contains, ConvexHull};

@@ -20,8 +20,8 @@ use rstar::primitives::GeomWithData;
 use rstar::RTree;
 
 use super::obstacles::{boundary_distance, Obstacles};
-use super::street::Segment;
-use super::tiling::tile_id;
+use crate::geom::segment::Segment;
+use crate::model::tile::tile_id;
 use crate::model::{
     sane, BillboardKind, Dataset, Plan, PlannedBillboard, PointFeature, Skipped, FAR,
 };
@@ -38,7 +38,7 @@ struct Surroundings<'a> {
     lots: RTree<GeomWithData<[f64; 2], usize>>,
     info: Vec<(Option<&'a str>, f64)>,
     streets: RTree<Segment>,
-    dem: Option<&'a crate::input::dem::Dem>,
+    dem: Option<&'a crate::model::dem::Dem>,
 }
 
 impl<'a> Surroundings<'a> {
@@ -367,12 +367,12 @@ fn lot_sources<'a>(
     // How deep each planned town lot's house is, as a share of the lot's depth.
     let mut built: HashMap<&str, f64> = HashMap::new();
     for m in plan.tiles.values().flatten().filter(|m| m.height.is_none()) {
-        let f = super::kura::Frame::of(m);
-        let depth = super::kura::local_ring(m, f)
+        let f = super::house::frame_of(m);
+        let depth = super::house::local_ring(m, f)
             .iter()
             .map(|q| q[1])
             .fold(0.0, f64::max);
-        let end = super::kura::house_end(m, depth, catalog, p);
+        let end = super::house::house_end(m, depth, catalog, p);
         built.insert(m.id.as_str(), if depth > 0.0 { end / depth } else { 1.0 });
     }
     let mut out = Vec::new();
@@ -602,7 +602,7 @@ fn texture_of(raw: &str, textures: &[String]) -> Option<String> {
             .contains(&n)
             .then(|| textures[n - 1].clone());
     }
-    crate::generate::materials::find(raw).map(|_| raw.to_string())
+    crate::materials::find(raw).map(|_| raw.to_string())
 }
 
 /// Hard-core thinning: in the order of the points' random keys, a point is kept when no kept

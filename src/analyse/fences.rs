@@ -12,7 +12,6 @@ use geo_types::Coord;
 
 use super::room::{LotEdges, MAX_ROOM};
 use super::street::StreetEdges;
-use super::tiling;
 use crate::model::{FenceKind, FenceLine, Lot, PlannedFence};
 use crate::params::Params;
 
@@ -242,8 +241,7 @@ pub fn plan_lot_fences(
     lots_file: &str,
 ) -> (Vec<PlannedFence>, Vec<String>) {
     let mut warnings = Vec::new();
-    let r = &lot.outline.exterior().0;
-    let ring: Vec<Coord<f64>> = r[..r.len().saturating_sub(1)].to_vec();
+    let ring: Vec<Coord<f64>> = crate::geom::ring::open(lot.outline.exterior()).to_vec();
     if ring.len() < 3 {
         return (Vec::new(), warnings);
     }
@@ -258,7 +256,7 @@ pub fn plan_lot_fences(
         template: template_of(lot, params),
         ground: lot.ground,
         district: lot.district.clone(),
-        tile: tiling::tile_id(centroid, params.tile_size, params.tile_origin),
+        tile: crate::model::tile::tile_id(centroid, params.tile_size, params.tile_origin),
         attrs: height_attr(&lot.attrs, params, &what, &mut warnings),
     };
     let mut out = segments(&w, &ring, true, gate, params, &mut warnings);
@@ -298,14 +296,12 @@ pub fn plan_line_fences(
     if pts.len() < 2 {
         return (Vec::new(), warnings);
     }
-    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
-    for p in &pts {
-        lo = [lo[0].min(p.x), lo[1].min(p.y)];
-        hi = [hi[0].max(p.x), hi[1].max(p.y)];
-    }
+    let Some(b) = crate::geom::bbox::bbox(pts.iter().copied()) else {
+        return (Vec::new(), warnings);
+    };
     let centre = Coord {
-        x: (lo[0] + hi[0]) / 2.0,
-        y: (lo[1] + hi[1]) / 2.0,
+        x: (b[0] + b[2]) / 2.0,
+        y: (b[1] + b[3]) / 2.0,
     };
     let what = format!("{file}: fence {}", f.id);
     // Segment numbering for `eN` and `1` follows the line as it is walled.
@@ -326,7 +322,7 @@ pub fn plan_line_fences(
         template,
         ground: 0.0,
         district: None,
-        tile: tiling::tile_id(centre, params.tile_size, params.tile_origin),
+        tile: crate::model::tile::tile_id(centre, params.tile_size, params.tile_origin),
         attrs: height_attr(&f.attrs, params, &what, &mut warnings),
     };
     let out = segments(&w, &pts, closed, gate, params, &mut warnings);

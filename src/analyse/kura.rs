@@ -11,86 +11,17 @@
 //! not depend on the order of lots or on tiles.
 
 use geo::Contains;
-use geo_types::{Coord, LineString, Polygon};
+use geo_types::{LineString, Polygon};
 use rayon::prelude::*;
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
+use super::house::{house_end, local_ring};
+use crate::geom::clip::{overlap_area, Quad};
+use crate::geom::frame::Frame;
 use crate::model::{KuraDecision, PlannedMachiya};
 use crate::params::Params;
 use crate::templates::Catalog;
-
-/// An oriented rectangle in map coordinates, corners counter-clockwise.
-pub type Quad = [Coord<f64>; 4];
-
-/// A machiya's frontage frame: u along the street, v into the lot.
-#[derive(Clone, Copy)]
-pub(crate) struct Frame {
-    pub a: Coord<f64>,
-    pub u: Coord<f64>,
-    pub v: Coord<f64>,
-}
-
-impl Frame {
-    pub fn of(m: &PlannedMachiya) -> Frame {
-        Frame {
-            a: m.frontage.a,
-            u: m.frontage.u_axis(),
-            v: m.frontage.v_axis(),
-        }
-    }
-    pub fn local(&self, c: Coord<f64>) -> [f64; 2] {
-        let (dx, dy) = (c.x - self.a.x, c.y - self.a.y);
-        [dx * self.u.x + dy * self.u.y, dx * self.v.x + dy * self.v.y]
-    }
-    fn map(&self, p: [f64; 2]) -> Coord<f64> {
-        Coord {
-            x: self.a.x + p[0] * self.u.x + p[1] * self.v.x,
-            y: self.a.y + p[0] * self.u.y + p[1] * self.v.y,
-        }
-    }
-    /// The rectangle `[u0, v0, u1, v1]` as a map quad.
-    pub fn quad(&self, r: [f64; 4]) -> Quad {
-        [
-            self.map([r[0], r[1]]),
-            self.map([r[2], r[1]]),
-            self.map([r[2], r[3]]),
-            self.map([r[0], r[3]]),
-        ]
-    }
-}
-
-/// The exterior ring in the frame, not closed.
-pub(crate) fn local_ring(m: &PlannedMachiya, f: Frame) -> Vec<[f64; 2]> {
-    let r = &m.outline.exterior().0;
-    r[..r.len().saturating_sub(1)]
-        .iter()
-        .map(|c| f.local(*c))
-        .collect()
-}
-
-/// Where the house ends behind the frontage: its type's `setback` + `depth` (else
-/// `machiya.depth`), at most the lot; a footprint building is its whole outline.
-pub(crate) fn house_end(
-    m: &PlannedMachiya,
-    lot_depth: f64,
-    catalog: &Catalog,
-    params: &Params,
-) -> f64 {
-    if m.height.is_some() {
-        return lot_depth;
-    }
-    let (mut setback, mut depth) = (0.0, 0.0);
-    if let Some(t) = catalog.machiya(&m.mtype) {
-        let overrides = catalog.overrides(&m.mtype, m.district.as_deref());
-        setback = t.param(&overrides, "setback").unwrap_or(0.0);
-        depth = t.param(&overrides, "depth").unwrap_or(0.0);
-    }
-    if depth <= 0.0 {
-        depth = params.machiya.depth;
-    }
-    (setback + depth).min(lot_depth)
-}
 
 /// The ring's u-range over the band `v0 <= v <= v1`: the smallest range holding every part
 /// of the lot in the band (`outer`), and the largest range every line of the band crosses
@@ -200,41 +131,10 @@ fn lot_holds(lot: &Polygon<f64>, q: &Quad) -> bool {
     lot.contains(&poly)
 }
 
-/// Area of the overlap of two convex quads (Sutherland-Hodgman of one by the other).
-pub fn overlap_area(a: &Quad, b: &Quad) -> f64 {
-    let mut poly: Vec<Coord<f64>> = a.to_vec();
-    for i in 0..4 {
-        let (p, q) = (b[i], b[(i + 1) % 4]);
-        let side = |c: Coord<f64>| (q.x - p.x) * (c.y - p.y) - (q.y - p.y) * (c.x - p.x);
-        let mut out = Vec::with_capacity(poly.len() + 2);
-        for j in 0..poly.len() {
-            let (c, d) = (poly[j], poly[(j + 1) % poly.len()]);
-            let (sc, sd) = (side(c), side(d));
-            if sc >= 0.0 {
-                out.push(c);
-            }
-            if (sc >= 0.0) != (sd >= 0.0) {
-                let t = sc / (sc - sd);
-                out.push(Coord {
-                    x: c.x + t * (d.x - c.x),
-                    y: c.y + t * (d.y - c.y),
-                });
-            }
-        }
-        poly = out;
-        if poly.len() < 3 {
-            return 0.0;
-        }
-    }
-    let n = poly.len();
-    (0..n)
-        .map(|i| {
-            let (p, q) = (poly[i], poly[(i + 1) % n]);
-            p.x * q.y - q.x * p.y
-        })
-        .sum::<f64>()
-        .abs()
-        / 2.0
+/// The lower-left and upper-right corners of a quad's bounding box, as rstar takes them.
+fn corners(q: &Quad) -> ([f64; 2], [f64; 2]) {
+    let b = crate::geom::bbox::bbox(q.iter().copied()).expect("a quad has corners");
+    ([b[0], b[1]], [b[2], b[3]])
 }
 
 /// Decides every machiya's kura: candidates, placement, provisional plots and collisions.
@@ -246,7 +146,7 @@ pub fn decide(planned: &mut [&mut PlannedMachiya], catalog: &Catalog, params: &P
     let plots: Vec<Quad> = planned
         .par_iter_mut()
         .map(|m| {
-            let f = Frame::of(m);
+            let f = super::house::frame_of(m);
             let ring = local_ring(m, f);
             let depth = ring.iter().map(|p| p[1]).fold(0.0, f64::max);
             let end = house_end(m, depth, catalog, params);
@@ -267,11 +167,7 @@ pub fn decide(planned: &mut [&mut PlannedMachiya], catalog: &Catalog, params: &P
             .iter()
             .enumerate()
             .map(|(i, q)| {
-                let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
-                for c in q {
-                    lo = [lo[0].min(c.x), lo[1].min(c.y)];
-                    hi = [hi[0].max(c.x), hi[1].max(c.y)];
-                }
+                let (lo, hi) = corners(q);
                 GeomWithData::new(Rectangle::from_corners(lo, hi), i)
             })
             .collect(),
@@ -285,11 +181,7 @@ pub fn decide(planned: &mut [&mut PlannedMachiya], catalog: &Catalog, params: &P
                 return false;
             }
             let q = &plots[i];
-            let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
-            for c in q {
-                lo = [lo[0].min(c.x), lo[1].min(c.y)];
-                hi = [hi[0].max(c.x), hi[1].max(c.y)];
-            }
+            let (lo, hi) = corners(q);
             tree.locate_in_envelope_intersecting(&AABB::from_corners(lo, hi))
                 .any(|other| other.data != i && overlap_area(q, &plots[other.data]) > tol)
         })
@@ -304,6 +196,7 @@ pub fn decide(planned: &mut [&mut PlannedMachiya], catalog: &Catalog, params: &P
 #[cfg(test)]
 mod tests {
     use super::*;
+    use geo_types::Coord;
 
     fn quad(x0: f64, y0: f64, x1: f64, y1: f64) -> Quad {
         [

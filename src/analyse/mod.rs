@@ -4,12 +4,12 @@
 pub mod billboards;
 pub mod fences;
 pub mod frontage;
+pub mod house;
 pub mod kura;
 pub mod obstacles;
 pub mod room;
 pub mod street;
 pub mod terrain;
-pub mod tiling;
 
 use geo::Centroid;
 use geo_types::Coord;
@@ -158,10 +158,7 @@ fn plan_lot(
             reason,
         })
     };
-    let ring: Vec<Coord<f64>> = {
-        let r = &lot.outline.exterior().0;
-        r[..r.len().saturating_sub(1)].to_vec()
-    };
+    let ring: Vec<Coord<f64>> = { crate::geom::ring::open(lot.outline.exterior()).to_vec() };
     let Some(centroid) = lot.outline.centroid() else {
         return skip("the outline has no centroid".into());
     };
@@ -191,9 +188,9 @@ fn plan_lot(
         Some(t) => (t.to_string(), true),
         None => (draw_type(params, &lot.id, lot.district.as_deref()), false),
     };
-    let computed = || tiling::tile_id(centroid, params.tile_size, params.tile_origin);
+    let computed = || crate::model::tile::tile_id(centroid, params.tile_size, params.tile_origin);
     let tile = match lot.tile.as_deref() {
-        Some(t) if tiling::is_valid_tile_name(t) => t.to_string(),
+        Some(t) if crate::model::tile::is_valid_tile_name(t) => t.to_string(),
         Some(t) => {
             warnings.push(format!(
                 "{lots_file}: lot {}: tile `{t}` is not usable as a file name (letters, digits, \
@@ -269,10 +266,7 @@ fn plan_footprint(
     catalog: &Catalog,
 ) -> Outcome {
     let fp = &params.layers.footprints;
-    let ring: Vec<Coord<f64>> = {
-        let r = &f.outline.exterior().0;
-        r[..r.len().saturating_sub(1)].to_vec()
-    };
+    let ring: Vec<Coord<f64>> = { crate::geom::ring::open(f.outline.exterior()).to_vec() };
     let Some(centroid) = f.outline.centroid() else {
         return Outcome::Skipped(Skipped {
             layer: "footprints".into(),
@@ -301,7 +295,7 @@ fn plan_footprint(
             mtype: given.unwrap_or(&fp.default_type).to_string(),
             type_given: given.is_some(),
             district: f.district.clone(),
-            tile: tiling::tile_id(centroid.0, params.tile_size, params.tile_origin),
+            tile: crate::model::tile::tile_id(centroid.0, params.tile_size, params.tile_origin),
             ground: f.ground,
             height: Some(f.height),
             attrs: Vec::new(),

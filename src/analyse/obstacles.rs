@@ -11,8 +11,8 @@ use geo_types::{Coord, Point, Polygon};
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
-use super::kura::{house_end, local_ring, Frame};
-use super::street::segment_distance_2;
+use super::house::{frame_of, house_end, local_ring};
+use crate::geom::segment::segment_distance_2;
 use crate::model::{sane, PlannedFence, PlannedMachiya};
 use crate::params::Params;
 use crate::templates::Catalog;
@@ -49,7 +49,7 @@ impl Obstacles {
     ) -> Obstacles {
         let mut items = Vec::new();
         for m in houses {
-            let f = Frame::of(m);
+            let f = frame_of(m);
             let depth = local_ring(m, f).iter().map(|p| p[1]).fold(0.0, f64::max);
             items.push(Obstacle::House {
                 outline: m.outline.clone(),

@@ -5,45 +5,10 @@
 //! centreline distance stops as soon as no wider street can still be nearer.
 
 use geo_types::{Coord, Polygon};
-use rstar::{PointDistance, RTree, RTreeObject, AABB};
+use rstar::{PointDistance, RTree, AABB};
 
+use crate::geom::segment::Segment;
 use crate::model::Street;
-
-/// A straight segment carrying a value, in an R-tree: here a street edge with its half-width
-/// (0 for block boundaries, which are the edge itself); `input::widths` uses it for lines
-/// carrying a street width.
-#[derive(Debug, Clone, Copy)]
-pub struct Segment {
-    pub a: [f64; 2],
-    pub b: [f64; 2],
-    pub value: f64,
-}
-
-impl RTreeObject for Segment {
-    type Envelope = AABB<[f64; 2]>;
-    fn envelope(&self) -> Self::Envelope {
-        AABB::from_corners(self.a, self.b)
-    }
-}
-
-impl PointDistance for Segment {
-    fn distance_2(&self, p: &[f64; 2]) -> f64 {
-        segment_distance_2(*p, self.a, self.b)
-    }
-}
-
-/// Squared distance from `p` to the segment `a`-`b`.
-pub fn segment_distance_2(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let (qx, qy) = (a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
-    qx * qx + qy * qy
-}
 
 /// All street edges of a dataset, indexed for nearest-edge queries.
 pub struct StreetEdges {
@@ -97,17 +62,15 @@ impl StreetEdges {
     pub fn distances(&self, pts: &[Coord<f64>]) -> Vec<f64> {
         const NEAR: f64 = 12.0;
         let probe = NEAR + self.max_half_width;
-        let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
-        for p in pts {
-            lo = [lo[0].min(p.x - probe), lo[1].min(p.y - probe)];
-            hi = [hi[0].max(p.x + probe), hi[1].max(p.y + probe)];
-        }
-        let near: Vec<&Segment> = if pts.is_empty() {
-            Vec::new()
-        } else {
-            self.tree
-                .locate_in_envelope_intersecting(&AABB::from_corners(lo, hi))
-                .collect()
+        let near: Vec<&Segment> = match crate::geom::bbox::bbox(pts.iter().copied()) {
+            None => Vec::new(),
+            Some(b) => {
+                let lo = [b[0] - probe, b[1] - probe];
+                let hi = [b[2] + probe, b[3] + probe];
+                self.tree
+                    .locate_in_envelope_intersecting(&AABB::from_corners(lo, hi))
+                    .collect()
+            }
         };
         pts.iter()
             .map(|p| {

@@ -4,7 +4,7 @@
 
 use geo_types::Coord;
 
-use crate::input::dem::Dem;
+use crate::model::dem::Dem;
 use crate::model::{PlannedFence, PlannedMachiya};
 
 /// Sets every house's ground from the DEM; returns how many sampled points were off it.

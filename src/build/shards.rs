@@ -427,20 +427,16 @@ pub fn list_tiles(plan: &Plan, tile_size: f64, origin: [f64; 2]) -> Vec<TileInfo
     plan.tiles
         .iter()
         .map(|(id, lots)| {
-            let bounds = match crate::analyse::tiling::parse_tile_id(id) {
-                Some((c, r)) => {
-                    let x = origin[0] + c as f64 * tile_size;
-                    let y = origin[1] + r as f64 * tile_size;
-                    [x, y, x + tile_size, y + tile_size]
-                }
-                // A tile named in the data: the extent of its features.
-                None => lots
-                    .iter()
-                    .flat_map(|m| m.outline.exterior().0.iter())
-                    .fold([f64::MAX, f64::MAX, f64::MIN, f64::MIN], |b, c| {
-                        [b[0].min(c.x), b[1].min(c.y), b[2].max(c.x), b[3].max(c.y)]
-                    }),
-            };
+            // A tile named in the data: the extent of its houses (a tile of walls alone has
+            // none, and is given the empty box it always had).
+            let bounds =
+                crate::model::tile::tile_bounds(id, tile_size, origin).unwrap_or_else(|| {
+                    crate::geom::bbox::bbox(
+                        lots.iter()
+                            .flat_map(|m| m.outline.exterior().0.iter().copied()),
+                    )
+                    .unwrap_or([f64::MAX, f64::MAX, f64::MIN, f64::MIN])
+                });
             TileInfo {
                 id: id.clone(),
                 machiya: lots.iter().filter(|m| m.height.is_none()).count(),

@@ -6,8 +6,8 @@ use geo_types::Coord;
 
 use super::clip::LocalPoly;
 use super::instance::{instantiate, Local, Site};
-use super::materials;
 use super::mesh::{Frame, Mesh};
+use crate::materials;
 use crate::model::{BillboardKind, PlannedBillboard, Skipped, TileStats};
 use crate::params::Params;
 use crate::templates::expr::Lot;

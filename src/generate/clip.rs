@@ -163,7 +163,7 @@ fn clip_boolean(poly: &LocalPoly, lo: f64, hi: f64) -> Vec<LocalPoly> {
     )
     .to_polygon();
     let ring_of = |ls: &LineString<f64>, ccw: bool| {
-        let mut r: LocalRing = ls.0[..ls.0.len().saturating_sub(1)]
+        let mut r: LocalRing = crate::geom::ring::open(ls)
             .iter()
             .map(|c| [c.x, c.y])
             .collect();

@@ -24,25 +24,7 @@ const WORLD_TEXTURE_BASE: f64 = 2.0;
 const ROOF_TEXTURE_BASE: f64 = 1.0;
 
 /// The frontage frame: u along the street, v into the lot, in map metres.
-#[derive(Debug, Clone, Copy)]
-pub struct Local {
-    pub a: Coord<f64>,
-    pub u: Coord<f64>,
-    pub v: Coord<f64>,
-}
-
-impl Local {
-    pub fn to_map(self, p: [f64; 2]) -> Coord<f64> {
-        Coord {
-            x: self.a.x + p[0] * self.u.x + p[1] * self.v.x,
-            y: self.a.y + p[0] * self.u.y + p[1] * self.v.y,
-        }
-    }
-    pub fn to_local(self, c: Coord<f64>) -> [f64; 2] {
-        let (dx, dy) = (c.x - self.a.x, c.y - self.a.y);
-        [dx * self.u.x + dy * self.u.y, dx * self.v.x + dy * self.v.y]
-    }
-}
+pub use crate::geom::frame::Frame as Local;
 
 /// Where a template is built.
 #[derive(Debug, Clone)]
@@ -326,7 +308,7 @@ fn faces(
             .map(|(&i, [s, t])| {
                 let p = pts[i];
                 let h = site.ground + site.slope * p[0] + p[2];
-                let pos = mesh.vertex(frame, site.local.to_map([p[0], p[1]]), h);
+                let pos = mesh.vertex(frame, site.local.map([p[0], p[1]]), h);
                 (pos, mesh.uv(s, t))
             })
             .collect();
@@ -435,7 +417,7 @@ fn extrude(
             let corners = tri
                 .iter()
                 .map(|&p| {
-                    let pos = mesh.vertex(frame, local.to_map(p), top(p));
+                    let pos = mesh.vertex(frame, local.map(p), top(p));
                     // Tile courses run along the eaves: texture x across the slope.
                     let (su, sv) = stretch(p);
                     let (s, t) = if su > sv {
@@ -452,7 +434,7 @@ fn extrude(
                 .iter()
                 .rev()
                 .map(|&p| {
-                    let pos = mesh.vertex(frame, local.to_map(p), bottom(p));
+                    let pos = mesh.vertex(frame, local.map(p), bottom(p));
                     let uv = mesh.uv(p[0] / WORLD_TEXTURE_BASE, p[1] / WORLD_TEXTURE_BASE);
                     (pos, uv)
                 })
@@ -469,8 +451,8 @@ fn extrude(
                 continue;
             }
             let (hp0, hq0, hp1, hq1) = (bottom(p), bottom(q), top(p), top(q));
-            let pm = local.to_map(p);
-            let qm = local.to_map(q);
+            let pm = local.map(p);
+            let qm = local.map(q);
             let ids = [
                 mesh.vertex(frame, pm, hp0),
                 mesh.vertex(frame, qm, hq0),

@@ -24,9 +24,9 @@ pub fn site_of(m: &PlannedMachiya) -> Result<Site, String> {
     };
     let to_ring = |ls: &geo_types::LineString<f64>| -> LocalRing {
         dedup(
-            ls.0[..ls.0.len().saturating_sub(1)]
+            crate::geom::ring::open(ls)
                 .iter()
-                .map(|c| local.to_local(*c))
+                .map(|c| local.local(*c))
                 .collect(),
         )
     };

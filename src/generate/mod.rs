@@ -9,7 +9,6 @@ pub mod fences;
 pub mod instance;
 pub mod kura;
 pub mod machiya;
-pub mod materials;
 pub mod mesh;
 pub mod terrain;
 
@@ -46,7 +45,7 @@ pub struct TilePlan<'a> {
     pub fences: &'a [PlannedFence],
     pub billboards: &'a [PlannedBillboard],
     /// The DEM, the tile's id and its bounds, when the terrain is to be written.
-    pub ground: Option<(&'a crate::input::dem::Dem, &'a str, [f64; 4])>,
+    pub ground: Option<(&'a crate::model::dem::Dem, &'a str, [f64; 4])>,
 }
 
 impl<'a> TilePlan<'a> {

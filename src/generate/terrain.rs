@@ -7,9 +7,9 @@
 
 use geo_types::Coord;
 
-use super::materials;
 use super::mesh::{Frame, Mesh};
-use crate::input::dem::Dem;
+use crate::materials;
+use crate::model::dem::Dem;
 
 /// Texture base of the ground: one repeat per this many metres.
 const GROUND_TEXTURE_BASE: f64 = 4.0;

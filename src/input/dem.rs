@@ -1,391 +1,248 @@
-//! Terrain: an elevation grid (ESRI ASCII grid `.asc`, or GeoTIFF `.tif` placed by its
-//! GeoTIFF tags or a `.tfw` world file) sampled bilinearly.
+//! Terrain files: an elevation grid (ESRI ASCII grid `.asc`, or GeoTIFF `.tif` placed by its
+//! GeoTIFF tags or a `.tfw` world file) read into a [`Dem`].
 //!
 //! The grid is in the output CRS (a `.prj` beside it that says otherwise is an error: reproject
-//! the DEM first). Cells equal to `NODATA_value` are left out of the interpolation; a point
-//! outside the grid gets the elevation of the nearest edge cell and is counted, so the report
-//! can say how many features stood off the DEM.
+//! the DEM first). Cells equal to `NODATA_value` (or GDAL's no-data tag) are no-data.
 
 use std::path::Path;
 
-use geo_types::Coord;
-
 use super::InputError;
+pub use crate::model::dem::{Dem, Sample};
 
-/// An elevation grid: `z[row * ncols + col]`, row 0 at the top (north).
-#[derive(Debug, Clone)]
-pub struct Dem {
-    pub file: String,
-    pub ncols: usize,
-    pub nrows: usize,
-    /// Lower-left corner of the lower-left cell.
-    pub xll: f64,
-    pub yll: f64,
-    pub cell: f64,
+/// [`Dem::from_grid`], its complaint put to the file.
+fn grid(
+    file: String,
+    ncols: usize,
+    nrows: usize,
+    xll: f64,
+    yll: f64,
+    cell: f64,
     z: Vec<f64>,
-    /// Cells whose value no ground has (outside [`crate::model::ELEVATION_RANGE`]), read as
-    /// no-data: an undeclared no-data value, or damage.
-    pub implausible: usize,
+) -> Result<Dem, InputError> {
+    Dem::from_grid(file.clone(), ncols, nrows, xll, yll, cell, z)
+        .map_err(|message| InputError::Layer { file, message })
 }
 
-/// An elevation, and whether the point lay outside the grid.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sample {
-    pub z: f64,
-    pub outside: bool,
-}
-
-impl Dem {
-    /// Reads a DEM: a GeoTIFF by its extension (`.tif`, `.tiff`), else an ESRI ASCII grid.
-    pub fn read(path: &Path) -> Result<Dem, InputError> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
-            Some("tif" | "tiff") => Dem::read_geotiff(path),
-            _ => Dem::read_ascii(path),
-        }
+/// Reads a DEM: a GeoTIFF by its extension (`.tif`, `.tiff`), else an ESRI ASCII grid.
+pub fn read(path: &Path) -> Result<Dem, InputError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("tif" | "tiff") => read_geotiff(path),
+        _ => read_ascii(path),
     }
+}
 
-    /// Reads a single-band GeoTIFF: placed by ModelPixelScale + ModelTiepoint, else by a
-    /// world file beside it; GDAL's NODATA tag is honoured.
-    pub fn read_geotiff(path: &Path) -> Result<Dem, InputError> {
-        use tiff::decoder::{Decoder, DecodingResult};
-        use tiff::tags::Tag;
-        let file = path.display().to_string();
-        let bad = |message: String| InputError::Layer {
-            file: file.clone(),
-            message,
-        };
-        let reader = std::fs::File::open(path).map_err(|e| bad(format!("cannot read: {e}")))?;
-        let mut dec = Decoder::new(std::io::BufReader::new(reader))
-            .map_err(|e| bad(format!("not a readable TIFF: {e}")))?;
-        let (w, h) = dec
-            .dimensions()
-            .map_err(|e| bad(format!("not a readable TIFF: {e}")))?;
-        let (ncols, nrows) = (w as usize, h as usize);
-        if ncols.saturating_mul(nrows) > 400_000_000 {
-            return Err(bad(format!("{ncols} x {nrows} cells is more than this tool reads (4e8); crop or resample the DEM")));
-        }
-        let tag = |dec: &mut Decoder<_>, t: Tag| -> Option<Vec<f64>> {
-            dec.find_tag(t)
-                .ok()
-                .flatten()
-                .and_then(|v| v.into_f64_vec().ok())
-        };
-        let scale = tag(&mut dec, Tag::ModelPixelScaleTag);
-        let tie = tag(&mut dec, Tag::ModelTiepointTag);
-        let nodata = dec
-            .find_tag(Tag::Unknown(42113))
+/// Reads a single-band GeoTIFF: placed by ModelPixelScale + ModelTiepoint, else by a
+/// world file beside it; GDAL's NODATA tag is honoured.
+pub fn read_geotiff(path: &Path) -> Result<Dem, InputError> {
+    use tiff::decoder::{Decoder, DecodingResult};
+    use tiff::tags::Tag;
+    let file = path.display().to_string();
+    let bad = |message: String| InputError::Layer {
+        file: file.clone(),
+        message,
+    };
+    let reader = std::fs::File::open(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+    let mut dec = Decoder::new(std::io::BufReader::new(reader))
+        .map_err(|e| bad(format!("not a readable TIFF: {e}")))?;
+    let (w, h) = dec
+        .dimensions()
+        .map_err(|e| bad(format!("not a readable TIFF: {e}")))?;
+    let (ncols, nrows) = (w as usize, h as usize);
+    if ncols.saturating_mul(nrows) > 400_000_000 {
+        return Err(bad(format!(
+            "{ncols} x {nrows} cells is more than this tool reads (4e8); crop or resample the DEM"
+        )));
+    }
+    let tag = |dec: &mut Decoder<_>, t: Tag| -> Option<Vec<f64>> {
+        dec.find_tag(t)
             .ok()
             .flatten()
-            .and_then(|v| v.into_string().ok())
-            .and_then(|s| s.trim().trim_end_matches('\0').parse::<f64>().ok());
-        // Upper-left corner and cell size.
-        let (x0, ytop, cell) = match (scale, tie) {
-            (Some(s), Some(t)) if s.len() >= 2 && t.len() >= 6 => {
-                if (s[0] - s[1]).abs() > 1e-9 * s[0].abs() {
-                    return Err(bad(format!(
-                        "cells of {} x {} are not square; resample the DEM",
-                        s[0], s[1]
-                    )));
-                }
-                (t[3] - t[0] * s[0], t[4] + t[1] * s[1], s[0])
+            .and_then(|v| v.into_f64_vec().ok())
+    };
+    let scale = tag(&mut dec, Tag::ModelPixelScaleTag);
+    let tie = tag(&mut dec, Tag::ModelTiepointTag);
+    let nodata = dec
+        .find_tag(Tag::Unknown(42113))
+        .ok()
+        .flatten()
+        .and_then(|v| v.into_string().ok())
+        .and_then(|s| s.trim().trim_end_matches('\0').parse::<f64>().ok());
+    // Upper-left corner and cell size.
+    let (x0, ytop, cell) = match (scale, tie) {
+        (Some(s), Some(t)) if s.len() >= 2 && t.len() >= 6 => {
+            if (s[0] - s[1]).abs() > 1e-9 * s[0].abs() {
+                return Err(bad(format!(
+                    "cells of {} x {} are not square; resample the DEM",
+                    s[0], s[1]
+                )));
             }
-            _ => {
-                let tfw = path.with_extension("tfw");
-                let text = std::fs::read_to_string(&tfw).map_err(|_| {
-                    bad(format!(
-                        "no GeoTIFF placement tags and no world file {}: the DEM cannot be placed",
-                        tfw.display()
-                    ))
-                })?;
-                let v: Vec<f64> = text
-                    .split_ascii_whitespace()
-                    .filter_map(|w| w.parse().ok())
-                    .collect();
-                let [a, d, b, e, c, f] = v[..] else {
-                    return Err(bad(format!(
-                        "{}: a world file has 6 numbers",
-                        tfw.display()
-                    )));
-                };
-                if d != 0.0 || b != 0.0 || (a + e).abs() > 1e-9 * a.abs() {
-                    return Err(bad(format!(
-                        "{}: a rotated or non-square grid; resample the DEM",
-                        tfw.display()
-                    )));
-                }
-                // C, F are the centre of the upper-left cell.
-                (c - a / 2.0, f + a / 2.0, a)
-            }
-        };
-        let data = dec
-            .read_image()
-            .map_err(|e| bad(format!("cannot decode the raster: {e}")))?;
-        let z: Vec<f64> = match data {
-            DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
-            DecodingResult::F64(v) => v,
-            DecodingResult::I16(v) => v.into_iter().map(f64::from).collect(),
-            DecodingResult::U16(v) => v.into_iter().map(f64::from).collect(),
-            DecodingResult::I32(v) => v.into_iter().map(f64::from).collect(),
-            DecodingResult::U32(v) => v.into_iter().map(f64::from).collect(),
-            DecodingResult::U8(v) => v.into_iter().map(f64::from).collect(),
-            _ => {
-                return Err(bad(
-                    "an unsupported sample type (use 8-32 bit integers or floats)".into(),
+            (t[3] - t[0] * s[0], t[4] + t[1] * s[1], s[0])
+        }
+        _ => {
+            let tfw = path.with_extension("tfw");
+            let text = std::fs::read_to_string(&tfw).map_err(|_| {
+                bad(format!(
+                    "no GeoTIFF placement tags and no world file {}: the DEM cannot be placed",
+                    tfw.display()
                 ))
-            }
-        };
-        if z.len() != ncols * nrows {
-            return Err(bad(format!(
-                "{} samples for {ncols} x {nrows} cells: one band only",
-                z.len()
-            )));
-        }
-        let z = z
-            .into_iter()
-            .map(|v| {
-                if Some(v) == nodata || !v.is_finite() {
-                    f64::NAN
-                } else {
-                    v
-                }
-            })
-            .collect();
-        Dem::from_grid(
-            file.clone(),
-            ncols,
-            nrows,
-            x0,
-            ytop - nrows as f64 * cell,
-            cell,
-            z,
-        )
-    }
-
-    /// A DEM from its grid; checks the grid is usable.
-    fn from_grid(
-        file: String,
-        ncols: usize,
-        nrows: usize,
-        xll: f64,
-        yll: f64,
-        cell: f64,
-        z: Vec<f64>,
-    ) -> Result<Dem, InputError> {
-        let bad = |message: String| InputError::Layer {
-            file: file.clone(),
-            message,
-        };
-        if !(cell.is_finite() && cell > 0.0) || ncols == 0 || nrows == 0 {
-            return Err(bad(format!(
-                "a grid of {ncols} x {nrows} cells of {cell} m is empty"
-            )));
-        }
-        if !(xll.is_finite()
-            && yll.is_finite()
-            && xll.abs() < crate::model::FAR
-            && yll.abs() < crate::model::FAR)
-        {
-            return Err(bad(format!(
-                "the grid's corner ({xll}, {yll}) is not a place within 1e8 m of the CRS's \
-                 origin: the header or the georeferencing is damaged"
-            )));
-        }
-        // Numbers no ground has (an undeclared no-data value such as -3.4e38) are no-data.
-        let mut implausible = 0usize;
-        let z: Vec<f64> = z
-            .into_iter()
-            .map(|v| {
-                if v.is_nan() || crate::model::ELEVATION_RANGE.contains(&v) {
-                    v
-                } else {
-                    implausible += 1;
-                    f64::NAN
-                }
-            })
-            .collect();
-        if z.iter().all(|v| v.is_nan()) {
-            return Err(bad(format!(
-                "every cell is NODATA (or outside {}..{} m)",
-                crate::model::ELEVATION_RANGE.start(),
-                crate::model::ELEVATION_RANGE.end()
-            )));
-        }
-        Ok(Dem {
-            implausible,
-            file,
-            ncols,
-            nrows,
-            xll,
-            yll,
-            cell,
-            z,
-        })
-    }
-
-    /// Reads an ESRI ASCII grid.
-    pub fn read_ascii(path: &Path) -> Result<Dem, InputError> {
-        let file = path.display().to_string();
-        let bad = |message: String| InputError::Layer {
-            file: file.clone(),
-            message,
-        };
-        let text = std::fs::read_to_string(path).map_err(|e| bad(format!("cannot read: {e}")))?;
-        let mut words = text.split_ascii_whitespace().peekable();
-        let (mut ncols, mut nrows, mut cell, mut nodata) = (None, None, None, None);
-        let (mut x, mut y, mut centre) = (None, None, false);
-        while let Some(w) = words.peek() {
-            let key = w.to_ascii_lowercase();
-            if key.parse::<f64>().is_ok() {
-                break;
-            }
-            words.next();
-            let v = words
-                .next()
-                .ok_or_else(|| bad(format!("header `{key}` has no value")))?;
-            let num = |v: &str| -> Result<f64, InputError> {
-                v.parse::<f64>()
-                    .map_err(|_| bad(format!("header `{key}` = `{v}` is not a number")))
+            })?;
+            let v: Vec<f64> = text
+                .split_ascii_whitespace()
+                .filter_map(|w| w.parse().ok())
+                .collect();
+            let [a, d, b, e, c, f] = v[..] else {
+                return Err(bad(format!(
+                    "{}: a world file has 6 numbers",
+                    tfw.display()
+                )));
             };
-            match key.as_str() {
-                "ncols" => ncols = Some(num(v)? as usize),
-                "nrows" => nrows = Some(num(v)? as usize),
-                "xllcorner" => x = Some(num(v)?),
-                "yllcorner" => y = Some(num(v)?),
-                "xllcenter" => {
-                    x = Some(num(v)?);
-                    centre = true;
-                }
-                "yllcenter" => {
-                    y = Some(num(v)?);
-                    centre = true;
-                }
-                "cellsize" => cell = Some(num(v)?),
-                "nodata_value" => nodata = Some(num(v)?),
-                other => return Err(bad(format!("unknown header `{other}` (an ESRI ASCII grid has ncols, nrows, xllcorner, yllcorner, cellsize, NODATA_value)"))),
+            if d != 0.0 || b != 0.0 || (a + e).abs() > 1e-9 * a.abs() {
+                return Err(bad(format!(
+                    "{}: a rotated or non-square grid; resample the DEM",
+                    tfw.display()
+                )));
             }
+            // C, F are the centre of the upper-left cell.
+            (c - a / 2.0, f + a / 2.0, a)
         }
-        let missing = |k: &str| bad(format!("the header lacks `{k}`"));
-        let (ncols, nrows) = (
-            ncols.ok_or_else(|| missing("ncols"))?,
-            nrows.ok_or_else(|| missing("nrows"))?,
-        );
-        let cell = cell.ok_or_else(|| missing("cellsize"))?;
-        let (mut xll, mut yll) = (
-            x.ok_or_else(|| missing("xllcorner"))?,
-            y.ok_or_else(|| missing("yllcorner"))?,
-        );
-        if !(cell.is_finite() && cell > 0.0) || ncols == 0 || nrows == 0 {
-            return Err(bad(format!(
-                "a grid of {ncols} x {nrows} cells of {cell} m is empty"
-            )));
+    };
+    let data = dec
+        .read_image()
+        .map_err(|e| bad(format!("cannot decode the raster: {e}")))?;
+    let z: Vec<f64> = match data {
+        DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::F64(v) => v,
+        DecodingResult::I16(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::U16(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::I32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::U32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::U8(v) => v.into_iter().map(f64::from).collect(),
+        _ => {
+            return Err(bad(
+                "an unsupported sample type (use 8-32 bit integers or floats)".into(),
+            ))
         }
-        if ncols.saturating_mul(nrows) > 400_000_000 {
-            return Err(bad(format!("{ncols} x {nrows} cells is more than this tool reads (4e8); crop or resample the DEM")));
-        }
-        if centre {
-            xll -= cell / 2.0;
-            yll -= cell / 2.0;
-        }
-        let mut z = Vec::with_capacity(ncols * nrows);
-        for w in words {
-            let v: f64 = w
-                .parse()
-                .map_err(|_| bad(format!("value {} (`{w}`) is not a number", z.len() + 1)))?;
-            z.push(if Some(v) == nodata || !v.is_finite() {
+    };
+    if z.len() != ncols * nrows {
+        return Err(bad(format!(
+            "{} samples for {ncols} x {nrows} cells: one band only",
+            z.len()
+        )));
+    }
+    let z = z
+        .into_iter()
+        .map(|v| {
+            if Some(v) == nodata || !v.is_finite() {
                 f64::NAN
             } else {
                 v
-            });
-        }
-        if z.len() != ncols * nrows {
-            return Err(bad(format!(
-                "{} values for {ncols} x {nrows} = {} cells (is the file cut short?)",
-                z.len(),
-                ncols * nrows
-            )));
-        }
-        Dem::from_grid(file, ncols, nrows, xll, yll, cell, z)
-    }
-
-    fn at(&self, col: usize, row: usize) -> f64 {
-        self.z[row * self.ncols + col]
-    }
-
-    /// The elevation at `p`: bilinear between the four nearest cell centres (NODATA cells
-    /// left out), the nearest edge cell's outside the grid, the nearest valid cell's when all
-    /// four are NODATA.
-    pub fn sample(&self, p: Coord<f64>) -> Sample {
-        let top = self.yll + self.nrows as f64 * self.cell;
-        let fx = (p.x - self.xll) / self.cell - 0.5;
-        let fy = (top - p.y) / self.cell - 0.5;
-        let outside = p.x < self.xll
-            || p.x > self.xll + self.ncols as f64 * self.cell
-            || p.y < self.yll
-            || p.y > top;
-        let fx = fx.clamp(0.0, (self.ncols - 1) as f64);
-        let fy = fy.clamp(0.0, (self.nrows - 1) as f64);
-        let (c0, r0) = (fx.floor() as usize, fy.floor() as usize);
-        let (c1, r1) = ((c0 + 1).min(self.ncols - 1), (r0 + 1).min(self.nrows - 1));
-        let (tx, ty) = (fx - c0 as f64, fy - r0 as f64);
-        let mut sum = 0.0;
-        let mut weight = 0.0;
-        for (c, r, w) in [
-            (c0, r0, (1.0 - tx) * (1.0 - ty)),
-            (c1, r0, tx * (1.0 - ty)),
-            (c0, r1, (1.0 - tx) * ty),
-            (c1, r1, tx * ty),
-        ] {
-            let v = self.at(c, r);
-            if !v.is_nan() && w > 0.0 {
-                sum += v * w;
-                weight += w;
             }
+        })
+        .collect();
+    grid(file, ncols, nrows, x0, ytop - nrows as f64 * cell, cell, z)
+}
+
+/// Reads an ESRI ASCII grid.
+pub fn read_ascii(path: &Path) -> Result<Dem, InputError> {
+    let file = path.display().to_string();
+    let bad = |message: String| InputError::Layer {
+        file: file.clone(),
+        message,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+    let mut words = text.split_ascii_whitespace().peekable();
+    let (mut ncols, mut nrows, mut cell, mut nodata) = (None, None, None, None);
+    let (mut x, mut y, mut centre) = (None, None, false);
+    while let Some(w) = words.peek() {
+        let key = w.to_ascii_lowercase();
+        if key.parse::<f64>().is_ok() {
+            break;
         }
-        let z = if weight > 0.0 {
-            sum / weight
-        } else {
-            self.nearest_valid(c0, r0)
+        words.next();
+        let v = words
+            .next()
+            .ok_or_else(|| bad(format!("header `{key}` has no value")))?;
+        let num = |v: &str| -> Result<f64, InputError> {
+            v.parse::<f64>()
+                .map_err(|_| bad(format!("header `{key}` = `{v}` is not a number")))
         };
-        Sample { z, outside }
-    }
-
-    /// The valid cell nearest (col, row), searching rings outward.
-    fn nearest_valid(&self, col: usize, row: usize) -> f64 {
-        let reach = self.ncols.max(self.nrows);
-        for d in 1..=reach {
-            let mut best: Option<(usize, f64)> = None;
-            let (c0, c1) = (col.saturating_sub(d), (col + d).min(self.ncols - 1));
-            let (r0, r1) = (row.saturating_sub(d), (row + d).min(self.nrows - 1));
-            for r in r0..=r1 {
-                for c in c0..=c1 {
-                    let v = self.at(c, r);
-                    let dist = c.abs_diff(col).pow(2) + r.abs_diff(row).pow(2);
-                    if !v.is_nan() && best.is_none_or(|(bd, _)| dist < bd) {
-                        best = Some((dist, v));
-                    }
-                }
+        match key.as_str() {
+            "ncols" => ncols = Some(num(v)? as usize),
+            "nrows" => nrows = Some(num(v)? as usize),
+            "xllcorner" => x = Some(num(v)?),
+            "yllcorner" => y = Some(num(v)?),
+            "xllcenter" => {
+                x = Some(num(v)?);
+                centre = true;
             }
-            if let Some((_, v)) = best {
-                return v;
+            "yllcenter" => {
+                y = Some(num(v)?);
+                centre = true;
             }
+            "cellsize" => cell = Some(num(v)?),
+            "nodata_value" => nodata = Some(num(v)?),
+            other => return Err(bad(format!("unknown header `{other}` (an ESRI ASCII grid has ncols, nrows, xllcorner, yllcorner, cellsize, NODATA_value)"))),
         }
-        0.0
     }
+    let missing = |k: &str| bad(format!("the header lacks `{k}`"));
+    let (ncols, nrows) = (
+        ncols.ok_or_else(|| missing("ncols"))?,
+        nrows.ok_or_else(|| missing("nrows"))?,
+    );
+    let cell = cell.ok_or_else(|| missing("cellsize"))?;
+    let (mut xll, mut yll) = (
+        x.ok_or_else(|| missing("xllcorner"))?,
+        y.ok_or_else(|| missing("yllcorner"))?,
+    );
+    if !(cell.is_finite() && cell > 0.0) || ncols == 0 || nrows == 0 {
+        return Err(bad(format!(
+            "a grid of {ncols} x {nrows} cells of {cell} m is empty"
+        )));
+    }
+    if ncols.saturating_mul(nrows) > 400_000_000 {
+        return Err(bad(format!(
+            "{ncols} x {nrows} cells is more than this tool reads (4e8); crop or resample the DEM"
+        )));
+    }
+    if centre {
+        xll -= cell / 2.0;
+        yll -= cell / 2.0;
+    }
+    let mut z = Vec::with_capacity(ncols * nrows);
+    for w in words {
+        let v: f64 = w
+            .parse()
+            .map_err(|_| bad(format!("value {} (`{w}`) is not a number", z.len() + 1)))?;
+        z.push(if Some(v) == nodata || !v.is_finite() {
+            f64::NAN
+        } else {
+            v
+        });
+    }
+    if z.len() != ncols * nrows {
+        return Err(bad(format!(
+            "{} values for {ncols} x {nrows} = {} cells (is the file cut short?)",
+            z.len(),
+            ncols * nrows
+        )));
+    }
+    grid(file, ncols, nrows, xll, yll, cell, z)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use geo_types::Coord;
 
     fn grid(text: &str) -> Result<Dem, InputError> {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("dem.asc");
         std::fs::write(&p, text).unwrap();
-        Dem::read_ascii(&p)
+        read_ascii(&p)
     }
 
     const SLOPE: &str =
@@ -441,7 +298,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let ascii = grid(SLOPE).unwrap();
         for tags in [true, false] {
-            let d = Dem::read(&geotiff(dir.path(), tags)).unwrap();
+            let d = read(&geotiff(dir.path(), tags)).unwrap();
             assert_eq!(
                 (d.ncols, d.nrows, d.xll, d.yll, d.cell),
                 (3, 2, 0.0, 0.0, 10.0)
@@ -455,7 +312,7 @@ mod tests {
         // Neither tags nor a world file: the DEM cannot be placed.
         let p = geotiff(dir.path(), false);
         std::fs::remove_file(dir.path().join("dem.tfw")).unwrap();
-        let e = Dem::read(&p).unwrap_err().to_string();
+        let e = read(&p).unwrap_err().to_string();
         assert!(e.contains("cannot be placed"), "{e}");
     }
 

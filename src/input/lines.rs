@@ -7,12 +7,8 @@ use super::fields::resolve_field;
 use super::geometry::lines_of;
 use super::target::to_target;
 use super::{widths, InputError, Opened};
-use crate::model::{Dataset, FenceLine, Skipped, Street};
+use crate::model::{Dataset, FenceLine, Skipped, Street, MAX_STREET_WIDTH};
 use crate::params::Params;
-
-/// The widest street taken from the data, metres (the widest avenues are about 100 m; a
-/// larger number is a unit error or damaged data).
-pub const MAX_STREET_WIDTH: f64 = 200.0;
 
 /// Free-standing fence lines: each part of each polyline, with the feature's attributes.
 pub(super) fn read_fence_lines(

@@ -20,7 +20,6 @@ mod lines;
 mod polygons;
 mod target;
 
-pub use lines::MAX_STREET_WIDTH;
 use lines::{read_fence_lines, read_streets};
 use polygons::{assign_districts, read_footprints, read_lots};
 use target::{resolve_crs, to_target};
@@ -466,7 +465,7 @@ fn read_dem(
             });
         }
     }
-    let dem = dem::Dem::read(&path)?;
+    let dem = dem::read(&path)?;
     if dem.implausible > 0 {
         warnings.push(format!(
             "{}: {} cell(s) hold a number no ground has (outside {}..{} m, such as an \

@@ -4,7 +4,7 @@
 use geo_types::LineString;
 use rstar::{PointDistance, RTree};
 
-use crate::analyse::street::Segment;
+use crate::geom::segment::Segment;
 use crate::model::Street;
 
 /// Splits streets into straight pieces and gives each the width of the nearest width line

@@ -17,8 +17,8 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
-use crate::generate::materials::TEXTURES;
 use crate::generate::mesh::Mesh;
+use crate::materials::TEXTURES;
 use report::ManifestFile;
 
 pub fn sha256_hex(bytes: &[u8]) -> String {

@@ -8,7 +8,7 @@
 
 use std::fmt::Write;
 
-use crate::generate::materials::MATERIALS;
+use crate::materials::MATERIALS;
 
 /// MTL text listing every material; textures are referenced as `../textures/<file>`.
 pub fn mtl_text() -> String {

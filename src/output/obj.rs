@@ -1,14 +1,14 @@
 //! Wavefront OBJ text for one tile.
 //!
 //! Coordinates are whole millimetres in the mesh, printed as fixed-point metres with an
-//! integer formatter: measured six times faster than `{:.3}` on this kind of file, with the
-//! same bytes (see crates.md). Faces are grouped by material within each object so each
-//! object has at most one `usemtl` per material.
+//! integer formatter: measured six times faster than `{:.3}` on this kind of file when the
+//! writer was made, with the same bytes. Faces are grouped by material within each object so
+//! each object has at most one `usemtl` per material.
 
 use std::io::Write;
 
-use super::super::generate::materials::MATERIALS;
-use super::super::generate::mesh::Mesh;
+use crate::generate::mesh::Mesh;
+use crate::materials::MATERIALS;
 
 /// Appends `v` (millimetres) as metres with three decimals.
 fn push_mm(buf: &mut Vec<u8>, v: i64) {

@@ -11,7 +11,7 @@ use geo_types::{Coord, Polygon};
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
 use super::text::{draw_text, text_width};
-use crate::analyse::tiling::parse_tile_id;
+use crate::model::tile::parse_tile_id;
 use crate::model::{Dataset, Plan};
 
 /// Longest side of the image in pixels.
@@ -54,18 +54,13 @@ impl View {
         let bounds = match tile {
             Some(b) => b,
             None => {
-                let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
                 let outlines = data
                     .lots
                     .iter()
                     .map(|l| &l.outline)
                     .chain(data.footprints.iter().map(|f| &f.outline));
-                for c in outlines.flat_map(|p| p.exterior().0.iter()) {
-                    x0 = x0.min(c.x);
-                    y0 = y0.min(c.y);
-                    x1 = x1.max(c.x);
-                    y1 = y1.max(c.y);
-                }
+                let [x0, y0, x1, y1] =
+                    crate::geom::bbox::bbox(outlines.flat_map(|p| p.exterior().0.iter().copied()))?;
                 if x0 >= x1 || y0 >= y1 {
                     return None;
                 }

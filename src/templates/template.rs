@@ -8,7 +8,7 @@ use geo_types::Coord;
 
 use super::expr::{compile, Expr, Lot};
 use super::file::{Loc, OutlineSource, PartSource, Source, Src, Text};
-use crate::generate::materials;
+use crate::materials;
 
 /// What a template models; `type_mix` may name only machiya.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]

@@ -1,7 +1,11 @@
 //! Plain data passed between the pipeline stages.
 //!
 //! Every stage takes these types and returns new ones; none of them does I/O. Keeping them
-//! here (and not inside a stage) lets `input/` and `analyse/` stay independent of each other.
+//! here (and not inside a stage) lets the stages depend on the data, never on each other:
+//! `model` depends on nothing of ours.
+
+pub mod dem;
+pub mod tile;
 
 use std::collections::BTreeMap;
 
@@ -19,6 +23,10 @@ pub const FAR: f64 = 1e8;
 /// no-data value nobody declared (GDAL's float32 -3.4e38): DEM cells are then no-data, lots
 /// and footprints are skipped.
 pub const ELEVATION_RANGE: std::ops::RangeInclusive<f64> = -1000.0..=9000.0;
+
+/// The widest street taken from the data or the parameters, metres (the widest avenues are
+/// about 100 m; a larger number is a unit error or damaged data).
+pub const MAX_STREET_WIDTH: f64 = 200.0;
 
 /// Whether a point is nearer than [`FAR`] to the CRS's origin.
 pub fn sane(c: Coord<f64>) -> bool {
@@ -174,7 +182,7 @@ pub struct Dataset {
     pub people: Option<Vec<PointFeature>>,
     pub trees: Option<Vec<PointFeature>>,
     /// The terrain, when the input has one.
-    pub dem: Option<crate::input::dem::Dem>,
+    pub dem: Option<dem::Dem>,
     /// City blocks (machi 町 / gaiku 街区): their boundaries are street edges.
     pub blocks: Vec<Polygon<f64>>,
     pub streets: Vec<Street>,
@@ -238,7 +246,7 @@ impl Frontage {
 }
 
 /// A tile id `<col>_<row>` on the fixed grid.
-pub type TileId = String;
+pub use tile::TileId;
 
 /// A machiya lot after analysis: everything generation needs, nothing more.
 #[derive(Debug, Clone)]

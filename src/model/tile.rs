@@ -1,18 +1,21 @@
-//! Tile ids on a fixed grid (paper section 2.2 (3)).
+//! Tiles (the paper's fixed-size squares of the city): their ids and the ground they cover.
 //!
-//! The grid is anchored at `tile_origin`, not at the data, so a tile keeps its id when the
-//! input grows: scripts that regenerate "tile 12_7" keep working.
+//! Tile `c_r` covers `x0 + c*size <= x < x0 + (c+1)*size` (and the same for `r` in y), with
+//! `tile_origin = [x0, y0]` fixed so ids never change when the data grows.
 
 use geo_types::Coord;
+
+/// A tile's id: `<col>_<row>` on the grid, or a name given in the data.
+pub type TileId = String;
 
 /// The id `<col>_<row>` of the tile holding `p`.
 ///
 /// ```
-/// use edo_city::analyse::tiling::tile_id;
+/// use edo_city::model::tile::tile_id;
 /// use geo_types::Coord;
 /// assert_eq!(tile_id(Coord { x: 260.0, y: -10.0 }, 250.0, [0.0, 0.0]), "1_-1");
 /// ```
-pub fn tile_id(p: Coord<f64>, size: f64, origin: [f64; 2]) -> String {
+pub fn tile_id(p: Coord<f64>, size: f64, origin: [f64; 2]) -> TileId {
     let col = ((p.x - origin[0]) / size).floor() as i64;
     let row = ((p.y - origin[1]) / size).floor() as i64;
     format!("{col}_{row}")
@@ -22,7 +25,7 @@ pub fn tile_id(p: Coord<f64>, size: f64, origin: [f64; 2]) -> String {
 /// or be mistaken for a flag.
 ///
 /// ```
-/// use edo_city::analyse::tiling::is_valid_tile_name;
+/// use edo_city::model::tile::is_valid_tile_name;
 /// assert!(is_valid_tile_name("12_7"));
 /// assert!(is_valid_tile_name("sanjo.east"));
 /// assert!(!is_valid_tile_name("../12_7"));

@@ -1,0 +1,9 @@
+//! Plane geometry under every stage: one operation a file, each with a doc test. Nothing
+//! here knows a lot, a street or a file; the stages (`input`, `analyse`, `generate`,
+//! `output`) and the growers build on it. Where `geo` has the algorithm, it is used.
+
+pub mod bbox;
+pub mod clip;
+pub mod frame;
+pub mod ring;
+pub mod segment;
