@@ -139,6 +139,120 @@ fn open(
     }))
 }
 
+/// Every layer a build reads, one slot a role; `None` where the role is switched off or its
+/// optional default file is not there. The one list of roles: opening, CRS resolution, the
+/// read warnings and the report all walk [`Layers::all`] in this order (lots first: the
+/// first layer decides the output CRS).
+struct Layers {
+    lots: Option<Opened>,
+    footprints: Option<Opened>,
+    streets: Option<Opened>,
+    blocks: Option<Opened>,
+    widths: Option<Opened>,
+    districts: Option<Opened>,
+    fences: Option<Opened>,
+    people: Option<Opened>,
+    trees: Option<Opened>,
+}
+
+impl Layers {
+    /// Opens every role's layer (see [`open`]).
+    fn open(dir: &Path, params: &Params) -> Result<Layers, InputError> {
+        let defaults = Params::default();
+        let (l, d) = (&params.layers, &defaults.layers);
+        // (role, file, encoding, the default file: an optional role's is allowed to be absent)
+        let role = |role, file: &str, encoding: &str, default: &str| {
+            open(dir, role, file, encoding, default)
+        };
+        Ok(Layers {
+            lots: role("lots", &l.lots.file, &l.lots.encoding, &d.lots.file)?,
+            footprints: role("footprints", &l.footprints.file, &l.footprints.encoding, "")?,
+            streets: role(
+                "streets",
+                &l.streets.file,
+                &l.streets.encoding,
+                &d.streets.file,
+            )?,
+            blocks: role("blocks", &l.blocks.file, &l.blocks.encoding, &d.blocks.file)?,
+            widths: role(
+                "street_widths",
+                &l.street_widths.file,
+                &l.street_widths.encoding,
+                "",
+            )?,
+            districts: role("districts", &l.districts.file, &l.districts.encoding, "")?,
+            fences: role("fences", &l.fences.file, &l.fences.encoding, &d.fences.file)?,
+            people: role("people", &l.people.file, &l.people.encoding, &d.people.file)?,
+            trees: role("trees", &l.trees.file, &l.trees.encoding, &d.trees.file)?,
+        })
+    }
+
+    /// The opened layers, in the order of the roles.
+    fn all(&self) -> impl Iterator<Item = &Opened> {
+        [
+            &self.lots,
+            &self.footprints,
+            &self.streets,
+            &self.blocks,
+            &self.widths,
+            &self.districts,
+            &self.fences,
+            &self.people,
+            &self.trees,
+        ]
+        .into_iter()
+        .flatten()
+    }
+
+    /// The same, to change.
+    fn all_mut(&mut self) -> impl Iterator<Item = &mut Opened> {
+        [
+            &mut self.lots,
+            &mut self.footprints,
+            &mut self.streets,
+            &mut self.blocks,
+            &mut self.widths,
+            &mut self.districts,
+            &mut self.fences,
+            &mut self.people,
+            &mut self.trees,
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
+/// What reading a layer noticed, into the dataset: its read warnings, a skip for every record
+/// the DBF marks deleted, and its line of the report.
+fn report_layer(o: &Opened, data: &mut Dataset) {
+    data.warnings.extend(o.layer.warnings.iter().cloned());
+    for &record in &o.layer.deleted {
+        data.skipped.push(Skipped {
+            layer: o.role.into(),
+            file: o.file.clone(),
+            id: format!("record {record}"),
+            record: Some(record),
+            reason: "the DBF marks the record as deleted (an edit that was never packed): it \
+                     is not built; undelete it, or save the layer as a new file to drop it"
+                .into(),
+        });
+    }
+    data.layers.push(LayerInfo {
+        role: o.role.into(),
+        file: o.file.clone(),
+        features: o.layer.records,
+        encoding: o.layer.encoding.clone(),
+        crs: o
+            .src
+            .as_ref()
+            .map(|c| c.definition.clone())
+            .unwrap_or_else(|| "unknown (no .prj)".into()),
+        reprojected: o.reproject,
+        vertices_before: 0,
+        vertices_after: 0,
+    });
+}
+
 /// Reads every layer the parameter file maps, as one dataset in one CRS.
 pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> {
     if !dir.is_dir() {
@@ -147,158 +261,35 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             dir.display()
         )));
     }
-    let defaults = Params::default();
     let l = &params.layers;
-    let dl = &defaults.layers;
-    let mut lots = open(dir, "lots", &l.lots.file, &l.lots.encoding, &dl.lots.file)?;
-    let mut footprints = open(
-        dir,
-        "footprints",
-        &l.footprints.file,
-        &l.footprints.encoding,
-        "",
-    )?;
-    let mut streets = open(
-        dir,
-        "streets",
-        &l.streets.file,
-        &l.streets.encoding,
-        &dl.streets.file,
-    )?;
-    let mut blocks = open(
-        dir,
-        "blocks",
-        &l.blocks.file,
-        &l.blocks.encoding,
-        &dl.blocks.file,
-    )?;
-    let mut widths = open(
-        dir,
-        "street_widths",
-        &l.street_widths.file,
-        &l.street_widths.encoding,
-        "",
-    )?;
-    let mut districts = open(
-        dir,
-        "districts",
-        &l.districts.file,
-        &l.districts.encoding,
-        "",
-    )?;
-    let mut fences = open(
-        dir,
-        "fences",
-        &l.fences.file,
-        &l.fences.encoding,
-        &dl.fences.file,
-    )?;
-    let mut people = open(
-        dir,
-        "people",
-        &l.people.file,
-        &l.people.encoding,
-        &dl.people.file,
-    )?;
-    let mut trees = open(
-        dir,
-        "trees",
-        &l.trees.file,
-        &l.trees.encoding,
-        &dl.trees.file,
-    )?;
-
+    let dl = &Params::default().layers;
+    let mut layers = Layers::open(dir, params)?;
     let mut data = Dataset::default();
     let target = {
-        let mut all: Vec<&mut Opened> = [
-            &mut lots,
-            &mut footprints,
-            &mut streets,
-            &mut blocks,
-            &mut widths,
-            &mut districts,
-            &mut fences,
-            &mut people,
-            &mut trees,
-        ]
-        .into_iter()
-        .filter_map(|o| o.as_mut())
-        .collect();
+        let mut all: Vec<&mut Opened> = layers.all_mut().collect();
         resolve_crs(params, &mut all, &mut data.warnings)?
     };
-    for o in [
-        &mut lots,
-        &mut footprints,
-        &mut streets,
-        &mut blocks,
-        &mut widths,
-        &mut districts,
-        &mut fences,
-        &mut people,
-        &mut trees,
-    ]
-    .into_iter()
-    .flatten()
-    {
+    for o in layers.all_mut() {
         o.reproject = matches!((&o.src, &target), (Some(s), Some(t)) if !s.same_as(t));
     }
     data.crs = target
         .as_ref()
         .map(|c| c.definition.clone())
         .unwrap_or_default();
-    for o in [
-        &lots,
-        &footprints,
-        &streets,
-        &blocks,
-        &widths,
-        &districts,
-        &fences,
-        &people,
-        &trees,
-    ]
-    .into_iter()
-    .flatten()
-    {
-        data.warnings.extend(o.layer.warnings.iter().cloned());
-        for &record in &o.layer.deleted {
-            data.skipped.push(Skipped {
-                layer: o.role.into(),
-                file: o.file.clone(),
-                id: format!("record {record}"),
-                record: Some(record),
-                reason: "the DBF marks the record as deleted (an edit that was never packed): \
-                         it is not built; undelete it, or save the layer as a new file to drop it"
-                    .into(),
-            });
-        }
-        data.layers.push(LayerInfo {
-            role: o.role.into(),
-            file: o.file.clone(),
-            features: o.layer.records,
-            encoding: o.layer.encoding.clone(),
-            crs: o
-                .src
-                .as_ref()
-                .map(|c| c.definition.clone())
-                .unwrap_or_else(|| "unknown (no .prj)".into()),
-            reprojected: o.reproject,
-            vertices_before: 0,
-            vertices_after: 0,
-        });
+    for o in layers.all() {
+        report_layer(o, &mut data);
     }
-
-    if let Some(o) = &mut lots {
+    if let Some(o) = &mut layers.lots {
         data.crs_wkt = o.layer.prj.clone();
         read_lots(dir, params, o, &target, &mut data)?;
     }
-    if let Some(o) = &footprints {
+    if let Some(o) = &layers.footprints {
         if data.crs_wkt.is_none() {
             data.crs_wkt = o.layer.prj.clone();
         }
         read_footprints(params, o, &target, &mut data)?;
     }
-    if let Some(o) = &blocks {
+    if let Some(o) = &layers.blocks {
         for f in &o.layer.features {
             let read =
                 polygons_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polygons"))?;
@@ -321,10 +312,10 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             }
         }
     }
-    if let Some(o) = &streets {
-        read_streets(params, o, &target, widths.as_ref(), &mut data)?;
+    if let Some(o) = &layers.streets {
+        read_streets(params, o, &target, layers.widths.as_ref(), &mut data)?;
     }
-    if let Some(o) = &districts {
+    if let Some(o) = &layers.districts {
         assign_districts(params, o, &target, &mut data)?;
     }
     let something = !data.lots.is_empty() || !data.footprints.is_empty();
@@ -342,12 +333,12 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
             dir.join(&l.streets.file).display()
         )));
     }
-    if let Some(o) = &fences {
+    if let Some(o) = &layers.fences {
         read_fence_lines(params, o, &target, &mut data)?;
     }
     for (o, settings, slot) in [
-        (&people, &l.people, &mut data.people),
-        (&trees, &l.trees, &mut data.trees),
+        (&layers.people, &l.people, &mut data.people),
+        (&layers.trees, &l.trees, &mut data.trees),
     ] {
         if let Some(o) = o {
             *slot = Some(points::read_points(
@@ -360,18 +351,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         }
     }
     data.dem = read_dem(dir, params, &target, &dl.dem.file, &mut data.warnings)?;
-    for o in [
-        &lots,
-        &footprints,
-        &streets,
-        &blocks,
-        &widths,
-        &districts,
-        &fences,
-    ]
-    .into_iter()
-    .flatten()
-    {
+    for o in layers.all() {
         data.warnings.extend(o.winding_warning());
     }
     simplify::generalise(&mut data, &params.simplify);

@@ -1,0 +1,334 @@
+//! One function a command: each takes its parsed flags, resolves its parameters once, calls
+//! the library and prints what the user reads.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use super::args::*;
+use super::progress::Bars;
+use super::summary::{print_check, print_summary};
+use super::Problems;
+use edo_city::build::{build, shards, BuildOptions, NoProgress, Selection};
+use edo_city::params::Params;
+
+/// `edo-city build`.
+pub fn build_command(args: BuildArgs) -> Result<()> {
+    let BuildArgs {
+        input,
+        out,
+        params,
+        templates,
+        threads,
+        quiet,
+        timings,
+        no_plan,
+        tiles,
+        shard,
+        force,
+    } = args;
+    let params = load_params(params.as_deref())?;
+    let opts = BuildOptions {
+        input,
+        out,
+        params,
+        templates,
+        threads,
+        // A plan of the whole city; shards and single tiles leave it to the full build.
+        plan_image: !no_plan && tiles.is_none() && shard.is_none(),
+        selection: match (tiles, shard) {
+            (Some(t), _) => Selection::Tiles(t),
+            (_, Some((index, count))) => Selection::Shard { index, count },
+            _ => Selection::All,
+        },
+        force,
+    };
+    let bars = Bars::new(quiet || !std::io::stderr().is_terminal());
+    let outcome = build(&opts, &bars).context("the build did not finish")?;
+    if !quiet {
+        print_summary(&opts, &outcome)?;
+    }
+    if timings {
+        let t = &outcome.timings;
+        eprintln!(
+            "timings: read {:.3} s, analyse {:.3} s (kura plots and R-tree {:.3} s, people and trees {:.3} s), generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, total {:.3} s",
+            t.read.as_secs_f64(),
+            t.analyse.as_secs_f64(),
+            t.kura.as_secs_f64(),
+            t.billboards.as_secs_f64(),
+            t.generate_and_write.as_secs_f64(),
+            t.generate_cpu.as_secs_f64(),
+            t.write_cpu.as_secs_f64(),
+            t.plan.as_secs_f64(),
+            t.total.as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
+/// `edo-city synth`.
+pub fn synth_command(args: SynthArgs) -> Result<()> {
+    let SynthArgs {
+        dir,
+        lots,
+        seed,
+        force,
+    } = args;
+    let s = edo_city::synth::write_town(&dir, lots, seed, force).map_err(anyhow::Error::msg)?;
+    say!(
+        "wrote {}: {} lots ({} machiya), {} blocks, {} streets",
+        dir.display(),
+        s.lots,
+        s.machiya,
+        s.blocks,
+        s.streets
+    );
+    Ok(())
+}
+
+/// `edo-city tiles`.
+pub fn tiles_command(args: TilesArgs) -> Result<()> {
+    let TilesArgs {
+        input,
+        params,
+        json,
+    } = args;
+    let params = load_params(params.as_deref())?;
+    let catalog = edo_city::build::load_catalog(&params, None)?;
+    let (_, plan, _, _) =
+        edo_city::build::read_and_analyse(&input, &params, &catalog, &NoProgress)?;
+    let tiles = shards::list_tiles(&plan, params.tile_size, params.tile_origin);
+    if json {
+        say!("{}", serde_json::to_string_pretty(&tiles)?);
+    } else {
+        say!("tile\tmachiya\tfootprints\txmin\tymin\txmax\tymax");
+        for t in tiles {
+            say!(
+                "{}\t{}\t{}\t{:.3}\t{:.3}\t{:.3}\t{:.3}",
+                t.id,
+                t.machiya,
+                t.footprints,
+                t.bounds[0],
+                t.bounds[1],
+                t.bounds[2],
+                t.bounds[3]
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `edo-city check`.
+pub fn check_command(args: CheckArgs) -> Result<()> {
+    let CheckArgs {
+        input,
+        params,
+        templates,
+        json,
+    } = args;
+    let params = load_params(params.as_deref())?;
+    let r = edo_city::build::check(&input, &params, templates.as_deref())?;
+    if json {
+        say!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        print_check(&r)?;
+    }
+    let problems = r.counts.skipped + r.warnings.len();
+    if problems > 0 {
+        return Err(Problems(problems).into());
+    }
+    Ok(())
+}
+
+/// `edo-city compare`.
+pub fn compare_command(args: CompareArgs) -> Result<()> {
+    let CompareArgs { a, b, json, plan } = args;
+    let c = edo_city::compare::compare(&a, &b)?;
+    if json {
+        say!("{}", serde_json::to_string_pretty(&c)?);
+    } else {
+        print!("{}", edo_city::compare::render(&c));
+    }
+    if let Some(path) = plan {
+        let png = edo_city::compare::difference_map(&c, &a)?;
+        edo_city::output::atomic::write_atomic(&path, &png)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        if !json {
+            say!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// `edo-city plan`.
+pub fn plan_command(args: PlanArgs) -> Result<()> {
+    let PlanArgs { out, output, tile } = args;
+    let png = edo_city::build::draw_plan_of(&out, tile.as_deref())?;
+    edo_city::output::atomic::write_atomic(&output, &png)
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    say!("wrote {}", output.display());
+    Ok(())
+}
+
+/// `edo-city merge`.
+pub fn merge_command(args: MergeArgs) -> Result<()> {
+    let MergeArgs { dirs, no_plan } = args;
+    let report = shards::merge(&dirs, !no_plan)?;
+    say!(
+        "merged into {}: {} tiles, {} machiya, {} footprints, {} skipped",
+        dirs[0].display(),
+        report.counts.tiles,
+        report.counts.machiya,
+        report.counts.footprints,
+        report.counts.skipped
+    );
+    Ok(())
+}
+
+/// `edo-city init`.
+pub fn init_command(args: InitArgs) -> Result<()> {
+    let InitArgs { dir, output, force } = args;
+    if !dir.is_dir() {
+        anyhow::bail!("{} is not a directory", dir.display());
+    }
+    let text = edo_city::init::params_text(&dir);
+    if output.as_os_str() == "-" {
+        print!("{text}");
+    } else {
+        if output.exists() && !force {
+            anyhow::bail!(
+                "{} exists; give --force to replace it, or -o another file",
+                output.display()
+            );
+        }
+        edo_city::output::atomic::write_atomic(&output, text.as_bytes())
+            .with_context(|| format!("cannot write {}", output.display()))?;
+        let word = |p: &std::path::Path| edo_city::init::shell_word(&p.display().to_string());
+        say!(
+            "wrote {}: check the guesses, then run\n  edo-city build {} --params {} --out out\nand look at out/plan.png",
+            output.display(),
+            word(&dir),
+            word(&output)
+        );
+    }
+    Ok(())
+}
+
+/// `edo-city params`.
+pub fn params_command() -> Result<()> {
+    print!("{}", edo_city::params::DEFAULT_TOML);
+    Ok(())
+}
+
+/// `edo-city template`.
+pub fn template_command(args: TemplateArgs) -> Result<()> {
+    let TemplateArgs {
+        name,
+        width,
+        depth,
+        output,
+        params,
+        templates,
+        set,
+    } = args;
+    template_alone(name, width, depth, &output, params, templates, &set)
+}
+
+/// The parameter file given with `--params`, resolved and checked (every key, range and
+/// `extends`), else the defaults: the one place a command gets its parameters.
+fn load_params(path: Option<&Path>) -> Result<Params> {
+    Ok(match path {
+        Some(p) => Params::from_path(p)?,
+        None => Params::default(),
+    })
+}
+
+/// `edo-city template`: list the templates, or build one alone.
+fn template_alone(
+    name: Option<String>,
+    width: f64,
+    depth: f64,
+    output: &Path,
+    params: Option<PathBuf>,
+    templates: Option<PathBuf>,
+    set: &[String],
+) -> anyhow::Result<()> {
+    let params = load_params(params.as_deref())?;
+    let catalog = edo_city::build::load_catalog(&params, templates.as_deref())?;
+    let Some(name) = name else {
+        say!("template\tkind\tkanji\tfile\tparameters");
+        for t in catalog.templates.values() {
+            let kind = if t.is_abstract {
+                format!("{} (abstract)", t.kind.name())
+            } else {
+                t.kind.name().to_string()
+            };
+            say!(
+                "{}\t{kind}\t{}\t{}\t{}",
+                t.name,
+                t.kanji,
+                t.file,
+                t.param_names().join(" ")
+            );
+        }
+        return Ok(());
+    };
+    let t = match catalog
+        .get(&name)
+        .or_else(|| catalog.resolve(&name).and_then(|n| catalog.get(n)))
+    {
+        Some(t) => t,
+        None => anyhow::bail!(
+            "no template `{name}` (templates: {})",
+            catalog
+                .templates
+                .keys()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    let mut sets = Vec::new();
+    for s in set {
+        let (k, v) = s
+            .split_once('=')
+            .ok_or_else(|| anyhow::anyhow!("--set {s}: write PARAM=VALUE"))?;
+        let v: f64 = v
+            .trim()
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--set {s}: `{v}` is not a number"))?;
+        sets.push((k.trim().to_string(), v));
+    }
+    let alone = edo_city::author::build_alone(&catalog, t, width, depth, &params, &sets)
+        .map_err(anyhow::Error::msg)?;
+    let n =
+        edo_city::author::write(&alone, output, &params.textures).map_err(anyhow::Error::msg)?;
+    say!(
+        "{} ({}) on a {width} x {depth} m lot: {} vertices, {} faces, parts {}",
+        t.name,
+        t.kind.name(),
+        alone.mesh.positions.len(),
+        alone.mesh.faces.len(),
+        alone.parts.join(", ")
+    );
+    match alone.declared_height {
+        Some(h) => say!("height {:.3} m (declared {h:.3} m)", alone.top),
+        None => say!("height {:.3} m", alone.top),
+    }
+    say!(
+        "{}; wrote {} with its .mtl and {n} textures in {}",
+        if edo_city::author::is_closed(&alone.mesh) {
+            "closed shell"
+        } else {
+            "open surfaces (billboards or a fence panel)"
+        },
+        output.display(),
+        output
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join("textures")
+            .display()
+    );
+    Ok(())
+}
