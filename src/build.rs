@@ -328,17 +328,17 @@ fn write_city(
         .map_err(|e| write_err(&opts.out.join("textures"), e))?;
 
     let files = layer_files(&opts.input, params);
-    let tiles: Vec<_> = plan
+    let tiles: Vec<&String> = plan
         .tiles
         .iter()
-        .filter(|(id, _)| selected.contains(id.as_str()))
+        .filter(|id| selected.contains(id.as_str()))
         .collect();
     progress.start("writing tiles", tiles.len() as u64);
     // Nanoseconds per stage summed over threads, to compare the writer with a raw write.
     let (gen_ns, write_ns) = (AtomicU64::new(0), AtomicU64::new(0));
     let results: Vec<Result<report::ManifestTile, BuildError>> = tiles
         .par_iter()
-        .map(|(id, _)| {
+        .map(|&id| {
             let t = Instant::now();
             let tile = generate::TilePlan {
                 ground: terrain_of(&data, params, id),
@@ -352,7 +352,7 @@ fn write_city(
             write_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
             progress.inc(1);
             written.map(|(obj, mtl)| report::ManifestTile {
-                id: (*id).clone(),
+                id: id.clone(),
                 obj,
                 mtl,
                 stats: meshes.stats,
@@ -376,7 +376,7 @@ fn write_city(
             let mut new: std::collections::BTreeMap<String, report::ManifestTile> =
                 written.into_iter().map(|t| (t.id.clone(), t)).collect();
             let mut out = Vec::new();
-            for id in plan.tiles.keys() {
+            for id in &plan.tiles {
                 if let Some(t) = new.remove(id) {
                     out.push(t);
                 } else if let Some(t) = prev.tiles.iter().find(|t| &t.id == id) {
@@ -445,7 +445,7 @@ pub fn check(
     let tiles: Vec<report::ManifestTile> = plan
         .tiles
         .par_iter()
-        .map(|(id, _)| {
+        .map(|id| {
             let tile = generate::TilePlan::of(&plan, id);
             let meshes = generate::generate_tile(&tile, &catalog, params, plan.origin, &files);
             let none = report::ManifestFile {

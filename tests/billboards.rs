@@ -327,7 +327,7 @@ fn point_layers_replace_the_generated_billboards() {
         (street[0].x + street[1].x) / 2.0,
         (street[0].y + street[1].y) / 2.0,
     ];
-    let house = plan.tiles.values().flatten().next().unwrap();
+    let house = plan.houses.values().flatten().next().unwrap();
     let f = house.frontage;
     let v = f.v_axis();
     let in_house = [

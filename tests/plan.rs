@@ -28,7 +28,7 @@ fn lots_are_painted_in_their_types_colours() {
     assert_eq!((png.width(), png.height()), (2400, 2400));
 
     let (mut checked, mut types) = (0, std::collections::BTreeSet::new());
-    for m in plan.tiles.values().flatten() {
+    for m in plan.houses.values().flatten() {
         let c = m.outline.centroid().unwrap();
         let (x, y) = view.pixel(&c.0);
         // Leave out what the legend (top right) and the scale bar (bottom left) cover.

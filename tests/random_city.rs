@@ -278,7 +278,7 @@ proptest! {
         let mut built = std::collections::BTreeSet::new();
         let mut skipped: std::collections::BTreeSet<String> =
             plan.skipped.iter().map(|s| s.id.clone()).collect();
-        for id in plan.tiles.keys() {
+        for id in &plan.tiles {
             let tile = edo_city::generate::TilePlan::of(&plan, id);
             let t = edo_city::generate::generate_tile(&tile, &catalog, &params, plan.origin, &files);
             for s in &t.stats.skipped {

@@ -134,7 +134,7 @@ mod random_geometry {
             let plan = edo_city::analyse::analyse(&data, &params, &catalog, "lots.shp", &|_| {});
             let files = edo_city::generate::LayerFiles::default();
             let mut houses = 0;
-            for lots in plan.tiles.values() {
+            for lots in plan.houses.values() {
                 let tile = edo_city::generate::TilePlan { lots, ..Default::default() };
                 let t = edo_city::generate::generate_tile(&tile, &catalog, &params, plan.origin, &files);
                 for s in &t.stats.skipped {
@@ -158,7 +158,7 @@ mod random_geometry {
                 }
             }
             let skipped = plan.skipped.len()
-                + plan.tiles.values().flatten().count() - houses;
+                + plan.houses.values().flatten().count() - houses;
             prop_assert_eq!(houses + skipped, 1, "the lot is either built or skipped");
         }
     }

@@ -161,7 +161,7 @@ pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, param
     }
     let near = Surroundings::new(data);
     let obstacles = Obstacles::new(
-        plan.tiles.values().flatten(),
+        plan.houses.values().flatten(),
         plan.fences.values().flatten(),
         catalog,
         params,
@@ -187,7 +187,7 @@ pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, param
                 };
                 // Generated billboards dress the built city: a tile with no house, kura or
                 // fence gets none (streets often run on past the lots).
-                sources.retain(|s| s.tiles.iter().any(|t| plan.tiles.contains_key(&t.0)));
+                sources.retain(|s| s.tiles.iter().any(|t| plan.tiles.contains(&t.0)));
                 let scale = budget(&sources, &k, &mut plan.warnings);
                 let drawn: Vec<Vec<Candidate>> = sources
                     .par_iter()
@@ -215,8 +215,8 @@ pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, param
     }
     for (b, given) in all {
         if given {
-            plan.tiles.entry(b.tile.clone()).or_default();
-        } else if !plan.tiles.contains_key(&b.tile) {
+            plan.tiles.insert(b.tile.clone());
+        } else if !plan.tiles.contains(&b.tile) {
             continue; // strayed over a tile border into a tile with nothing built
         }
         plan.billboards.entry(b.tile.clone()).or_default().push(b);
@@ -366,7 +366,7 @@ fn lot_sources<'a>(
     let t = &p.trees;
     // How deep each planned town lot's house is, as a share of the lot's depth.
     let mut built: HashMap<&str, f64> = HashMap::new();
-    for m in plan.tiles.values().flatten().filter(|m| m.height.is_none()) {
+    for m in plan.houses.values().flatten().filter(|m| !m.is_footprint()) {
         let f = super::house::frame_of(m);
         let depth = super::house::local_ring(m, f)
             .iter()

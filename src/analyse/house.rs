@@ -4,12 +4,12 @@
 
 use crate::geom::frame::Frame;
 use crate::geom::ring;
-use crate::model::PlannedMachiya;
+use crate::model::PlannedHouse;
 use crate::params::Params;
 use crate::templates::Catalog;
 
 /// A machiya's frontage frame: u along the street, v into the lot.
-pub fn frame_of(m: &PlannedMachiya) -> Frame {
+pub fn frame_of(m: &PlannedHouse) -> Frame {
     Frame {
         a: m.frontage.a,
         u: m.frontage.u_axis(),
@@ -18,7 +18,7 @@ pub fn frame_of(m: &PlannedMachiya) -> Frame {
 }
 
 /// The exterior ring in the frame, not closed.
-pub fn local_ring(m: &PlannedMachiya, f: Frame) -> Vec<[f64; 2]> {
+pub fn local_ring(m: &PlannedHouse, f: Frame) -> Vec<[f64; 2]> {
     ring::open(m.outline.exterior())
         .iter()
         .map(|c| f.local(*c))
@@ -27,8 +27,8 @@ pub fn local_ring(m: &PlannedMachiya, f: Frame) -> Vec<[f64; 2]> {
 
 /// Where the house ends behind the frontage: its type's `setback` + `depth` (else
 /// `machiya.depth`), at most the lot; a footprint building is its whole outline.
-pub fn house_end(m: &PlannedMachiya, lot_depth: f64, catalog: &Catalog, params: &Params) -> f64 {
-    if m.height.is_some() {
+pub fn house_end(m: &PlannedHouse, lot_depth: f64, catalog: &Catalog, params: &Params) -> f64 {
+    if m.is_footprint() {
         return lot_depth;
     }
     let (mut setback, mut depth) = (0.0, 0.0);

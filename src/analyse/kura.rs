@@ -19,7 +19,7 @@ use rstar::{RTree, AABB};
 use super::house::{house_end, local_ring};
 use crate::geom::clip::{overlap_area, Quad};
 use crate::geom::frame::Frame;
-use crate::model::{KuraDecision, PlannedMachiya};
+use crate::model::{KuraDecision, PlannedHouse};
 use crate::params::Params;
 use crate::templates::Catalog;
 
@@ -82,7 +82,7 @@ fn u_ranges(ring: &[[f64; 2]], v0: f64, v1: f64) -> Option<((f64, f64), (f64, f6
 
 /// Where a candidate's kura stands, in its frame: `[u0, v0, u1, v1]`, or why none does.
 fn place(
-    m: &PlannedMachiya,
+    m: &PlannedHouse,
     ring: &[[f64; 2]],
     f: Frame,
     end: f64,
@@ -91,7 +91,7 @@ fn place(
 ) -> KuraDecision {
     let k = &params.kura;
     let width = m.frontage.width();
-    if m.height.is_some() || width < k.min_frontage || depth < k.depth_ratio * width {
+    if m.is_footprint() || width < k.min_frontage || depth < k.depth_ratio * width {
         return KuraDecision::NotCandidate;
     }
     let v1 = depth - k.back_margin;
@@ -138,7 +138,7 @@ fn corners(q: &Quad) -> ([f64; 2], [f64; 2]) {
 }
 
 /// Decides every machiya's kura: candidates, placement, provisional plots and collisions.
-pub fn decide(planned: &mut [&mut PlannedMachiya], catalog: &Catalog, params: &Params) {
+pub fn decide(planned: &mut [&mut PlannedHouse], catalog: &Catalog, params: &Params) {
     if !params.kura.enabled {
         return;
     }

@@ -16,7 +16,7 @@ use geo_types::Coord;
 use rand::RngExt;
 use rayon::prelude::*;
 
-use crate::model::{Dataset, Footprint, Lot, LotUse, Plan, PlannedMachiya, Skipped};
+use crate::model::{Dataset, Footprint, Lot, LotUse, Plan, PlannedHouse, Skipped};
 use crate::params::Params;
 use crate::rng::feature_rng;
 use crate::templates::Catalog;
@@ -25,7 +25,7 @@ use street::StreetEdges;
 
 /// Why a lot did not make it into the plan, or what it became.
 enum Outcome {
-    Planned(Box<PlannedMachiya>, Vec<String>),
+    Planned(Box<PlannedHouse>, Vec<String>),
     Skipped(Skipped),
 }
 
@@ -68,7 +68,7 @@ pub fn analyse(
     let mut outcomes = outcomes;
     let mut fp_outcomes = fp_outcomes;
     let t = std::time::Instant::now();
-    let mut planned: Vec<&mut PlannedMachiya> = outcomes
+    let mut planned: Vec<&mut PlannedHouse> = outcomes
         .iter_mut()
         .chain(fp_outcomes.iter_mut())
         .filter_map(|o| match o {
@@ -97,7 +97,8 @@ pub fn analyse(
                     plan.frontage_fallback += 1;
                 }
                 plan.warnings.extend(warnings);
-                plan.tiles.entry(m.tile.clone()).or_default().push(*m);
+                plan.tiles.insert(m.tile.clone());
+                plan.houses.entry(m.tile.clone()).or_default().push(*m);
             }
             Outcome::Skipped(s) => plan.skipped.push(s),
         }
@@ -121,7 +122,7 @@ pub fn analyse(
             }
             plan.warnings.extend(warnings);
             for f in segments {
-                plan.tiles.entry(f.tile.clone()).or_default();
+                plan.tiles.insert(f.tile.clone());
                 plan.fences.entry(f.tile.clone()).or_default().push(f);
             }
         }
@@ -203,7 +204,7 @@ fn plan_lot(
     };
     let attrs = template_attributes(lot, &mtype, catalog, lots_file, &mut warnings);
     Outcome::Planned(
-        Box::new(PlannedMachiya {
+        Box::new(PlannedHouse {
             id: lot.id.clone(),
             record: lot.record,
             outline: lot.outline.clone(),
@@ -213,7 +214,7 @@ fn plan_lot(
             district: lot.district.clone(),
             tile,
             ground: lot.ground,
-            height: None,
+            source: crate::model::HouseSource::Lot,
             attrs,
             kura: Default::default(),
         }),
@@ -287,7 +288,7 @@ fn plan_footprint(
         ));
     }
     Outcome::Planned(
-        Box::new(PlannedMachiya {
+        Box::new(PlannedHouse {
             id: f.id.clone(),
             record: f.record,
             outline: f.outline.clone(),
@@ -297,7 +298,7 @@ fn plan_footprint(
             district: f.district.clone(),
             tile: crate::model::tile::tile_id(centroid.0, params.tile_size, params.tile_origin),
             ground: f.ground,
-            height: Some(f.height),
+            source: crate::model::HouseSource::Footprint { height: f.height },
             attrs: Vec::new(),
             kura: Default::default(),
         }),

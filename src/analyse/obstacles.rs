@@ -13,7 +13,7 @@ use rstar::{RTree, AABB};
 
 use super::house::{frame_of, house_end, local_ring};
 use crate::geom::segment::segment_distance_2;
-use crate::model::{sane, PlannedFence, PlannedMachiya};
+use crate::model::{sane, PlannedFence, PlannedHouse};
 use crate::params::Params;
 use crate::templates::Catalog;
 
@@ -42,7 +42,7 @@ impl Obstacles {
     /// Every house and kura that will be built (kura as `kura.collision` decides) and every
     /// fence segment.
     pub fn new<'a>(
-        houses: impl Iterator<Item = &'a PlannedMachiya>,
+        houses: impl Iterator<Item = &'a PlannedHouse>,
         fences: impl Iterator<Item = &'a PlannedFence>,
         catalog: &Catalog,
         params: &Params,
@@ -144,12 +144,12 @@ mod tests {
     use super::*;
     use crate::model::{Frontage, KuraDecision};
 
-    fn house(kura: KuraDecision) -> PlannedMachiya {
+    fn house(kura: KuraDecision) -> PlannedHouse {
         let outline = Polygon::new(
             vec![(0.0, 0.0), (6.0, 0.0), (6.0, 30.0), (0.0, 30.0), (0.0, 0.0)].into(),
             vec![],
         );
-        PlannedMachiya {
+        PlannedHouse {
             id: "1".into(),
             record: 0,
             outline,
@@ -163,7 +163,7 @@ mod tests {
             district: None,
             tile: "0_0".into(),
             ground: 0.0,
-            height: None,
+            source: crate::model::HouseSource::Lot,
             attrs: vec![],
             kura,
         }

@@ -5,10 +5,10 @@
 use geo_types::Coord;
 
 use crate::model::dem::Dem;
-use crate::model::{PlannedFence, PlannedMachiya};
+use crate::model::{PlannedFence, PlannedHouse};
 
 /// Sets every house's ground from the DEM; returns how many sampled points were off it.
-pub fn ground_houses(planned: &mut [&mut PlannedMachiya], dem: &Dem) -> usize {
+pub fn ground_houses(planned: &mut [&mut PlannedHouse], dem: &Dem) -> usize {
     let mut off = 0;
     for m in planned.iter_mut() {
         let f = &m.frontage;

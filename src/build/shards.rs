@@ -151,7 +151,7 @@ pub fn previous_manifest(out: &Path, needs: &str) -> Result<Manifest, BuildError
 fn features(plan: &Plan) -> BTreeMap<&str, usize> {
     plan.tiles
         .iter()
-        .map(|(id, lots)| (id.as_str(), lots.len()))
+        .map(|id| (id.as_str(), plan.houses.get(id).map_or(0, Vec::len)))
         .collect()
 }
 
@@ -178,7 +178,7 @@ pub fn shard_of_tiles(plan: &Plan, count: usize) -> BTreeMap<String, usize> {
 /// The ids of the tiles this run writes.
 pub fn select(plan: &Plan, selection: &Selection) -> Result<HashSet<String>, BuildError> {
     match selection {
-        Selection::All => Ok(plan.tiles.keys().cloned().collect()),
+        Selection::All => Ok(plan.tiles.iter().cloned().collect()),
         Selection::Tiles(ids) => {
             if ids.is_empty() || ids.iter().any(|id| id.trim().is_empty()) {
                 return Err(BuildError::Config(format!(
@@ -187,10 +187,7 @@ pub fn select(plan: &Plan, selection: &Selection) -> Result<HashSet<String>, Bui
                     ids.join(",")
                 )));
             }
-            let unknown: Vec<&String> = ids
-                .iter()
-                .filter(|id| !plan.tiles.contains_key(*id))
-                .collect();
+            let unknown: Vec<&String> = ids.iter().filter(|id| !plan.tiles.contains(*id)).collect();
             if !unknown.is_empty() {
                 return Err(BuildError::Config(format!(
                     "no feature falls in tile(s) {}; `edo-city tiles <input>` lists the {} tiles of this input",
@@ -426,7 +423,8 @@ pub struct TileInfo {
 pub fn list_tiles(plan: &Plan, tile_size: f64, origin: [f64; 2]) -> Vec<TileInfo> {
     plan.tiles
         .iter()
-        .map(|(id, lots)| {
+        .map(|id| {
+            let lots = plan.houses.get(id).map_or(&[][..], Vec::as_slice);
             // A tile named in the data: the extent of its houses (a tile of walls alone has
             // none, and is given the empty box it always had).
             let bounds =
@@ -439,8 +437,8 @@ pub fn list_tiles(plan: &Plan, tile_size: f64, origin: [f64; 2]) -> Vec<TileInfo
                 });
             TileInfo {
                 id: id.clone(),
-                machiya: lots.iter().filter(|m| m.height.is_none()).count(),
-                footprints: lots.iter().filter(|m| m.height.is_some()).count(),
+                machiya: lots.iter().filter(|m| !m.is_footprint()).count(),
+                footprints: lots.iter().filter(|m| m.is_footprint()).count(),
                 bounds,
             }
         })
@@ -450,11 +448,11 @@ pub fn list_tiles(plan: &Plan, tile_size: f64, origin: [f64; 2]) -> Vec<TileInfo
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Frontage, PlannedMachiya};
+    use crate::model::{Frontage, PlannedHouse};
     use geo_types::{Coord, LineString, Polygon};
 
     fn plan_with(counts: &[(&str, usize)]) -> Plan {
-        let lot = PlannedMachiya {
+        let lot = PlannedHouse {
             id: "x".into(),
             record: 0,
             outline: Polygon::new(LineString::from(vec![(0., 0.), (1., 0.), (1., 1.)]), vec![]),
@@ -468,13 +466,14 @@ mod tests {
             district: None,
             tile: String::new(),
             ground: 0.0,
-            height: None,
+            source: crate::model::HouseSource::Lot,
             attrs: Vec::new(),
             kura: Default::default(),
         };
         let mut plan = Plan::default();
         for (id, n) in counts {
-            plan.tiles.insert(id.to_string(), vec![lot.clone(); *n]);
+            plan.tiles.insert(id.to_string());
+            plan.houses.insert(id.to_string(), vec![lot.clone(); *n]);
         }
         plan
     }
@@ -493,7 +492,7 @@ mod tests {
         assert_eq!(shards.len(), 6);
         let mut load = [0; 3];
         for (id, s) in &shards {
-            load[*s] += plan.tiles[id].len();
+            load[*s] += plan.houses[id].len();
         }
         assert_eq!(load.iter().sum::<usize>(), 160);
         assert!(

@@ -8,7 +8,7 @@ use geo_types::Coord;
 use super::clip::LocalPoly;
 use super::instance::{instantiate, Local, Site};
 use super::mesh::{Frame, Mesh};
-use crate::model::PlannedMachiya;
+use crate::model::PlannedHouse;
 use crate::params::MachiyaParams;
 use crate::templates::expr::Lot;
 use crate::templates::template::SiteInputs;
@@ -17,7 +17,7 @@ use crate::templates::Template;
 /// Builds the kura of `m` on `rect` (`[u0, v0, u1, v1]` in the machiya's frame).
 #[allow(clippy::too_many_arguments)]
 pub fn build(
-    m: &PlannedMachiya,
+    m: &PlannedHouse,
     rect: [f64; 4],
     t: &Template,
     overrides: &[(usize, f64)],

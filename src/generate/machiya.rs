@@ -8,14 +8,14 @@
 use super::clip::{area, dedup, LocalPoly, LocalRing};
 use super::instance::{instantiate, Local, Site};
 use super::mesh::{Frame, Mesh};
-use crate::model::PlannedMachiya;
+use crate::model::PlannedHouse;
 use crate::params::MachiyaParams;
 use crate::templates::expr::Lot;
 use crate::templates::template::{SiteInputs, N_INPUTS};
 use crate::templates::Template;
 
 /// The lot of `m` in its frontage frame.
-pub fn site_of(m: &PlannedMachiya) -> Result<Site, String> {
+pub fn site_of(m: &PlannedHouse) -> Result<Site, String> {
     let f = &m.frontage;
     let local = Local {
         a: f.a,
@@ -61,7 +61,7 @@ pub fn site_of(m: &PlannedMachiya) -> Result<Site, String> {
 /// What every template is told about a feature (see `template::INPUTS`).
 pub fn inputs(
     site: &Site,
-    m: &PlannedMachiya,
+    m: &PlannedHouse,
     params: &MachiyaParams,
     random: f64,
 ) -> [f64; N_INPUTS] {
@@ -76,7 +76,7 @@ pub fn inputs(
         ground: m.ground,
         id: &m.id,
         district: m.district.as_deref(),
-        building_height: m.height.unwrap_or(0.0),
+        building_height: m.footprint_height().unwrap_or(0.0),
         machiya_depth: params.depth,
         min_depth: params.min_depth,
         random,
@@ -87,7 +87,7 @@ pub fn inputs(
 
 /// Builds the mesh of one machiya, or says why it cannot be built.
 pub fn build(
-    m: &PlannedMachiya,
+    m: &PlannedHouse,
     t: &Template,
     overrides: &[(usize, f64)],
     params: &MachiyaParams,
@@ -119,15 +119,11 @@ mod tests {
     use crate::templates::Catalog;
     use geo_types::Coord;
 
-    fn build_plain(
-        m: &PlannedMachiya,
-        t: &Template,
-        params: &MachiyaParams,
-    ) -> Result<Mesh, String> {
+    fn build_plain(m: &PlannedHouse, t: &Template, params: &MachiyaParams) -> Result<Mesh, String> {
         build(m, t, &[], params, 0.5, Frame { origin: [0.0, 0.0] })
     }
 
-    fn declared_height(m: &PlannedMachiya, t: &Template, params: &MachiyaParams) -> f64 {
+    fn declared_height(m: &PlannedHouse, t: &Template, params: &MachiyaParams) -> f64 {
         let site = site_of(m).unwrap();
         let slots = t
             .evaluate(&inputs(&site, m, params, 0.5), &[], &[], &site)
@@ -144,10 +140,10 @@ mod tests {
     use geo_types::{LineString, Polygon};
     use proptest::prelude::*;
 
-    fn planned(ring: &[[f64; 2]]) -> PlannedMachiya {
+    fn planned(ring: &[[f64; 2]]) -> PlannedHouse {
         let mut pts: Vec<Coord<f64>> = ring.iter().map(|p| Coord { x: p[0], y: p[1] }).collect();
         pts.push(pts[0]);
-        PlannedMachiya {
+        PlannedHouse {
             id: "1".into(),
             record: 0,
             outline: Polygon::new(LineString(pts), vec![]),
@@ -167,7 +163,7 @@ mod tests {
             district: None,
             tile: "0_0".into(),
             ground: 0.0,
-            height: None,
+            source: crate::model::HouseSource::Lot,
             attrs: Vec::new(),
             kura: Default::default(),
         }

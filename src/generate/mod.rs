@@ -13,7 +13,7 @@ pub mod mesh;
 pub mod terrain;
 
 use crate::model::{
-    FenceKind, KuraDecision, PlannedBillboard, PlannedFence, PlannedMachiya, Skipped, TileStats,
+    FenceKind, KuraDecision, PlannedBillboard, PlannedFence, PlannedHouse, Skipped, TileStats,
 };
 use crate::params::Params;
 use crate::templates::Catalog;
@@ -41,7 +41,7 @@ pub struct LayerFiles {
 /// What one tile of the plan holds.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TilePlan<'a> {
-    pub lots: &'a [PlannedMachiya],
+    pub lots: &'a [PlannedHouse],
     pub fences: &'a [PlannedFence],
     pub billboards: &'a [PlannedBillboard],
     /// The DEM, the tile's id and its bounds, when the terrain is to be written.
@@ -52,7 +52,7 @@ impl<'a> TilePlan<'a> {
     /// Tile `id` of `plan`, without terrain.
     pub fn of(plan: &'a crate::model::Plan, id: &str) -> TilePlan<'a> {
         TilePlan {
-            lots: plan.tiles.get(id).map_or(&[][..], Vec::as_slice),
+            lots: plan.houses.get(id).map_or(&[][..], Vec::as_slice),
             fences: plan.fences.get(id).map_or(&[][..], Vec::as_slice),
             billboards: plan.billboards.get(id).map_or(&[][..], Vec::as_slice),
             ground: None,
@@ -83,7 +83,7 @@ pub fn generate_tile(
         .then(|| catalog.get(&params.kura.template))
         .flatten();
     for m in tile.lots {
-        let layer = if m.height.is_some() {
+        let layer = if m.is_footprint() {
             "footprints"
         } else {
             "lots"
@@ -96,7 +96,7 @@ pub fn generate_tile(
             }
             None => Err(format!("machiya type `{}` has no template", m.mtype)),
         };
-        let (file, skipped) = match m.height {
+        let (file, skipped) = match m.footprint_height() {
             None => (&files.lots, "lots"),
             Some(_) => (&files.footprints, "footprints"),
         };
@@ -117,7 +117,7 @@ pub fn generate_tile(
         out.meshes.push(mesh);
         let st = &mut out.stats;
         let district = m.district.clone().unwrap_or_default();
-        let by_type = if m.height.is_some() {
+        let by_type = if m.is_footprint() {
             st.footprints += 1;
             &mut st.footprints_by_type
         } else {

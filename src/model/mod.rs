@@ -248,9 +248,33 @@ impl Frontage {
 /// A tile id `<col>_<row>` on the fixed grid.
 pub use tile::TileId;
 
+/// What a planned house stands for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HouseSource {
+    /// A lot-filling machiya on a town lot: its template decides its height.
+    Lot,
+    /// A building footprint of the data (PLATEAU, OSM), built to its own total height, metres.
+    Footprint { height: f64 },
+}
+
+impl PlannedHouse {
+    /// The footprint's total height, for a house from a footprint layer.
+    pub fn footprint_height(&self) -> Option<f64> {
+        match self.source {
+            HouseSource::Lot => None,
+            HouseSource::Footprint { height } => Some(height),
+        }
+    }
+
+    /// Whether the house comes from a footprint layer (not a lot).
+    pub fn is_footprint(&self) -> bool {
+        self.footprint_height().is_some()
+    }
+}
+
 /// A machiya lot after analysis: everything generation needs, nothing more.
 #[derive(Debug, Clone)]
-pub struct PlannedMachiya {
+pub struct PlannedHouse {
     pub id: String,
     pub record: usize,
     pub outline: Polygon<f64>,
@@ -263,8 +287,8 @@ pub struct PlannedMachiya {
     pub tile: TileId,
     /// Ground elevation under the house, metres.
     pub ground: f64,
-    /// Total height for a footprint house; `None` for a lot-filling machiya.
-    pub height: Option<f64>,
+    /// What the house is: a machiya filling its lot, or a building footprint of the data.
+    pub source: HouseSource,
     /// The feature's numeric attributes that its template declares (`[attributes]`).
     pub attrs: Vec<(String, f64)>,
     /// Its kura, as section 4.2 decided.
@@ -403,12 +427,12 @@ impl KuraCounts {
     }
 }
 
-impl PlannedMachiya {
+impl PlannedHouse {
     /// Object name in the OBJ: `machiya_<id>` for lots, `footprint_<id>` for footprints.
     pub fn object_name(&self) -> String {
-        match self.height {
-            None => format!("machiya_{}", self.id),
-            Some(_) => format!("footprint_{}", self.id),
+        match self.source {
+            HouseSource::Lot => format!("machiya_{}", self.id),
+            HouseSource::Footprint { .. } => format!("footprint_{}", self.id),
         }
     }
 }
@@ -418,8 +442,11 @@ impl PlannedMachiya {
 pub struct Plan {
     /// Dataset origin in projected metres: output coordinates are relative to it.
     pub origin: [f64; 2],
-    /// Machiya per tile, each tile's list in input order.
-    pub tiles: BTreeMap<TileId, Vec<PlannedMachiya>>,
+    /// Houses (machiya and footprints) per tile, each tile's list in input order.
+    pub houses: BTreeMap<TileId, Vec<PlannedHouse>>,
+    /// Every tile with something to build (houses, fences or given people and trees): the
+    /// tiles a full build writes.
+    pub tiles: std::collections::BTreeSet<TileId>,
     pub frontage_fallback: usize,
     /// Footprints planned (they share the tiles with the machiya).
     pub footprints: usize,
@@ -429,11 +456,11 @@ pub struct Plan {
     pub kura_time: std::time::Duration,
     /// Time spent placing people and trees.
     pub billboards_time: std::time::Duration,
-    /// Fence segments and gates per tile, in input order (a tile here always has an entry,
-    /// maybe empty, in `tiles`).
+    /// Fence segments and gates per tile, in input order (each of these tiles is in
+    /// `tiles`).
     pub fences: BTreeMap<TileId, Vec<PlannedFence>>,
-    /// People and trees per tile, only in tiles that have an entry in `tiles`; people first,
-    /// each kind in a fixed order.
+    /// People and trees per tile, only in tiles of `tiles`; people first, each kind in a
+    /// fixed order.
     pub billboards: BTreeMap<TileId, Vec<PlannedBillboard>>,
 }
 

@@ -94,10 +94,10 @@ impl View {
 
 /// The colour each machiya type gets: by type-name order among the types in the plan.
 pub fn type_colours(plan: &Plan) -> BTreeMap<String, [u8; 3]> {
-    plan.tiles
+    plan.houses
         .values()
         .flatten()
-        .filter(|m| m.height.is_none())
+        .filter(|m| !m.is_footprint())
         .map(|m| m.mtype.clone())
         .collect::<std::collections::BTreeSet<_>>()
         .into_iter()
@@ -177,10 +177,10 @@ pub fn draw_plan(
     let colours = type_colours(plan);
     let skipped: HashSet<&str> = plan.skipped.iter().map(|s| s.id.as_str()).collect();
     let planned: HashSet<&str> = plan
-        .tiles
+        .houses
         .values()
         .flatten()
-        .filter(|m| m.height.is_none())
+        .filter(|m| !m.is_footprint())
         .map(|m| m.id.as_str())
         .collect();
     for lot in &data.lots {
@@ -197,8 +197,8 @@ pub fn draw_plan(
             pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin, id, None);
         }
     }
-    for m in plan.tiles.values().flatten() {
-        let colour = match m.height {
+    for m in plan.houses.values().flatten() {
+        let colour = match m.footprint_height() {
             Some(_) => FOOTPRINT,
             None => colours.get(&m.mtype).copied().unwrap_or(TYPE_COLOURS[0]),
         };
@@ -213,7 +213,7 @@ pub fn draw_plan(
             width: 1.5,
             ..Stroke::default()
         };
-        for m in plan.tiles.values().flatten() {
+        for m in plan.houses.values().flatten() {
             let Some(r) = m.kura.rect() else { continue };
             let (u, v, a) = (m.frontage.u_axis(), m.frontage.v_axis(), m.frontage.a);
             let at = |p: [f64; 2]| Coord {
@@ -283,7 +283,7 @@ pub fn draw_plan(
         width: 2.5,
         ..Stroke::default()
     };
-    for m in plan.tiles.values().flatten() {
+    for m in plan.houses.values().flatten() {
         if let Some(path) = line_path(view, &[m.frontage.a, m.frontage.b]) {
             pm.stroke_path(&path, &paint(FRONTAGE, 255), &frontage, id, None);
         }
@@ -329,7 +329,7 @@ fn draw_tile_grid(pm: &mut Pixmap, view: &View, plan: &Plan, (size, origin): (f6
         dash: tiny_skia::StrokeDash::new(vec![6.0, 4.0], 0.0),
         ..Stroke::default()
     };
-    for id in plan.tiles.keys() {
+    for id in &plan.tiles {
         let Some((c, r)) = parse_tile_id(id) else {
             continue;
         };
