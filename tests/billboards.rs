@@ -263,7 +263,8 @@ fn a_density_beyond_the_tile_cap_is_capped_with_a_warning() {
         .as_array()
         .unwrap()
         .iter()
-        .map(|w| w.as_str().unwrap())
+        .filter(|w| w["class"] == "billboards" && w["key"] == "people.max_points_per_tile")
+        .map(|w| w["message"].as_str().unwrap())
         .collect();
     assert!(
         warnings

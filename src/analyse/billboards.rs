@@ -444,7 +444,11 @@ fn tiles_under(bb: geo_types::Rect<f64>, centroid: Coord<f64>, p: &Params) -> Ve
 
 /// Density scale per tile: a tile whose sources expect more than `max_points_per_tile`
 /// points has its densities scaled down to it, with a warning.
-fn budget(sources: &[Source], k: &Kind, warnings: &mut Vec<String>) -> BTreeMap<String, f64> {
+fn budget(
+    sources: &[Source],
+    k: &Kind,
+    warnings: &mut Vec<crate::model::Warning>,
+) -> BTreeMap<String, f64> {
     let mut expected: BTreeMap<&str, f64> = BTreeMap::new();
     for s in sources {
         for (tile, share) in &s.tiles {
@@ -455,11 +459,17 @@ fn budget(sources: &[Source], k: &Kind, warnings: &mut Vec<String>) -> BTreeMap<
     for (tile, e) in expected {
         if e > k.max_per_tile as f64 {
             let f = k.max_per_tile as f64 / e;
-            warnings.push(format!(
-                "{}: tile {tile} would get about {e:.0} {} at `{}`, more than \
-                 max_points_per_tile = {}; its density was scaled by {f:.4}",
-                k.layer, k.layer, k.density_key, k.max_per_tile
-            ));
+            warnings.push(
+                crate::model::Warning::new(
+                    crate::model::WarningClass::Billboards,
+                    format!(
+                        "{}: tile {tile} would get about {e:.0} {} at `{}`, more than \
+                         max_points_per_tile = {}; its density was scaled by {f:.4}",
+                        k.layer, k.layer, k.density_key, k.max_per_tile
+                    ),
+                )
+                .for_key(&format!("{}.max_points_per_tile", k.layer)),
+            );
             scale.insert(tile.to_string(), f);
         }
     }
@@ -579,13 +589,18 @@ fn from_points(
         if let Some(t) = &f.texture {
             match texture_of(t, k.textures) {
                 Some(name) => c.b.texture = name,
-                None => plan.warnings.push(format!(
-                    "{}: {} {}: texture `{t}` is neither a library material nor a number \
-                     from 1 to {}; one was drawn",
-                    k.file,
+                None => plan.warnings.push(crate::model::Warning::feature(
                     k.layer,
-                    f.id,
-                    k.textures.len()
+                    k.file,
+                    &f.id,
+                    format!(
+                        "{}: {} {}: texture `{t}` is neither a library material nor a number \
+                         from 1 to {}; one was drawn",
+                        k.file,
+                        k.layer,
+                        f.id,
+                        k.textures.len()
+                    ),
                 )),
             }
         }
@@ -645,7 +660,7 @@ fn thin(mut points: Vec<Candidate>, spacing: f64) -> Vec<PlannedBillboard> {
 fn cap_tiles(
     points: Vec<PlannedBillboard>,
     k: &Kind,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<crate::model::Warning>,
 ) -> Vec<PlannedBillboard> {
     let mut per_tile: BTreeMap<String, Vec<PlannedBillboard>> = BTreeMap::new();
     for b in points {
@@ -654,14 +669,20 @@ fn cap_tiles(
     let mut out = Vec::new();
     for (tile, mut v) in per_tile {
         if v.len() > k.max_per_tile {
-            warnings.push(format!(
+            warnings.push(
+                crate::model::Warning::new(
+                    crate::model::WarningClass::Billboards,
+                    format!(
                 "{}: tile {tile} has {} points, more than max_points_per_tile = {}; the first \
                  {} were kept",
                 k.layer,
                 v.len(),
                 k.max_per_tile,
                 k.max_per_tile
-            ));
+            ),
+                )
+                .for_key(&format!("{}.max_points_per_tile", k.layer)),
+            );
             v.truncate(k.max_per_tile);
         }
         v.sort_by(|a, b| a.id.cmp(&b.id));

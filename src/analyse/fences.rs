@@ -112,7 +112,7 @@ fn segments(
     closed: bool,
     gate: Option<usize>,
     params: &Params,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<crate::model::Warning>,
 ) -> Vec<PlannedFence> {
     let n = pts.len();
     let count = if closed { n } else { n - 1 };
@@ -163,13 +163,18 @@ fn segments(
         }
         let gw = params.fence.gate_width;
         if len <= gw {
-            warnings.push(format!(
-                "{}: {} {}: edge {} is {len:.2} m, shorter than the gate ({gw} m): the gate \
-                 fills the edge",
+            warnings.push(crate::model::Warning::feature(
+                w.layer,
                 w.file,
-                if w.layer == "lots" { "lot" } else { "fence" },
                 w.id,
-                i + 1
+                format!(
+                    "{}: {} {}: edge {} is {len:.2} m, shorter than the gate ({gw} m): the gate \
+                 fills the edge",
+                    w.file,
+                    if w.layer == "lots" { "lot" } else { "fence" },
+                    w.id,
+                    i + 1
+                ),
             ));
             out.push(seg(a, b, 0.0, 0.0, FenceKind::Gate, i));
             continue;
@@ -197,7 +202,7 @@ fn height_attr(
     attrs: &std::collections::BTreeMap<String, String>,
     params: &Params,
     what: &str,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<crate::model::Warning>,
 ) -> Vec<(String, f64)> {
     let Some(raw) = attr(attrs, &params.fence.height_field) else {
         return Vec::new();
@@ -207,11 +212,17 @@ fn height_attr(
             vec![("height".to_string(), h)]
         }
         _ => {
-            warnings.push(format!(
-                "{what}: `{}` = `{raw}` is not a wall height in metres (above 0, up to \
+            warnings.push(
+                crate::model::Warning::new(
+                    crate::model::WarningClass::Feature,
+                    format!(
+                        "{what}: `{}` = `{raw}` is not a wall height in metres (above 0, up to \
                  {MAX_WALL_HEIGHT}); its wall has the template's height",
-                params.fence.height_field
-            ));
+                        params.fence.height_field
+                    ),
+                )
+                .for_key("fence.height_field"),
+            );
             Vec::new()
         }
     }
@@ -224,11 +235,14 @@ fn gate_of(
     edges: &StreetEdges,
     params: &Params,
     what: &str,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<crate::model::Warning>,
 ) -> Option<usize> {
     let raw = attr(attrs, &params.fence.gate_field).unwrap_or("");
     gate_edge(raw, pts, edges).unwrap_or_else(|e| {
-        warnings.push(format!("{what}: {e}; no gate built"));
+        warnings.push(crate::model::Warning::new(
+            crate::model::WarningClass::Feature,
+            format!("{what}: {e}; no gate built"),
+        ));
         None
     })
 }
@@ -239,7 +253,7 @@ pub fn plan_lot_fences(
     edges: &StreetEdges,
     params: &Params,
     lots_file: &str,
-) -> (Vec<PlannedFence>, Vec<String>) {
+) -> (Vec<PlannedFence>, Vec<crate::model::Warning>) {
     let mut warnings = Vec::new();
     let ring: Vec<Coord<f64>> = crate::geom::ring::open(lot.outline.exterior()).to_vec();
     if ring.len() < 3 {
@@ -274,7 +288,7 @@ pub fn plan_line_fences(
     edges: &StreetEdges,
     params: &Params,
     file: &str,
-) -> (Vec<PlannedFence>, Vec<String>) {
+) -> (Vec<PlannedFence>, Vec<crate::model::Warning>) {
     let mut warnings = Vec::new();
     let mut pts = f.line.0.clone();
     let closed = pts.len() >= 4 && {

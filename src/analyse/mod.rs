@@ -25,7 +25,7 @@ use street::StreetEdges;
 
 /// Why a lot did not make it into the plan, or what it became.
 enum Outcome {
-    Planned(Box<PlannedHouse>, Vec<String>),
+    Planned(Box<PlannedHouse>, Vec<crate::model::Warning>),
     Skipped(Skipped),
 }
 
@@ -104,14 +104,14 @@ pub fn analyse(
         }
     }
     if params.fence.enabled {
-        let walled: Vec<(Vec<crate::model::PlannedFence>, Vec<String>)> = data
+        let walled: Vec<(Vec<crate::model::PlannedFence>, Vec<crate::model::Warning>)> = data
             .lots
             .par_iter()
             .filter(|l| params.fence.uses.iter().any(|u| u == l.lot_use.name()))
             .map(|l| fences::plan_lot_fences(l, &edges, params, lots_file))
             .collect();
         let fences_file = params.layers.fences.file.clone();
-        let lines: Vec<(Vec<crate::model::PlannedFence>, Vec<String>)> = data
+        let lines: Vec<(Vec<crate::model::PlannedFence>, Vec<crate::model::Warning>)> = data
             .fence_lines
             .par_iter()
             .map(|f| fences::plan_line_fences(f, &edges, params, &fences_file))
@@ -132,11 +132,17 @@ pub fn analyse(
     plan.billboards_time = t.elapsed();
     if off_dem > 0 {
         if let Some(dem) = &data.dem {
-            plan.warnings.push(format!(
+            plan.warnings.push(
+                crate::model::Warning::new(
+                    crate::model::WarningClass::Layer,
+                    format!(
                 "{}: {off_dem} point(s) of houses or fences lie outside the DEM; they stand on \
                  the elevation of its nearest edge",
                 dem.file
-            ));
+            ),
+                )
+                .in_file(&dem.file),
+            );
         }
     }
     plan
@@ -178,9 +184,14 @@ fn plan_lot(
     let given = lot.mtype.as_deref().and_then(|m| {
         let r = catalog.resolve(m);
         if r.is_none() {
-            warnings.push(format!(
+            warnings.push(crate::model::Warning::feature(
+                "lots",
+                lots_file,
+                &lot.id,
+                format!(
                 "{lots_file}: lot {}: unknown machiya type `{m}`; a type was drawn from type_mix",
                 lot.id
+            ),
             ));
         }
         r
@@ -193,10 +204,15 @@ fn plan_lot(
     let tile = match lot.tile.as_deref() {
         Some(t) if crate::model::tile::is_valid_tile_name(t) => t.to_string(),
         Some(t) => {
-            warnings.push(format!(
+            warnings.push(crate::model::Warning::feature(
+                "lots",
+                lots_file,
+                &lot.id,
+                format!(
                 "{lots_file}: lot {}: tile `{t}` is not usable as a file name (letters, digits, \
                  `_`, `-` and `.` only); the computed tile was used",
                 lot.id
+            ),
             ));
             computed()
         }
@@ -230,7 +246,7 @@ fn template_attributes(
     mtype: &str,
     catalog: &Catalog,
     lots_file: &str,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<crate::model::Warning>,
 ) -> Vec<(String, f64)> {
     let Some(t) = catalog.machiya(mtype) else {
         return Vec::new();
@@ -247,10 +263,15 @@ fn template_attributes(
         }
         match raw.parse::<f64>() {
             Ok(x) if x.is_finite() => out.push((name.to_string(), x)),
-            _ => warnings.push(format!(
-                "{lots_file}: lot {}: attribute `{field}` = `{raw}` is not a number; template \
+            _ => warnings.push(crate::model::Warning::feature(
+                "lots",
+                lots_file,
+                &lot.id,
+                format!(
+                    "{lots_file}: lot {}: attribute `{field}` = `{raw}` is not a number; template \
                  {mtype} used its default",
-                lot.id
+                    lot.id
+                ),
             )),
         }
     }
@@ -282,9 +303,14 @@ fn plan_footprint(
     let mut warnings = Vec::new();
     let given = f.mtype.as_deref().and_then(|m| catalog.resolve(m));
     if let (Some(m), None) = (&f.mtype, given) {
-        warnings.push(format!(
-            "{}: footprint {}: unknown type `{m}`; built as {}",
-            fp.file, f.id, fp.default_type
+        warnings.push(crate::model::Warning::feature(
+            "footprints",
+            &fp.file,
+            &f.id,
+            format!(
+                "{}: footprint {}: unknown type `{m}`; built as {}",
+                fp.file, f.id, fp.default_type
+            ),
         ));
     }
     Outcome::Planned(

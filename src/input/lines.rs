@@ -126,10 +126,14 @@ pub(super) fn read_streets(
         }
     }
     if bad_width > 0 {
-        data.warnings.push(format!(
-            "{}: {bad_width} street(s) have a `{}` that is not a number of metres above 0 and \
+        data.warnings.push(crate::model::Warning::layer(
+            o.role,
+            &o.file,
+            format!(
+                "{}: {bad_width} street(s) have a `{}` that is not a number of metres above 0 and \
              up to {MAX_STREET_WIDTH}; they get the default width {} m",
-            o.file, sp.width_field, sp.default_width
+                o.file, sp.width_field, sp.default_width
+            ),
         ));
     }
     if let Some(wl) = widths {
@@ -178,11 +182,15 @@ pub(super) fn read_streets(
             }
         }
         let (pieces, matched) = widths::apply_widths(streets, &lines, wp.max_distance);
-        data.warnings.push(format!(
-            "{}: {matched} of {} street pieces took their width from {}",
-            o.file,
-            pieces.len(),
-            wl.file
+        data.warnings.push(crate::model::Warning::layer(
+            o.role,
+            &o.file,
+            format!(
+                "{}: {matched} of {} street pieces took their width from {}",
+                o.file,
+                pieces.len(),
+                wl.file
+            ),
         ));
         streets = pieces;
     }

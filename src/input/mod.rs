@@ -66,15 +66,16 @@ impl Opened {
     }
 
     /// The warning for the rings wound against the standard, if any.
-    fn winding_warning(&self) -> Option<String> {
+    fn winding_warning(&self) -> Option<crate::model::Warning> {
         let n = self.against_winding.get();
         (n > 0).then(|| {
-            format!(
+            let message = format!(
                 "{}: {n} ring(s) are wound against the shapefile standard (outer rings \
                  counter-clockwise or holes clockwise, as many non-ESRI tools write them); they \
                  were read by where they lie, as GDAL and QGIS read them",
                 self.file
-            )
+            );
+            crate::model::Warning::layer(self.role, &self.file, message)
         })
     }
 
@@ -225,7 +226,12 @@ impl Layers {
 /// What reading a layer noticed, into the dataset: its read warnings, a skip for every record
 /// the DBF marks deleted, and its line of the report.
 fn report_layer(o: &Opened, data: &mut Dataset) {
-    data.warnings.extend(o.layer.warnings.iter().cloned());
+    // The reader of the file knows the file; the role is known here.
+    data.warnings
+        .extend(o.layer.warnings.iter().map(|w| crate::model::Warning {
+            layer: Some(o.role.to_string()),
+            ..w.clone()
+        }));
     for &record in &o.layer.deleted {
         data.skipped.push(Skipped {
             layer: o.role.into(),
@@ -320,11 +326,12 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
     }
     let something = !data.lots.is_empty() || !data.footprints.is_empty();
     if !something {
-        data.warnings.push(
+        data.warnings.push(crate::model::Warning::new(
+            crate::model::WarningClass::Build,
             "no lots and no footprints were read: there is nothing to build (set `layers.lots.file` \
              or `layers.footprints.file`)"
-                .into(),
-        );
+                .to_string(),
+        ));
     } else if data.blocks.is_empty() && data.streets.is_empty() {
         return Err(InputError::Missing(format!(
             "no street edges: neither a blocks layer ({}) nor a streets layer ({}) was read; the \
@@ -382,16 +389,20 @@ fn rule(
     default_field: &str,
     values: &std::collections::BTreeMap<String, std::collections::BTreeMap<String, String>>,
     constants: &std::collections::BTreeMap<String, String>,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<crate::model::Warning>,
 ) -> AttributeRule {
     let resolved = resolve_field(field, &o.layer.fields, o.layer.text_encoding)
         .or_else(|| resolve_field(field, extra_fields, None))
         .map(String::from);
     if resolved.is_none() && !field.is_empty() && field != default_field {
-        warnings.push(format!(
-            "{}: no field `{field}` for `{attr}` (fields: {}); the attribute is left empty",
-            o.file,
-            o.layer.fields.join(", ")
+        warnings.push(crate::model::Warning::layer(
+            o.role,
+            &o.file,
+            format!(
+                "{}: no field `{field}` for `{attr}` (fields: {}); the attribute is left empty",
+                o.file,
+                o.layer.fields.join(", ")
+            ),
         ));
     }
     AttributeRule {
@@ -407,7 +418,7 @@ fn read_dem(
     params: &Params,
     target: &Option<Crs>,
     default_file: &str,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<crate::model::Warning>,
 ) -> Result<Option<dem::Dem>, InputError> {
     let file = params.layers.dem.file.trim();
     if file.is_empty() {
@@ -447,14 +458,18 @@ fn read_dem(
     }
     let dem = dem::read(&path)?;
     if dem.implausible > 0 {
-        warnings.push(format!(
-            "{}: {} cell(s) hold a number no ground has (outside {}..{} m, such as an \
+        warnings.push(crate::model::Warning::layer(
+            "dem",
+            &dem.file,
+            format!(
+                "{}: {} cell(s) hold a number no ground has (outside {}..{} m, such as an \
              undeclared no-data value like -3.4e38); they are read as NODATA: declare the \
              value (NODATA_value, or GDAL's no-data tag) to silence this",
-            dem.file,
-            dem.implausible,
-            crate::model::ELEVATION_RANGE.start(),
-            crate::model::ELEVATION_RANGE.end()
+                dem.file,
+                dem.implausible,
+                crate::model::ELEVATION_RANGE.start(),
+                crate::model::ELEVATION_RANGE.end()
+            ),
         ));
     }
     Ok(Some(dem))

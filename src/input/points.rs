@@ -17,7 +17,7 @@ pub(super) fn read_points(
     o: &Opened,
     target: &Option<super::crs::Crs>,
     skipped: &mut Vec<Skipped>,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<crate::model::Warning>,
 ) -> Result<Vec<PointFeature>, InputError> {
     let field = |name: &str| resolve_field(name, &o.layer.fields, o.layer.text_encoding);
     let (id_field, height_field, texture_field) = (
@@ -37,12 +37,17 @@ pub(super) fn read_points(
         let height = match value(height_field) {
             None => None,
             Some(raw) => match raw.parse::<f64>() {
-                Ok(h) if h.is_finite() && h > 0.0 => Some(h),
+                Ok(h) if h.is_finite() && h > 0.0 && h <= 100.0 => Some(h),
                 _ => {
-                    warnings.push(format!(
-                        "{}: {} {id}: height `{raw}` is not a positive number of metres; a \
-                         height was drawn",
-                        o.file, o.role
+                    warnings.push(crate::model::Warning::feature(
+                        o.role,
+                        &o.file,
+                        &id,
+                        format!(
+                            "{}: {} {id}: height `{raw}` is not a number of metres above 0 and \
+                         up to 100; a height was drawn",
+                            o.file, o.role
+                        ),
                     ));
                     None
                 }

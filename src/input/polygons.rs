@@ -122,11 +122,18 @@ pub(super) fn read_lots(
         }
     });
     if bad_ground > 0 {
-        data.warnings.push(format!(
-            "{}: {bad_ground} lot(s) have a `{}` that is not a number; they stand on the \
+        data.warnings.push(
+            crate::model::Warning::layer(
+                o.role,
+                &o.file,
+                format!(
+                    "{}: {bad_ground} lot(s) have a `{}` that is not a number; they stand on the \
              lowest Z of their outline, else 0",
-            o.file, lp.fields.ground
-        ));
+                    o.file, lp.fields.ground
+                ),
+            )
+            .for_key("layers.lots.fields.ground"),
+        );
     }
     data.lots = lots;
     Ok(())
@@ -229,11 +236,15 @@ pub(super) fn read_footprints(
         }
     }
     for (field, n) in unusable.into_inner() {
-        data.warnings.push(format!(
-            "{}: {n} footprint(s) have a `{field}` that is not a positive number (heights up \
+        data.warnings.push(crate::model::Warning::layer(
+            o.role,
+            &o.file,
+            format!(
+                "{}: {n} footprint(s) have a `{field}` that is not a positive number (heights up \
              to {MAX_BUILDING_HEIGHT} m, storeys up to 200); their height came from the next \
              source (height, storeys x storey_height, default_height)",
-            o.file
+                o.file
+            ),
         ));
     }
     Ok(())
@@ -320,9 +331,13 @@ pub(super) fn assign_districts(
         outside += f.district.is_none() as usize;
     }
     if outside > 0 {
-        data.warnings.push(format!(
+        data.warnings.push(crate::model::Warning::layer(
+            o.role,
+            &o.file,
+            format!(
             "{}: {outside} lot(s) or footprint(s) lie in no district polygon and have no district",
             o.file
+        ),
         ));
     }
     Ok(())

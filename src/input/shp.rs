@@ -34,7 +34,7 @@ pub struct Layer {
     pub fields: Vec<String>,
     /// The `.prj` text, if present.
     pub prj: Option<String>,
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::model::Warning>,
     /// Records in the file, deleted ones included (the FIDs run 0..records).
     pub records: usize,
     /// Records the DBF marks as deleted: they have no feature and are reported skipped.
@@ -143,7 +143,13 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
     })?;
 
     let cpg = sidecar(&path.with_extension("cpg")).unwrap_or_else(|why| {
-        warnings.push(format!("{why}; reading the DBF by its header"));
+        warnings.push(
+            crate::model::Warning::new(
+                crate::model::WarningClass::Layer,
+                format!("{why}; reading the DBF by its header"),
+            )
+            .in_file(&file),
+        );
         None
     });
     let (encoding, encoding_name) = if !forced.trim().is_empty() {
@@ -156,10 +162,10 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
         match encoding_for(label) {
             Some(enc) => (Some(enc), format!("{} (.cpg)", enc.name())),
             None => {
-                warnings.push(format!(
+                warnings.push(crate::model::Warning::new(crate::model::WarningClass::Layer, format!(
                     "{file}: the .cpg names an unknown code page `{}`; reading the DBF by its header",
                     label.trim()
-                ));
+                )).in_file(&file));
                 (None, "DBF header".to_string())
             }
         }
@@ -180,13 +186,19 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
     let fields: Vec<String> = dbf.fields().iter().map(|f| f.name().to_string()).collect();
     for (i, name) in fields.iter().enumerate() {
         if let Some(j) = fields[i + 1..].iter().position(|n| n == name) {
-            warnings.push(format!(
+            warnings.push(
+                crate::model::Warning::new(
+                    crate::model::WarningClass::Layer,
+                    format!(
                 "{}: two fields are named `{name}` (fields {} and {}); only the later one's \
                  values are read: rename one of them in the GIS",
                 dbf_path.display(),
                 i + 1,
                 i + j + 2
-            ));
+            ),
+                )
+                .in_file(&dbf_path.display().to_string()),
+            );
         }
     }
     let records = dbf.read().map_err(|e| InputError::Layer {
@@ -241,11 +253,11 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
         });
     }
     if garbled > 0 {
-        warnings.push(format!(
+        warnings.push(crate::model::Warning::new(crate::model::WarningClass::Layer, format!(
             "{file}: {garbled} text value(s) did not decode as {encoding_name} and contain \u{fffd}; \
              if the data is Japanese, add a .cpg file containing SHIFT_JIS or set \
              `encoding = \"shift_jis\"` for this layer in the parameter file"
-        ));
+        )).in_file(&file));
     }
     let prj = sidecar(&path.with_extension("prj")).map_err(|why| InputError::Layer {
         file: file.clone(),

@@ -21,7 +21,7 @@ pub struct Table {
     pub unusable: Vec<(usize, String, String)>,
     /// What the reader noticed and the user should know (ignored files, unnamed columns,
     /// formulas without values).
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::model::Warning>,
 }
 
 impl Table {
@@ -63,12 +63,18 @@ impl Table {
             .map(column_name)
             .collect();
         if !unnamed.is_empty() {
-            t.warnings.push(format!(
+            t.warnings.push(
+                crate::model::Warning::new(
+                    crate::model::WarningClass::Table,
+                    format!(
                 "{}: column(s) {} hold values but have no name in the header row (a merged \
                  header cell?); their values are not used: give each column a name of its own",
                 t.file,
                 unnamed.join(", ")
-            ));
+            ),
+                )
+                .in_file(&t.file),
+            );
         }
         let mut first: std::collections::HashMap<String, usize> = Default::default();
         for (n, values) in rows {
@@ -123,12 +129,18 @@ pub fn find_and_read(
     if csv.exists() {
         let mut t = read_csv(&csv, id_field)?;
         if xlsx.exists() {
-            t.warnings.push(format!(
+            t.warnings.push(
+                crate::model::Warning::new(
+                    crate::model::WarningClass::Table,
+                    format!(
                 "both {} and {} are there; the CSV was joined and the workbook ignored: remove \
                  or rename the one that is not current",
                 csv.display(),
                 xlsx.display()
-            ));
+            ),
+                )
+                .in_file(&t.file),
+            );
         }
         Ok(Some(t))
     } else if xlsx.exists() {
@@ -255,12 +267,18 @@ pub fn read_xlsx(path: &Path, sheet: &str, id_field: &str) -> Result<Table, Inpu
             })
             .count();
         if lost > 0 {
-            t.warnings.push(format!(
+            t.warnings.push(
+                crate::model::Warning::new(
+                    crate::model::WarningClass::Table,
+                    format!(
                 "{}: {lost} formula cell(s) of sheet `{name}` have no saved value and read as \
                  empty: open the workbook in Excel or LibreOffice and save it, so the values \
                  are stored",
                 t.file
-            ));
+            ),
+                )
+                .in_file(&t.file),
+            );
         }
     }
     Ok(t)

@@ -32,7 +32,11 @@ pub(super) fn layer_coords(o: &Opened) -> Vec<Coord<f64>> {
 /// Warns when a layer said to be in projected metres (by its `.prj` or by `crs`) has every
 /// coordinate within +-180 / +-90, as longitude/latitude degrees would be: a town that small
 /// around a CRS's origin is rare, a `.prj` copied from the wrong file is not.
-pub(super) fn degrees_in_metres(o: &Opened, params: &Params, warnings: &mut Vec<String>) {
+pub(super) fn degrees_in_metres(
+    o: &Opened,
+    params: &Params,
+    warnings: &mut Vec<crate::model::Warning>,
+) {
     let said = match &o.layer.prj {
         Some(wkt) => Crs::from_wkt(wkt).ok(),
         None => Crs::from_user(&params.crs).ok(),
@@ -46,11 +50,15 @@ pub(super) fn degrees_in_metres(o: &Opened, params: &Params, warnings: &mut Vec<
             Some(_) => "its .prj".to_string(),
             None => format!("`crs` = {}", params.crs),
         };
-        warnings.push(format!(
+        warnings.push(crate::model::Warning::layer(
+            o.role,
+            &o.file,
+            format!(
             "{}: every coordinate lies within +-180 / +-90, like longitude/latitude in degrees, \
              but {source} says projected metres ({}); if they are degrees, replace the .prj \
              with a WGS84 one or remove it",
             o.file, said.definition
+        ),
         ));
     }
 }
@@ -85,7 +93,7 @@ fn metres_in_degrees(o: &Opened) -> Result<(), InputError> {
 pub(super) fn resolve_crs(
     params: &Params,
     layers: &mut [&mut Opened],
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<crate::model::Warning>,
 ) -> Result<Option<Crs>, InputError> {
     let mut target = None;
     if !params.crs.trim().is_empty() {
@@ -109,24 +117,39 @@ pub(super) fn resolve_crs(
                 message: format!("{m}; fix the .prj or remove it and set `crs`"),
             })?),
             None if !params.crs.trim().is_empty() => {
-                warnings.push(format!(
-                    "{}: no .prj; its coordinates are taken to be in `crs` = {}",
-                    o.file, params.crs
-                ));
+                warnings.push(
+                    crate::model::Warning::layer(
+                        o.role,
+                        &o.file,
+                        format!(
+                            "{}: no .prj; its coordinates are taken to be in `crs` = {}",
+                            o.file, params.crs
+                        ),
+                    )
+                    .for_key("crs"),
+                );
                 Crs::from_user(&params.crs).ok()
             }
             None if crs::looks_like_degrees(layer_coords(o)) => {
-                warnings.push(format!(
+                warnings.push(crate::model::Warning::layer(
+                    o.role,
+                    &o.file,
+                    format!(
                     "{}: no .prj, and every coordinate looks like longitude/latitude in degrees; \
                      read as WGS84 degrees (add a .prj or set `crs` if that is wrong)",
                     o.file
+                ),
                 ));
                 Crs::from_user("EPSG:4326").ok()
             }
             None => {
-                warnings.push(format!(
+                warnings.push(crate::model::Warning::layer(
+                    o.role,
+                    &o.file,
+                    format!(
                     "{}: no .prj; its coordinates are taken as projected metres in the output CRS",
                     o.file
+                ),
                 ));
                 None
             }
@@ -148,10 +171,10 @@ pub(super) fn resolve_crs(
                     let lon = pts.iter().map(|c| c.x).sum::<f64>() / n;
                     let lat = pts.iter().map(|c| c.y).sum::<f64>() / n;
                     let utm = Crs::utm_for(lon, lat);
-                    warnings.push(format!(
+                    warnings.push(crate::model::Warning::layer(o.role, &o.file, format!(
                         "{} is in longitude/latitude; the city is built in {} (set `crs` to choose)",
                         o.file, utm.definition
-                    ));
+                    )).for_key("crs"));
                     Some(utm)
                 }
                 None => None,

@@ -6,6 +6,7 @@
 
 pub mod dem;
 pub mod tile;
+pub mod warning;
 
 use std::collections::BTreeMap;
 
@@ -193,7 +194,7 @@ pub struct Dataset {
     pub crs: String,
     pub layers: Vec<LayerInfo>,
     pub skipped: Vec<Skipped>,
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Warning>,
     pub joins: Vec<TableJoin>,
     /// For the layers whose features keep no record number (blocks, streets, districts,
     /// street widths): the records that gave at least one usable feature, by role. The
@@ -247,6 +248,7 @@ impl Frontage {
 
 /// A tile id `<col>_<row>` on the fixed grid.
 pub use tile::TileId;
+pub use warning::{Warning, WarningClass};
 
 /// What a planned house stands for.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -451,7 +453,7 @@ pub struct Plan {
     /// Footprints planned (they share the tiles with the machiya).
     pub footprints: usize,
     pub skipped: Vec<Skipped>,
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Warning>,
     /// Time spent placing kura and testing their provisional plots (for `--timings`).
     pub kura_time: std::time::Duration,
     /// Time spent placing people and trees.

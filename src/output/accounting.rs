@@ -111,7 +111,11 @@ pub fn ledgers(data: &Dataset) -> Vec<Ledger> {
 
 /// Closes each ledger with every skip of the build; adds a warning per layer that lost
 /// records.
-pub fn close(ledgers: &[Ledger], skipped: &[Skipped], warnings: &mut Vec<String>) -> Vec<Account> {
+pub fn close(
+    ledgers: &[Ledger],
+    skipped: &[Skipped],
+    warnings: &mut Vec<crate::model::Warning>,
+) -> Vec<Account> {
     ledgers
         .iter()
         .map(|l| {
@@ -152,11 +156,17 @@ pub fn close(ledgers: &[Ledger], skipped: &[Skipped], warnings: &mut Vec<String>
                 }
             }
             if a.unaccounted > 0 {
-                warnings.push(format!(
+                warnings.push(
+                    crate::model::Warning::new(
+                        crate::model::WarningClass::Build,
+                        format!(
                     "{}: {} record(s) were neither built nor listed as skipped (records {:?}); \
                      this is a defect of edo-city: please report it with the file",
                     a.file, a.unaccounted, a.unaccounted_records
-                ));
+                ),
+                    )
+                    .in_layer(&a.role, &a.file),
+                );
             }
             a
         })
@@ -199,7 +209,8 @@ mod tests {
         assert_eq!(a[0].unaccounted, 1);
         assert_eq!(a[0].unaccounted_records, vec![2]);
         assert_eq!(w.len(), 1);
-        assert!(w[0].contains("defect"), "{}", w[0]);
+        assert!(w[0].message.contains("defect"), "{}", w[0]);
+        assert_eq!(w[0].class, crate::model::WarningClass::Build);
     }
 
     #[test]

@@ -137,7 +137,7 @@ pub struct Report {
     pub skipped: Vec<Skipped>,
     pub skipped_by_reason: BTreeMap<String, usize>,
     pub tables: Vec<TableJoin>,
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::model::Warning>,
     /// Per layer: records read, built, skipped, and unaccounted (always 0; see
     /// [`super::accounting`]).
     pub accounting: Vec<super::accounting::Account>,
@@ -168,7 +168,7 @@ pub struct InputSummary {
     pub frontage_fallback: usize,
     pub skipped: Vec<Skipped>,
     pub tables: Vec<TableJoin>,
-    pub warnings: Vec<String>,
+    pub warnings: Vec<crate::model::Warning>,
     /// What each layer's records became in reading and analysis, closed in the report.
     #[serde(default)]
     pub ledgers: Vec<super::accounting::Ledger>,
