@@ -94,7 +94,14 @@ pub fn instantiate(
         let first_face = mesh.faces.len();
         let closed = match &part.shape {
             Shape::Prism(p) => {
-                prism(t, p, &part.name, site, frame, &cell, &scalar, mesh)?;
+                let cx = PartCx {
+                    t,
+                    name: &part.name,
+                    site,
+                    cell: &cell,
+                    scalar: &scalar,
+                };
+                prism(&cx, p, frame, mesh)?;
                 p.closed
             }
             Shape::Faces(f) => {
@@ -114,19 +121,42 @@ pub fn instantiate(
 
 type Scalar<'a> = dyn Fn(&Expr, &str, &str) -> Result<f64, String> + 'a;
 
-#[allow(clippy::too_many_arguments)]
+/// What every part of one template built on one site shares.
+struct PartCx<'a> {
+    t: &'a Template,
+    name: &'a str,
+    site: &'a Site,
+    /// The template's slots, with the `u` and `v` slots set per point by [`PartCx::at`].
+    cell: &'a RefCell<Vec<f64>>,
+    scalar: &'a Scalar<'a>,
+}
+
+impl PartCx<'_> {
+    /// A scalar expression of the part (finite, or an error naming `what`).
+    fn scalar(&self, e: &Expr, what: &str) -> Result<f64, String> {
+        (self.scalar)(e, what, self.name)
+    }
+
+    /// An expression of the part evaluated at the local point `q` (`u`, `v` set).
+    fn at(&self, e: &Expr, q: [f64; 2]) -> f64 {
+        let (us, vs) = (self.t.v_slot - 1, self.t.v_slot);
+        let mut s = self.cell.borrow_mut();
+        s[us] = q[0];
+        s[vs] = q[1];
+        e.eval(&s, self.site)
+    }
+}
+
+/// A prism part: its outline (the lot, or its own points) cut to its bands, split where its
+/// roof line bends, checked, and extruded between its bottom and top.
 fn prism(
-    t: &Template,
+    cx: &PartCx,
     p: &Prism,
-    name: &str,
-    site: &Site,
     frame: Frame,
-    cell: &RefCell<Vec<f64>>,
-    scalar: &Scalar,
     mesh: &mut Mesh,
 ) -> Result<(), String> {
     let bound = |e: &Option<Expr>, what: &str, inf: f64| -> Result<f64, String> {
-        e.as_ref().map_or(Ok(inf), |e| scalar(e, what, name))
+        e.as_ref().map_or(Ok(inf), |e| cx.scalar(e, what))
     };
     let (v0, v1) = (
         bound(&p.v0, "v0", f64::NEG_INFINITY)?,
@@ -136,108 +166,27 @@ fn prism(
         bound(&p.u0, "u0", f64::NEG_INFINITY)?,
         bound(&p.u1, "u1", f64::INFINITY)?,
     );
-    let outline = match &p.outline {
-        None => site.lot.clone(),
-        Some(points) => {
-            let mut ring: LocalRing = points
-                .iter()
-                .map(|[u, v]| {
-                    Ok([
-                        scalar(u, "an outline u", name)?,
-                        scalar(v, "an outline v", name)?,
-                    ])
-                })
-                .collect::<Result<_, String>>()?;
-            if area(&ring) < 0.0 {
-                ring.reverse();
-            }
-            let ring = dedup(ring);
-            if ring.len() < 3 || area(&ring) <= 1e-9 {
-                return Err(format!(
-                    "template {}: part `{name}`: the outline has no area",
-                    t.name
-                ));
-            }
-            LocalPoly::simple(ring)
-        }
-    };
+    let outline = prism_outline(cx, p)?;
     let mut pieces = Vec::new();
     for b in clip_band(&outline, v0, v1) {
         pieces.extend(clip_band_u(&b, u0, u1));
     }
     // Where the roof line bends: split there so that every top face is planar.
-    let splits_v: Vec<f64> = p
-        .split
-        .iter()
-        .map(|e| scalar(e, "a split", name))
-        .collect::<Result<_, _>>()?;
-    let splits_u: Vec<f64> = p
-        .split_u
-        .iter()
-        .map(|e| scalar(e, "a split_u", name))
-        .collect::<Result<_, _>>()?;
-    // A vertex within a millimetre of a split line is moved onto it: otherwise the two sides
-    // share a sliver that rounds to nothing and leaves the shell open.
-    let snap = |pieces: &mut Vec<LocalPoly>, axis: usize, s: f64| {
-        for q in pieces.iter_mut() {
-            for r in std::iter::once(&mut q.exterior).chain(q.holes.iter_mut()) {
-                for p in r.iter_mut() {
-                    if (p[axis] - s).abs() < 1e-3 {
-                        p[axis] = s;
-                    }
-                }
-            }
-        }
+    let splits = |exprs: &[Expr], what: &str| -> Result<Vec<f64>, String> {
+        exprs.iter().map(|e| cx.scalar(e, what)).collect()
     };
+    let (splits_v, splits_u) = (splits(&p.split, "a split")?, splits(&p.split_u, "a split_u")?);
     for &s in &splits_v {
-        snap(&mut pieces, 1, s);
-        pieces = pieces
-            .iter()
-            .flat_map(|q| {
-                let mut both = clip_band(q, f64::NEG_INFINITY, s);
-                both.extend(clip_band(q, s, f64::INFINITY));
-                both
-            })
-            .collect();
+        pieces = split_at(pieces, 1, s);
     }
     for &s in &splits_u {
-        snap(&mut pieces, 0, s);
-        pieces = pieces
-            .iter()
-            .flat_map(|q| {
-                let mut both = clip_band_u(q, f64::NEG_INFINITY, s);
-                both.extend(clip_band_u(q, s, f64::INFINITY));
-                both
-            })
-            .collect();
+        pieces = split_at(pieces, 0, s);
     }
     if pieces.is_empty() {
         // Nothing of the outline lies in the band: the part is absent on this lot.
         return Ok(());
     }
-    let (us, vs) = (t.v_slot - 1, t.v_slot);
-    let at = |e: &Expr, q: [f64; 2]| -> f64 {
-        let mut s = cell.borrow_mut();
-        s[us] = q[0];
-        s[vs] = q[1];
-        e.eval(&s, site)
-    };
-    // Check every corner once: finite, and the top not below the bottom.
-    for q in pieces.iter().flat_map(|x| x.rings().flatten()) {
-        let (b, h) = (at(&p.bottom, *q), at(&p.top, *q));
-        if !(b.is_finite() && h.is_finite()) {
-            return Err(format!(
-                "template {}: part `{name}`: top or bottom is not a number at u={:.2}, v={:.2}",
-                t.name, q[0], q[1]
-            ));
-        }
-        if h < b - 1e-6 {
-            return Err(format!(
-                "template {}: part `{name}`: top {h:.2} m is below bottom {b:.2} m (a negative height) at u={:.2}, v={:.2}",
-                t.name, q[0], q[1]
-            ));
-        }
-    }
+    check_heights(cx, p, &pieces)?;
     let front_v = if p.v0.is_some() {
         v0
     } else {
@@ -251,8 +200,8 @@ fn prism(
         Some(material) => Some(Facade {
             material,
             front_v,
-            base: scalar(&p.front_base, "front_base", name)?,
-            height: scalar(&p.front_height, "front_height", name)?,
+            base: cx.scalar(&p.front_base, "front_base")?,
+            height: cx.scalar(&p.front_height, "front_height")?,
         }),
         None => None,
     };
@@ -262,19 +211,87 @@ fn prism(
         wall: p.side_material,
         facade,
     };
-    let (g, slope) = (site.ground, site.slope);
+    let (g, slope) = (cx.site.ground, cx.site.slope);
     extrude(
         mesh,
         frame,
-        site.local,
+        cx.site.local,
         &pieces,
-        &|q| g + slope * q[0] + at(&p.bottom, q),
-        &|q| g + slope * q[0] + at(&p.top, q),
+        &|q| g + slope * q[0] + cx.at(&p.bottom, q),
+        &|q| g + slope * q[0] + cx.at(&p.top, q),
         &splits_v,
         &splits_u,
         &dress,
         g,
     );
+    Ok(())
+}
+
+/// The outline a prism is cut from: the lot, or the part's own points (counter-clockwise,
+/// with an area).
+fn prism_outline(cx: &PartCx, p: &Prism) -> Result<LocalPoly, String> {
+    let Some(points) = &p.outline else {
+        return Ok(cx.site.lot.clone());
+    };
+    let mut ring: LocalRing = points
+        .iter()
+        .map(|[u, v]| Ok([cx.scalar(u, "an outline u")?, cx.scalar(v, "an outline v")?]))
+        .collect::<Result<_, String>>()?;
+    if area(&ring) < 0.0 {
+        ring.reverse();
+    }
+    let ring = dedup(ring);
+    if ring.len() < 3 || area(&ring) <= 1e-9 {
+        return Err(format!(
+            "template {}: part `{}`: the outline has no area",
+            cx.t.name, cx.name
+        ));
+    }
+    Ok(LocalPoly::simple(ring))
+}
+
+/// The pieces split along the line `axis = s` (0: u, 1: v). A vertex within a millimetre of
+/// the line is first moved onto it: otherwise the two sides share a sliver that rounds to
+/// nothing and leaves the shell open.
+fn split_at(mut pieces: Vec<LocalPoly>, axis: usize, s: f64) -> Vec<LocalPoly> {
+    for q in pieces.iter_mut() {
+        for r in std::iter::once(&mut q.exterior).chain(q.holes.iter_mut()) {
+            for p in r.iter_mut() {
+                if (p[axis] - s).abs() < 1e-3 {
+                    p[axis] = s;
+                }
+            }
+        }
+    }
+    let clip = if axis == 1 { clip_band } else { clip_band_u };
+    pieces
+        .iter()
+        .flat_map(|q| {
+            let mut both = clip(q, f64::NEG_INFINITY, s);
+            both.extend(clip(q, s, f64::INFINITY));
+            both
+        })
+        .collect()
+}
+
+/// Every corner once: top and bottom finite, and the top not below the bottom.
+fn check_heights(cx: &PartCx, p: &Prism, pieces: &[LocalPoly]) -> Result<(), String> {
+    for q in pieces.iter().flat_map(|x| x.rings().flatten()) {
+        let (b, h) = (cx.at(&p.bottom, *q), cx.at(&p.top, *q));
+        if !(b.is_finite() && h.is_finite()) {
+            return Err(format!(
+                "template {}: part `{}`: top or bottom is not a number at u={:.2}, v={:.2}",
+                cx.t.name, cx.name, q[0], q[1]
+            ));
+        }
+        if h < b - 1e-6 {
+            return Err(format!(
+                "template {}: part `{}`: top {h:.2} m is below bottom {b:.2} m (a negative \
+                 height) at u={:.2}, v={:.2}",
+                cx.t.name, cx.name, q[0], q[1]
+            ));
+        }
+    }
     Ok(())
 }
 
