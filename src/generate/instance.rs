@@ -149,12 +149,7 @@ impl PartCx<'_> {
 
 /// A prism part: its outline (the lot, or its own points) cut to its bands, split where its
 /// roof line bends, checked, and extruded between its bottom and top.
-fn prism(
-    cx: &PartCx,
-    p: &Prism,
-    frame: Frame,
-    mesh: &mut Mesh,
-) -> Result<(), String> {
+fn prism(cx: &PartCx, p: &Prism, frame: Frame, mesh: &mut Mesh) -> Result<(), String> {
     let bound = |e: &Option<Expr>, what: &str, inf: f64| -> Result<f64, String> {
         e.as_ref().map_or(Ok(inf), |e| cx.scalar(e, what))
     };
@@ -175,7 +170,10 @@ fn prism(
     let splits = |exprs: &[Expr], what: &str| -> Result<Vec<f64>, String> {
         exprs.iter().map(|e| cx.scalar(e, what)).collect()
     };
-    let (splits_v, splits_u) = (splits(&p.split, "a split")?, splits(&p.split_u, "a split_u")?);
+    let (splits_v, splits_u) = (
+        splits(&p.split, "a split")?,
+        splits(&p.split_u, "a split_u")?,
+    );
     for &s in &splits_v {
         pieces = split_at(pieces, 1, s);
     }

@@ -154,12 +154,43 @@ pub fn draw_plan(
     let (w, h) = view.size();
     let mut pm = Pixmap::new(w, h)?;
     pm.fill(Color::from_rgba8(250, 248, 242, 255));
-    let id = Transform::identity();
-    let thin = Stroke {
+    // Bottom to top: street bands and blocks, lots and houses, kura, walls, people and trees,
+    // then the lines a reader checks (centrelines, frontages), the grid and the legend.
+    draw_streets(&mut pm, view, data);
+    let colours = type_colours(plan);
+    draw_lots_and_houses(&mut pm, view, data, plan, &colours);
+    let refused_any = kura.is_some_and(|avoid| draw_kura(&mut pm, view, plan, avoid));
+    let any_fence = draw_fences(&mut pm, view, plan);
+    let any_billboard = draw_billboards(&mut pm, view, plan);
+    draw_lines_on_top(&mut pm, view, data, plan);
+    draw_tile_grid(&mut pm, view, plan, tile_grid);
+    draw_scale_bar(&mut pm, view);
+    let kura_rows = match kura {
+        Some(_) => 1 + usize::from(refused_any),
+        None => 0,
+    };
+    draw_legend(
+        &mut pm,
+        &colours,
+        !data.footprints.is_empty(),
+        kura_rows,
+        any_fence,
+        any_billboard,
+    );
+    encode_png(&pm)
+}
+
+/// A one-pixel stroke.
+fn thin() -> Stroke {
+    Stroke {
         width: 1.0,
         ..Stroke::default()
-    };
+    }
+}
 
+/// Street bands as wide as the streets, and block outlines.
+fn draw_streets(pm: &mut Pixmap, view: &View, data: &Dataset) {
+    let id = Transform::identity();
     for street in &data.streets {
         if let Some(path) = line_path(view, &street.line.0) {
             let stroke = Stroke {
@@ -171,10 +202,20 @@ pub fn draw_plan(
     }
     for block in &data.blocks {
         if let Some(path) = polygon_path(view, block) {
-            pm.stroke_path(&path, &paint([160, 160, 160], 255), &thin, id, None);
+            pm.stroke_path(&path, &paint([160, 160, 160], 255), &thin(), id, None);
         }
     }
-    let colours = type_colours(plan);
+}
+
+/// Lots without a house (other uses, skipped ones), then every house by its type's colour.
+fn draw_lots_and_houses(
+    pm: &mut Pixmap,
+    view: &View,
+    data: &Dataset,
+    plan: &Plan,
+    colours: &BTreeMap<String, [u8; 3]>,
+) {
+    let id = Transform::identity();
     let skipped: HashSet<&str> = plan.skipped.iter().map(|s| s.id.as_str()).collect();
     let planned: HashSet<&str> = plan
         .houses
@@ -194,7 +235,7 @@ pub fn draw_plan(
                 OTHER_USE
             };
             pm.fill_path(&path, &paint(fill, 255), FillRule::EvenOdd, id, None);
-            pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin, id, None);
+            pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin(), id, None);
         }
     }
     for m in plan.houses.values().flatten() {
@@ -204,41 +245,45 @@ pub fn draw_plan(
         };
         if let Some(path) = polygon_path(view, &m.outline) {
             pm.fill_path(&path, &paint(colour, 255), FillRule::EvenOdd, id, None);
-            pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin, id, None);
+            pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin(), id, None);
         }
     }
+}
+
+/// Kura filled where built, outlined where the avoidance (`avoid`) refused them; whether any
+/// was refused (for the legend).
+fn draw_kura(pm: &mut Pixmap, view: &View, plan: &Plan, avoid: bool) -> bool {
+    let id = Transform::identity();
+    let refused = Stroke {
+        width: 1.5,
+        ..Stroke::default()
+    };
     let mut refused_any = false;
-    if let Some(avoid) = kura {
-        let refused = Stroke {
-            width: 1.5,
-            ..Stroke::default()
+    for m in plan.houses.values().flatten() {
+        let Some(r) = m.kura.rect() else { continue };
+        let q = crate::geom::frame::Frame {
+            a: m.frontage.a,
+            u: m.frontage.u_axis(),
+            v: m.frontage.v_axis(),
+        }
+        .quad(r);
+        let Some(path) = line_path(view, &[q[0], q[1], q[2], q[3], q[0]]) else {
+            continue;
         };
-        for m in plan.houses.values().flatten() {
-            let Some(r) = m.kura.rect() else { continue };
-            let (u, v, a) = (m.frontage.u_axis(), m.frontage.v_axis(), m.frontage.a);
-            let at = |p: [f64; 2]| Coord {
-                x: a.x + p[0] * u.x + p[1] * v.x,
-                y: a.y + p[0] * u.y + p[1] * v.y,
-            };
-            let ring = [
-                at([r[0], r[1]]),
-                at([r[2], r[1]]),
-                at([r[2], r[3]]),
-                at([r[0], r[3]]),
-                at([r[0], r[1]]),
-            ];
-            let Some(path) = line_path(view, &ring) else {
-                continue;
-            };
-            if m.kura.to_build(avoid).is_some() {
-                pm.fill_path(&path, &paint(KURA, 255), FillRule::EvenOdd, id, None);
-            } else {
-                refused_any = true;
-                pm.stroke_path(&path, &paint(KURA_REFUSED, 255), &refused, id, None);
-            }
+        if m.kura.to_build(avoid).is_some() {
+            pm.fill_path(&path, &paint(KURA, 255), FillRule::EvenOdd, id, None);
+        } else {
+            refused_any = true;
+            pm.stroke_path(&path, &paint(KURA_REFUSED, 255), &refused, id, None);
         }
     }
-    // Walls and gates (section 4.3): a dark line along each wall segment, a red bar per gate.
+    refused_any
+}
+
+/// Walls and gates (section 4.3): a dark line along each wall segment, a red bar per gate;
+/// whether there was any.
+fn draw_fences(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
+    let id = Transform::identity();
     let (wall, gate_bar) = (
         Stroke {
             width: 2.0,
@@ -260,7 +305,12 @@ pub fn draw_plan(
             pm.stroke_path(&path, &paint(colour, 255), stroke, id, None);
         }
     }
-    // People and trees (section 4.4): a dot each, a tree's as wide as its crown.
+    any_fence
+}
+
+/// People and trees (section 4.4): a dot each, a tree's as wide as its crown; whether there
+/// was any.
+fn draw_billboards(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
     let mut any_billboard = false;
     for b in plan.billboards.values().flatten() {
         let (x, y) = view.pixel(&b.at);
@@ -270,13 +320,20 @@ pub fn draw_plan(
         };
         if let Some(dot) = tiny_skia::PathBuilder::from_circle(x, y, r.max(1.5)) {
             any_billboard = true;
+            let id = Transform::identity();
             pm.fill_path(&dot, &paint(colour, 220), FillRule::Winding, id, None);
         }
     }
-    // Centrelines on top: in cadastral data the roads are parcels too and hide the bands.
+    any_billboard
+}
+
+/// Street centrelines and each house's frontage, on top: in cadastral data the roads are
+/// parcels too and would hide them.
+fn draw_lines_on_top(pm: &mut Pixmap, view: &View, data: &Dataset, plan: &Plan) {
+    let id = Transform::identity();
     for street in &data.streets {
         if let Some(path) = line_path(view, &street.line.0) {
-            pm.stroke_path(&path, &paint([60, 90, 140], 160), &thin, id, None);
+            pm.stroke_path(&path, &paint([60, 90, 140], 160), &thin(), id, None);
         }
     }
     let frontage = Stroke {
@@ -288,21 +345,6 @@ pub fn draw_plan(
             pm.stroke_path(&path, &paint(FRONTAGE, 255), &frontage, id, None);
         }
     }
-    draw_tile_grid(&mut pm, view, plan, tile_grid);
-    draw_scale_bar(&mut pm, view);
-    let kura_rows = match kura {
-        Some(_) => 1 + usize::from(refused_any),
-        None => 0,
-    };
-    draw_legend(
-        &mut pm,
-        &colours,
-        !data.footprints.is_empty(),
-        kura_rows,
-        any_fence,
-        any_billboard,
-    );
-    encode_png(&pm)
 }
 
 /// PNG with fast compression: at 2400 x 2400 the default level took most of the plan's time.

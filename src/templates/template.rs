@@ -301,28 +301,100 @@ fn material_of(slots: Slots, m: &Src<String>) -> Result<u16, String> {
 /// Compiles a template whose `extends` has been merged in.
 pub fn compile_template(s: &Source) -> Result<Template, String> {
     let here = Loc(s.file.clone());
-    let kind = match &s.kind {
-        None => {
-            return Err(err(
-                &s.name.loc,
-                "`kind` is missing (machiya, kura, fence, gate, tree or person)",
-            ))
-        }
-        Some(k) => Kind::ALL
-            .iter()
-            .find(|(n, _)| *n == k.value)
-            .map(|x| x.1)
-            .ok_or_else(|| {
-                err(
-                    &k.loc,
-                    format!(
-                        "unknown kind `{}` (machiya, kura, fence, gate, tree or person)",
-                        k.value
-                    ),
-                )
-            })?,
+    let kind = kind_of(s)?;
+    let ValueSlots {
+        names,
+        defaults,
+        params,
+        attributes,
+        derived: d0,
+        u,
+    } = declare_slots(s)?;
+    let scalar_names = Names { names: &names[..u] };
+    let all = Names { names: &names };
+    let derived = order_derived(s, &scalar_names, &names, d0)?;
+    let height = match &s.height {
+        Some(t) => Some((scalar_names.compile(t)?, t.loc.clone())),
+        None => None,
     };
-    // Slots: inputs, params, attributes, derived, v.
+    let material_slots = material_slots(s, kind, &here)?;
+    let checks = s
+        .checks
+        .iter()
+        .map(|(t, reason)| Ok((scalar_names.compile(t)?, reason.clone())))
+        .collect::<Result<Vec<_>, String>>()?;
+    let mut parts = Vec::new();
+    for p in &s.parts {
+        if parts.iter().any(|q: &Part| q.name == p.name.value) {
+            return Err(err(
+                &p.name.loc,
+                format!("a second part named `{}`", p.name.value),
+            ));
+        }
+        parts.push(compile_part(p, &scalar_names, &all, &s.materials)?);
+    }
+    if parts.is_empty() && !s.is_abstract {
+        return Err(err(&here, "the template has no `[[part]]`"));
+    }
+    Ok(Template {
+        name: s.name.value.clone(),
+        kanji: s.kanji.clone(),
+        kind,
+        description: s.description.clone(),
+        aliases: s.aliases.clone(),
+        file: s.file.clone(),
+        is_abstract: s.is_abstract,
+        defaults,
+        params: params..attributes,
+        attributes: attributes..d0,
+        derived,
+        v_slot: u + 1,
+        checks,
+        height,
+        parts,
+        names,
+        material_slots,
+    })
+}
+
+/// The template's `kind`, which decides where the city puts it.
+fn kind_of(s: &Source) -> Result<Kind, String> {
+    let Some(k) = &s.kind else {
+        return Err(err(
+            &s.name.loc,
+            "`kind` is missing (machiya, kura, fence, gate, tree or person)",
+        ));
+    };
+    Kind::ALL
+        .iter()
+        .find(|(n, _)| *n == k.value)
+        .map(|x| x.1)
+        .ok_or_else(|| {
+            err(
+                &k.loc,
+                format!(
+                    "unknown kind `{}` (machiya, kura, fence, gate, tree or person)",
+                    k.value
+                ),
+            )
+        })
+}
+
+/// The slots of a template's values, in order: inputs, parameters, attributes, derived
+/// values, then `u` and `v`; with where each group starts.
+struct ValueSlots {
+    names: Vec<String>,
+    /// Default values of the parameters and attributes, in slot order.
+    defaults: Vec<f64>,
+    params: usize,
+    attributes: usize,
+    derived: usize,
+    /// The `u` slot (`v` follows it).
+    u: usize,
+}
+
+/// Declares every name of the template once, refusing a name used twice or not a name.
+fn declare_slots(s: &Source) -> Result<ValueSlots, String> {
     let mut names: Vec<String> = INPUTS.iter().map(|i| i.0.to_string()).collect();
     let mut defaults = Vec::new();
     let declare = |name: &str, loc: &Loc, names: &mut Vec<String>| -> Result<(), String> {
@@ -343,30 +415,41 @@ pub fn compile_template(s: &Source) -> Result<Template, String> {
         names.push(name.to_string());
         Ok(())
     };
-    let p0 = names.len();
+    let params = names.len();
     for (k, v) in &s.params {
         declare(k, &v.loc, &mut names)?;
         defaults.push(v.value);
     }
-    let a0 = names.len();
+    let attributes = names.len();
     for (k, v) in &s.attributes {
         declare(k, &v.loc, &mut names)?;
         defaults.push(v.value);
     }
-    let d0 = names.len();
+    let derived = names.len();
     for (k, v) in &s.derived {
         declare(k, &v.loc, &mut names)?;
     }
-    let u_slot = names.len();
+    let u = names.len();
     names.push("u".into());
-    let v_slot = names.len();
     names.push("v".into());
-    let scalar_names = Names {
-        names: &names[..u_slot],
-    };
-    let all = Names { names: &names };
+    Ok(ValueSlots {
+        names,
+        defaults,
+        params,
+        attributes,
+        derived,
+        u,
+    })
+}
 
-    // Derived values, ordered so each needs only earlier ones.
+/// The derived values compiled and ordered so that each needs only earlier ones; a cycle is
+/// an error naming its members.
+fn order_derived(
+    s: &Source,
+    scalar_names: &Names,
+    names: &[String],
+    d0: usize,
+) -> Result<Vec<(usize, Expr, Loc)>, String> {
     let mut pending: BTreeMap<usize, (Expr, Loc, Vec<usize>)> = BTreeMap::new();
     for (i, (_, t)) in s.derived.iter().enumerate() {
         let e = scalar_names.compile(t)?;
@@ -400,63 +483,28 @@ pub fn compile_template(s: &Source) -> Result<Template, String> {
             derived.push((k, e, loc));
         }
     }
+    Ok(derived)
+}
 
-    let height = match &s.height {
-        Some(t) => Some((scalar_names.compile(t)?, t.loc.clone())),
-        None => None,
-    };
-    let mut material_slots = Vec::new();
+/// The `[materials]` slots with their library ids; a tree or person needs a `picture` slot
+/// (the drawn texture replaces it).
+fn material_slots(s: &Source, kind: Kind, here: &Loc) -> Result<Vec<(String, u16)>, String> {
+    let mut slots = Vec::new();
     for (k, m) in &s.materials {
         let id = material_of(&[], m).map_err(|e| format!("{e} (material slot `{k}`)"))?;
-        material_slots.push((k.clone(), id));
+        slots.push((k.clone(), id));
     }
     if matches!(kind, Kind::Tree | Kind::Person)
         && !s.is_abstract
-        && !material_slots.iter().any(|(k, _)| k == "picture")
+        && !slots.iter().any(|(k, _)| k == "picture")
     {
         return Err(err(
-            &here,
+            here,
             "a tree or person template needs a `picture` slot in `[materials]`: the texture \
              drawn for each billboard replaces it",
         ));
     }
-    let checks = s
-        .checks
-        .iter()
-        .map(|(t, reason)| Ok((scalar_names.compile(t)?, reason.clone())))
-        .collect::<Result<Vec<_>, String>>()?;
-    let mut parts = Vec::new();
-    for p in &s.parts {
-        if parts.iter().any(|q: &Part| q.name == p.name.value) {
-            return Err(err(
-                &p.name.loc,
-                format!("a second part named `{}`", p.name.value),
-            ));
-        }
-        parts.push(compile_part(p, &scalar_names, &all, &s.materials)?);
-    }
-    if parts.is_empty() && !s.is_abstract {
-        return Err(err(&here, "the template has no `[[part]]`"));
-    }
-    Ok(Template {
-        name: s.name.value.clone(),
-        kanji: s.kanji.clone(),
-        kind,
-        description: s.description.clone(),
-        aliases: s.aliases.clone(),
-        file: s.file.clone(),
-        is_abstract: s.is_abstract,
-        defaults,
-        params: p0..a0,
-        attributes: a0..d0,
-        derived,
-        v_slot,
-        checks,
-        height,
-        parts,
-        names,
-        material_slots,
-    })
+    Ok(slots)
 }
 
 fn compile_part(p: &PartSource, scalar: &Names, all: &Names, slots: Slots) -> Result<Part, String> {
