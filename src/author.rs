@@ -16,6 +16,7 @@ use crate::templates::{Catalog, Template};
 /// A template built alone.
 #[derive(Debug)]
 pub struct Alone {
+    /// The template's mesh, built on the rectangle.
     pub mesh: Mesh,
     /// The height the template declares, metres (None when it declares none).
     pub declared_height: Option<f64>,

@@ -29,11 +29,15 @@ pub mod shards;
 
 /// Progress of the long stages; the CLI draws bars, tests pass [`NoProgress`].
 pub trait Progress: Sync {
+    /// A stage of `total` steps (0 = unknown) begins.
     fn start(&self, stage: &str, total: u64);
+    /// `n` more steps of the stage are done.
     fn inc(&self, n: u64);
+    /// The stage is over.
     fn finish(&self);
 }
 
+/// No progress shown (tests, `check`, `plan`).
 pub struct NoProgress;
 
 impl Progress for NoProgress {
@@ -42,21 +46,29 @@ impl Progress for NoProgress {
     fn finish(&self) {}
 }
 
+/// Why a build did not finish (exit code 2); each names the file, key or directory.
 #[derive(Debug, Error)]
 pub enum BuildError {
+    /// The parameter file is wrong.
     #[error(transparent)]
     Params(#[from] ParamsError),
+    /// A template file is wrong.
     #[error(transparent)]
     Templates(#[from] TemplateError),
+    /// The input cannot be read.
     #[error(transparent)]
     Input(#[from] InputError),
+    /// The options or the output directory do not allow the build (the message says why).
     #[error("{0}")]
     Config(String),
     // The io::Error is in the message, not a `source`: the CLI prints the chain, and it
     // would say it twice.
+    /// A file could not be written (a full disk says what to do).
     #[error("cannot write {path}: {cause}{hint}")]
     Write {
+        /// The file or directory that could not be written.
         path: String,
+        /// What the operating system said.
         cause: std::io::Error,
         /// What to do, when there is something to say.
         hint: &'static str,
@@ -72,14 +84,22 @@ pub enum Selection {
     /// Only these tiles, rewritten inside an earlier full build (its manifest is updated).
     Tiles(Vec<String>),
     /// The I-th (from 1) of N balanced sets of tiles; writes `manifest.shard-I-of-N.json`.
-    Shard { index: usize, count: usize },
+    Shard {
+        /// I, from 1.
+        index: usize,
+        /// N.
+        count: usize,
+    },
 }
 
 /// What to build, already validated by the CLI.
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
+    /// The input directory.
     pub input: PathBuf,
+    /// The output directory.
     pub out: PathBuf,
+    /// The resolved, checked parameters.
     pub params: Params,
     /// Machiya type directory; `None` = `machiya.templates`, else the shipped types.
     pub templates: Option<PathBuf>,
@@ -87,6 +107,7 @@ pub struct BuildOptions {
     pub threads: usize,
     /// Also draw `<out>/plan.png`.
     pub plan_image: bool,
+    /// Which tiles to write.
     pub selection: Selection,
     /// Replace an output directory built from other parameters or input.
     pub force: bool,
@@ -95,25 +116,34 @@ pub struct BuildOptions {
 /// Wall time of each stage.
 #[derive(Debug, Clone, Default)]
 pub struct Timings {
+    /// Reading every layer.
     pub read: Duration,
+    /// Analysis (frontage, types, kura, fences, people and trees).
     pub analyse: Duration,
     /// Of `analyse`: kura placement, the R-tree of provisional plots and its queries.
     pub kura: Duration,
     /// Of `analyse`: people and trees (obstacle R-tree, Poisson draws, thinning).
     pub billboards: Duration,
+    /// Generating and writing the selected tiles (wall time).
     pub generate_and_write: Duration,
     /// Drawing plan.png.
     pub plan: Duration,
     /// Time spent generating meshes and formatting + writing files, summed over threads.
     pub generate_cpu: Duration,
+    /// Formatting and writing the files, summed over threads.
     pub write_cpu: Duration,
+    /// The whole run.
     pub total: Duration,
 }
 
+/// What a finished build returns to the CLI.
 #[derive(Debug)]
 pub struct BuildOutcome {
+    /// The report, as written to report.json.
     pub report: report::Report,
+    /// The time of each stage (`--timings`).
     pub timings: Timings,
+    /// Bytes of tiles this run wrote.
     pub bytes_written: u64,
     /// Tiles written by this run.
     pub tiles_written: usize,

@@ -16,38 +16,59 @@ use crate::model::tile::parse_tile_id;
 use crate::output::report::{assemble_report, Manifest, Report};
 use crate::output::text::{draw_text, text_width};
 
+/// One parameter whose value differs between the two builds.
 #[derive(Debug, Clone, Serialize)]
 pub struct ParamDiff {
+    /// The parameter's dotted key (`kura.collision`).
     pub key: String,
+    /// Its value in build A (`-` when absent).
     pub a: String,
+    /// Its value in build B.
     pub b: String,
 }
 
+/// One count of both builds side by side.
 #[derive(Debug, Clone, Serialize)]
 pub struct Row {
+    /// What is counted.
     pub name: String,
+    /// In build A.
     pub a: usize,
+    /// In build B.
     pub b: usize,
 }
 
+/// How the two builds' tiles compare, by the sha256 of their OBJ.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct TileDiff {
+    /// Tiles identical in both.
     pub same: usize,
+    /// Tiles in both whose bytes differ.
     pub differ: Vec<String>,
+    /// Tiles only build A has.
     pub only_a: Vec<String>,
+    /// Tiles only build B has.
     pub only_b: Vec<String>,
 }
 
+/// Two builds (two hypotheses) compared: what `compare` prints and `--json` writes.
 #[derive(Debug, Clone, Serialize)]
 pub struct Comparison {
+    /// Build A's directory.
     pub a: String,
+    /// Build B's directory.
     pub b: String,
+    /// The parameters that differ.
     pub params: Vec<ParamDiff>,
+    /// The totals: lots, machiya, types given and drawn, footprints, kura, skips, tiles.
     pub totals: Vec<Row>,
+    /// Machiya per type.
     pub by_type: Vec<Row>,
+    /// Houses per district.
     pub by_district: Vec<Row>,
     /// The paper's Table 2 for both builds.
     pub table2: Vec<Row>,
+    /// The tiles that changed.
     pub tiles: TileDiff,
     /// Why the two builds' tiles are not the same places (another tile size, tile origin or
     /// CRS), when they are not: then a tile id names other ground in each.

@@ -13,10 +13,15 @@ use crate::input::shp;
 pub struct Found {
     /// Path relative to the directory, with `/`.
     pub rel: String,
+    /// What the layer holds: polygon, polyline, point, ...
     pub kind: &'static str,
+    /// Its number of features.
     pub count: usize,
+    /// Its DBF field names.
     pub fields: Vec<String>,
+    /// The encoding its text was read in.
     pub encoding: String,
+    /// Its CRS's name from the `.prj`, or `no .prj`.
     pub crs: String,
 }
 

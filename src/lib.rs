@@ -8,6 +8,7 @@
 //! stage keeps (tests/architecture.rs checks them).
 
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
 pub mod analyse;
 pub mod author;

@@ -6,6 +6,7 @@
 /// One material of the MTL files.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Material {
+    /// The name templates and MTL files use.
     pub name: &'static str,
     /// Diffuse colour, used by viewers that ignore textures.
     pub kd: [f32; 3],
@@ -287,6 +288,7 @@ pub fn id(name: &str) -> u16 {
     find(name).unwrap_or_else(|| panic!("built-in material `{name}` missing from MATERIALS"))
 }
 
+/// Every material's name, for messages that list them.
 pub fn names() -> Vec<&'static str> {
     MATERIALS.iter().map(|m| m.name).collect()
 }

@@ -17,16 +17,38 @@ pub use billboards::{PeopleParams, PointsLayer, TreesParams};
 /// The default parameter file, shipped inside the binary.
 pub const DEFAULT_TOML: &str = include_str!("../params/default.toml");
 
+/// Why a parameter file cannot be used; each names the file (and the line and key where
+/// there is one).
 #[derive(Debug, Error)]
 pub enum ParamsError {
+    /// The file cannot be read.
     #[error("cannot read parameter file {path}: {cause}")]
-    Io { path: String, cause: std::io::Error },
+    Io {
+        /// The parameter file.
+        path: String,
+        /// What the operating system said.
+        cause: std::io::Error,
+    },
+    /// The file is not TOML, or a key is unknown or of the wrong type.
     #[error("parameter file {path}: {message}")]
-    Parse { path: String, message: String },
+    Parse {
+        /// The parameter file.
+        path: String,
+        /// The key, line and column, and what is wrong.
+        message: String,
+    },
+    /// A value is out of its range, or values contradict each other.
     #[error("parameter file {path}: {message}")]
-    Invalid { path: String, message: String },
+    Invalid {
+        /// The parameter file.
+        path: String,
+        /// The key and what it must be.
+        message: String,
+    },
 }
 
+/// A parameter file, resolved: the defaults of `params/default.toml` with every file of
+/// the `extends` chain overlaid, and checked (every key known, every number in range).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Params {
@@ -45,13 +67,21 @@ pub struct Params {
     /// `.prj`. Empty: the lots layer's own CRS when projected, else the UTM zone of its centre.
     #[serde(default)]
     pub crs: String,
+    /// Where each layer is and which fields hold what.
     pub layers: Layers,
+    /// The constants of Fig.4.
     pub frontage: FrontageParams,
+    /// The machiya: depth, minimum depth, type templates.
     pub machiya: MachiyaParams,
+    /// Kura, section 4.2.
     pub kura: KuraParams,
+    /// Vertex generalisation, section 2.2.
     pub simplify: SimplifyParams,
+    /// Fences and gates, section 4.3.
     pub fence: FenceParams,
+    /// People, section 4.4.
     pub people: PeopleParams,
+    /// Trees, section 4.4.
     pub trees: TreesParams,
     /// Relative weights of the machiya types drawn for lots of unknown type.
     pub type_mix: BTreeMap<String, f64>,
@@ -86,8 +116,10 @@ pub struct DistrictParams {
     /// and `trees.per_ha_machiya` there.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub people_per_100m: Option<f64>,
+    /// Trees per hectare of walled lots in this district, replacing `trees.per_ha`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trees_per_ha: Option<f64>,
+    /// Trees per hectare of open town-lot backs here, replacing `trees.per_ha_machiya`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trees_per_ha_machiya: Option<f64>,
 }
@@ -123,18 +155,29 @@ impl Params {
     }
 }
 
+/// Every layer's settings, one table a role.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Layers {
+    /// Lots (the parcels: town lots, estates, temples).
     pub lots: LotsLayer,
+    /// City blocks, whose outlines are street edges.
     pub blocks: BlocksLayer,
+    /// Street centrelines.
     pub streets: StreetsLayer,
+    /// Lines carrying street widths.
     pub street_widths: StreetWidthsLayer,
+    /// Building footprints.
     pub footprints: FootprintsLayer,
+    /// District polygons.
     pub districts: DistrictsLayer,
+    /// Free-standing fence lines.
     pub fences: FencesLayer,
+    /// People given as points (none: they are drawn).
     pub people: PointsLayer,
+    /// Trees given as points (none: they are drawn).
     pub trees: PointsLayer,
+    /// The terrain grid.
     pub dem: DemLayer,
 }
 
@@ -151,9 +194,12 @@ pub struct DemLayer {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FencesLayer {
+    /// Shapefile path, relative to the input directory; "" = no such layer.
     pub file: String,
+    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
+    /// Field holding the line's id (else its record number from 1).
     pub id_field: String,
 }
 
@@ -164,13 +210,15 @@ pub struct FencesLayer {
 pub struct DistrictsLayer {
     /// "" = no such layer.
     pub file: String,
+    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
     /// Field holding the district id (or name).
     pub id_field: String,
 }
 
-/// Settings shared by every layer: where it is and how its text is encoded.
+/// The lots layer (shikichi 敷地): town lots, estates and precincts, with their attribute
+/// table, field names, value maps and constants.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LotsLayer {
@@ -184,6 +232,7 @@ pub struct LotsLayer {
     /// XLSX sheet to read; empty = the first sheet.
     #[serde(default)]
     pub sheet: String,
+    /// Which fields hold which attribute.
     pub fields: LotFields,
     /// Value maps per attribute (`use`, `mtype`, `district`): raw value -> value.
     #[serde(default)]
@@ -193,32 +242,45 @@ pub struct LotsLayer {
     pub constants: BTreeMap<String, String>,
 }
 
+/// The lots layer's fields, by name (a Japanese name may be given whole; the DBF keeps
+/// 10 bytes of it).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LotFields {
+    /// Unique id, joining the attribute table.
     pub id: String,
+    /// Lot use: machiya, buke, kuge, jisha or other (empty = machiya).
     #[serde(rename = "use")]
     pub lot_use: String,
+    /// Machiya type (empty = drawn from `type_mix`).
     pub mtype: String,
+    /// District id.
     pub district: String,
+    /// Tile id given in the data (wins over the computed one).
     pub tile: String,
     /// Ground elevation field, metres; "" = none (Z of PolygonZ vertices, else 0).
     #[serde(default)]
     pub ground: String,
 }
 
+/// City blocks (machi 町 / gaiku 街区): their outlines are the street edges.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BlocksLayer {
+    /// Shapefile path, relative to the input directory; "" = no such layer.
     pub file: String,
+    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
 }
 
+/// Street centrelines; the street edge lies half the width from them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StreetsLayer {
+    /// Shapefile path, relative to the input directory; "" = no such layer.
     pub file: String,
+    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
     /// Field holding the full street width in metres.
@@ -234,8 +296,10 @@ pub struct StreetsLayer {
 pub struct StreetWidthsLayer {
     /// "" = no such layer.
     pub file: String,
+    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
+    /// Field holding the width, metres.
     pub width_field: String,
     /// A centreline piece takes the width of the nearest width line within this distance.
     pub max_distance: f64,
@@ -247,8 +311,10 @@ pub struct StreetWidthsLayer {
 pub struct FootprintsLayer {
     /// "" = no such layer.
     pub file: String,
+    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
+    /// Which fields hold which attribute.
     pub fields: FootprintFields,
     /// Value maps per attribute (`mtype`), as for lots.
     #[serde(default)]
@@ -261,14 +327,19 @@ pub struct FootprintsLayer {
     pub default_height: f64,
 }
 
+/// The footprints layer's fields, by name.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FootprintFields {
+    /// Unique id.
     pub id: String,
+    /// Machiya type (else `default_type`).
     pub mtype: String,
     /// Total height (ground to ridge), metres.
     pub height: String,
+    /// Number of storeys (a height of storeys x `storey_height` + 1 m).
     pub storeys: String,
+    /// Ground elevation, metres; "" = the lowest Z of a PolygonZ, else 0.
     pub ground: String,
 }
 
@@ -282,6 +353,7 @@ pub struct FrontageParams {
     pub min_length: f64,
 }
 
+/// The machiya (町家) built on town lots.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MachiyaParams {
@@ -299,6 +371,7 @@ pub struct MachiyaParams {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FenceParams {
+    /// Wall walled lots and fence lines at all.
     pub enabled: bool,
     /// Lot uses walled along their whole outline.
     pub uses: Vec<String>,
@@ -306,13 +379,16 @@ pub struct FenceParams {
     pub types: BTreeMap<String, String>,
     /// Fence template of a walled lot whose use is not in `types`.
     pub default_type: String,
+    /// Template of the gates.
     pub gate_template: String,
     /// Width of a gate, whatever the edge's length: 1 jo.
     pub gate_width: f64,
     /// Lot attributes: the fence template, the gate (1 = the edge facing the street, eN =
     /// edge N, 0 = none) and the wall height (metres, given to the template as `height`).
     pub type_field: String,
+    /// The gate attribute (see `type_field`).
     pub gate_field: String,
+    /// The wall height attribute (see `type_field`).
     pub height_field: String,
 }
 
@@ -340,16 +416,19 @@ pub struct KuraParams {
     pub min_frontage: f64,
     /// ... and a lot at least this many times as deep as its frontage is wide.
     pub depth_ratio: f64,
-    /// Size of a kura: along the street, and into the lot.
+    /// Size of a kura along the street, metres ...
     pub width: f64,
+    /// ... and into the lot.
     pub depth: f64,
-    /// A narrow or short lot shrinks its kura down to these; below them it gets none.
+    /// A narrow or short lot shrinks its kura down to these, along the street ...
     pub min_width: f64,
+    /// ... and into the lot; below them it gets none.
     pub min_depth: f64,
     /// Open ground between the back of the house and the kura (a courtyard).
     pub gap: f64,
-    /// Distance of the kura from the back and the sides of the lot.
+    /// Distance of the kura from the back of the lot ...
     pub back_margin: f64,
+    /// ... and from its sides.
     pub side_margin: f64,
     /// Collision avoidance of Fig.7: a kura whose provisional plot overlaps another plot is
     /// not built. false = the paper's "without avoidance" column.

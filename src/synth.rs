@@ -30,25 +30,35 @@ const ZONE6_PRJ: &str = r#"PROJCS["JGD2011 / Japan Plane Rectangular CS VI",GEOG
 /// What `synth` wrote.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SynthSummary {
+    /// Lots written.
     pub lots: usize,
+    /// Of them town lots (machiya).
     pub machiya: usize,
+    /// Blocks written.
     pub blocks: usize,
+    /// Street centrelines written.
     pub streets: usize,
 }
 
 /// A lot before it is written: outline (counter-clockwise) and attributes.
 #[derive(Debug, Clone)]
 pub struct SynthLot {
+    /// The lot's id, from 1.
     pub id: u64,
+    /// Its outline, counter-clockwise, not closed.
     pub ring: Vec<[f64; 2]>,
+    /// Its use (`machiya`, `buke`, ...).
     pub lot_use: &'static str,
+    /// Its machiya type in kanji, or "" (drawn by the build).
     pub mtype: &'static str,
+    /// Its district.
     pub district: &'static str,
 }
 
 /// A synthetic town in memory.
 #[derive(Debug, Clone)]
 pub struct Town {
+    /// The lots, in id order.
     pub lots: Vec<SynthLot>,
     /// Block outlines, counter-clockwise.
     pub blocks: Vec<Vec<[f64; 2]>>,
@@ -391,6 +401,7 @@ pub fn write_lots(path: &Path, lots: &[SynthLot]) -> Result<(), String> {
     sidecars(path, "SHIFT_JIS")
 }
 
+/// Writes the blocks layer (UTF-8, zone VI `.prj`).
 pub fn write_blocks(path: &Path, blocks: &[Vec<[f64; 2]>]) -> Result<(), String> {
     let table = dbase::TableWriterBuilder::new().add_numeric_field(field("id"), 10, 0);
     let mut w = shapefile::Writer::from_path(path, table).map_err(shp_err(path))?;

@@ -13,7 +13,9 @@ use crate::model::Frontage;
 /// The rule's two constants (see `[frontage]` in the parameter file).
 #[derive(Debug, Clone, Copy)]
 pub struct FrontageRule {
+    /// Largest angle at the lot's centroid between the two frontage vertices, degrees (Fig.4).
     pub max_angle_deg: f64,
+    /// Shortest frontage, metres: shorter candidates are passed over.
     pub min_length: f64,
 }
 

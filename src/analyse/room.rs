@@ -24,6 +24,7 @@ pub struct LotEdges {
 }
 
 impl LotEdges {
+    /// The edges of `lot`'s outline (holes included), indexed for room queries.
     pub fn new(lot: &Polygon<f64>) -> LotEdges {
         let mut edges = Vec::new();
         for (r, ring) in std::iter::once(lot.exterior())

@@ -17,6 +17,8 @@ pub struct StreetEdges {
 }
 
 impl StreetEdges {
+    /// The street edges of a dataset: the blocks' outlines, and every centreline moved out by
+    /// half its width.
     pub fn new(blocks: &[Polygon<f64>], streets: &[Street]) -> StreetEdges {
         let mut segs = Vec::new();
         for block in blocks {
@@ -104,6 +106,7 @@ impl StreetEdges {
         best
     }
 
+    /// Whether there is no street edge at all.
     pub fn is_empty(&self) -> bool {
         self.tree.size() == 0
     }

@@ -412,8 +412,11 @@ fn difference(first: &Manifest, m: &Manifest) -> Option<String> {
 /// One line of `edo-city tiles`.
 #[derive(Debug, Clone, Serialize)]
 pub struct TileInfo {
+    /// The tile's id.
     pub id: String,
+    /// Machiya in the tile.
     pub machiya: usize,
+    /// Footprint houses in the tile.
     pub footprints: usize,
     /// [xmin, ymin, xmax, ymax] of the tile, projected metres.
     pub bounds: [f64; 4],

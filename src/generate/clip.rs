@@ -14,7 +14,9 @@ pub type LocalRing = Vec<[f64; 2]>;
 /// so the polygon's inside is on the left of every edge.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LocalPoly {
+    /// The outer ring, counter-clockwise, not closed.
     pub exterior: LocalRing,
+    /// The holes, clockwise, not closed.
     pub holes: Vec<LocalRing>,
 }
 

@@ -31,6 +31,7 @@ pub use crate::geom::frame::Frame as Local;
 pub struct Site {
     /// The lot in the frontage frame (exterior counter-clockwise, holes clockwise).
     pub lot: LocalPoly,
+    /// The frontage frame the lot is given in.
     pub local: Local,
     /// Ground elevation, metres: h = 0 of the template at u = 0 ...
     pub ground: f64,

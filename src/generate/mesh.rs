@@ -12,18 +12,23 @@ use geo_types::Coord;
 /// seen from outside.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Face {
+    /// The material's id in the library.
     pub material: u16,
+    /// The corners: (position index, texture coordinate index), counter-clockwise seen from
+    /// outside.
     pub corners: Vec<(u32, u32)>,
 }
 
 /// One OBJ object (`o <name>`).
 #[derive(Debug, Clone, Default)]
 pub struct Mesh {
+    /// The OBJ object's name (`machiya_<id>`, `kura_<id>`, `people`, ...).
     pub name: String,
     /// Output frame, millimetres: x east, y up, z south, relative to the dataset origin.
     pub positions: Vec<[i64; 3]>,
     /// Texture coordinates in units of 1/10000.
     pub uvs: Vec<[i32; 2]>,
+    /// The faces, in the order they were built.
     pub faces: Vec<Face>,
     pos_index: HashMap<[i64; 3], u32>,
     uv_index: HashMap<[i32; 2], u32>,
@@ -32,10 +37,12 @@ pub struct Mesh {
 /// Converts map coordinates (east, north, height; metres) to the output frame.
 #[derive(Debug, Clone, Copy)]
 pub struct Frame {
+    /// The dataset origin (projected metres) the output coordinates are relative to.
     pub origin: [f64; 2],
 }
 
 impl Mesh {
+    /// An empty mesh named `name`.
     pub fn new(name: String) -> Mesh {
         Mesh {
             name,

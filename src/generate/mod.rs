@@ -23,6 +23,7 @@ use mesh::{Frame, Mesh};
 /// not be built).
 #[derive(Debug, Default)]
 pub struct TileMeshes {
+    /// The tile's meshes, one per object, in input order.
     pub meshes: Vec<Mesh>,
     /// What the tile holds, for the report.
     pub stats: TileStats,
@@ -31,18 +32,26 @@ pub struct TileMeshes {
 /// The files features came from, for skip reports.
 #[derive(Debug, Clone, Default)]
 pub struct LayerFiles {
+    /// The lots layer's file.
     pub lots: String,
+    /// The footprints layer's file.
     pub footprints: String,
+    /// The fence lines layer's file.
     pub fences: String,
+    /// The people point layer's file.
     pub people: String,
+    /// The trees point layer's file.
     pub trees: String,
 }
 
 /// What one tile of the plan holds.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TilePlan<'a> {
+    /// The tile's houses, in input order.
     pub lots: &'a [PlannedHouse],
+    /// The tile's fence segments and gates.
     pub fences: &'a [PlannedFence],
+    /// The tile's people and trees.
     pub billboards: &'a [PlannedBillboard],
     /// The DEM, the tile's id and its bounds, when the terrain is to be written.
     pub ground: Option<(&'a crate::model::dem::Dem, &'a str, [f64; 4])>,

@@ -20,8 +20,11 @@ use geo_types::Coord;
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frame {
+    /// The frame's origin, map metres.
     pub a: Coord<f64>,
+    /// The unit x axis (along the street for a frontage).
     pub u: Coord<f64>,
+    /// The unit y axis, `u` turned a quarter to the left (into the lot).
     pub v: Coord<f64>,
 }
 

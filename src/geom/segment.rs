@@ -7,8 +7,11 @@ use rstar::{PointDistance, RTreeObject, AABB};
 /// street centreline.
 #[derive(Debug, Clone, Copy)]
 pub struct Segment {
+    /// One end, map metres.
     pub a: [f64; 2],
+    /// The other end.
     pub b: [f64; 2],
+    /// What the segment carries (a half-width, a street width).
     pub value: f64,
 }
 

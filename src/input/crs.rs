@@ -69,6 +69,7 @@ impl Crs {
         Crs::from_proj_string(&def).expect("UTM definitions are valid")
     }
 
+    /// Whether the CRS is longitude/latitude in degrees (not projected metres).
     pub fn is_geographic(&self) -> bool {
         self.proj.is_latlong()
     }

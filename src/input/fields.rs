@@ -47,8 +47,11 @@ pub fn resolve_field<'a>(
 /// How one attribute is read: which field, what to use when it is empty, how to map values.
 #[derive(Debug, Clone, Default)]
 pub struct AttributeRule {
+    /// The layer's field holding the attribute, if it has one.
     pub field: Option<String>,
+    /// The constant of the parameter file, used where the field is empty or missing.
     pub constant: Option<String>,
+    /// The value map of the parameter file (the data's codes to edo-city's names).
     pub values: BTreeMap<String, String>,
 }
 

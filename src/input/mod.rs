@@ -35,12 +35,27 @@ use crs::Crs;
 use fields::{resolve_field, AttributeRule};
 use geometry::{map_polygon, polygons_of};
 
+/// Why the input cannot be read: the build stops before anything is written (exit code 2).
+/// Every message names the file and says what to do.
 #[derive(Debug, Error)]
 pub enum InputError {
+    /// A layer (or one of its sidecar files) cannot be used.
     #[error("{file}: {message}")]
-    Layer { file: String, message: String },
+    Layer {
+        /// The file, as the user named it.
+        file: String,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// An attribute table cannot be joined.
     #[error("attribute table {file}: {message}")]
-    Table { file: String, message: String },
+    Table {
+        /// The table's file.
+        file: String,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// Something the build needs is not there (a directory, a layer, street edges).
     #[error("{0}")]
     Missing(String),
 }

@@ -18,13 +18,17 @@ use super::InputError;
 pub struct Feature {
     /// Record number in the file, 0-based.
     pub record: usize,
+    /// The shape as read.
     pub shape: Shape,
+    /// Every DBF field as text, by field name.
     pub attrs: BTreeMap<String, String>,
 }
 
 /// A layer as read, before any interpretation.
 pub struct Layer {
+    /// The `.shp` file.
     pub path: PathBuf,
+    /// The features in record order, deleted records left out.
     pub features: Vec<Feature>,
     /// The encoding used for the DBF text, for the report.
     pub encoding: String,
@@ -34,6 +38,7 @@ pub struct Layer {
     pub fields: Vec<String>,
     /// The `.prj` text, if present.
     pub prj: Option<String>,
+    /// What reading noticed (encodings, repeated fields, sidecars).
     pub warnings: Vec<crate::model::Warning>,
     /// Records in the file, deleted ones included (the FIDs run 0..records).
     pub records: usize,

@@ -13,6 +13,7 @@ use super::InputError;
 /// A table as rows keyed by id; each row maps column name to text.
 #[derive(Debug, Clone, Default)]
 pub struct Table {
+    /// The table's file.
     pub file: String,
     /// Rows in file order: (id, values), each id once.
     pub rows: Vec<(String, BTreeMap<String, String>)>,

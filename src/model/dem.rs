@@ -11,12 +11,17 @@ use geo_types::Coord;
 /// An elevation grid: `z[row * ncols + col]`, row 0 at the top (north).
 #[derive(Debug, Clone)]
 pub struct Dem {
+    /// The DEM's file, for messages.
     pub file: String,
+    /// Columns of the grid.
     pub ncols: usize,
+    /// Rows of the grid.
     pub nrows: usize,
     /// Lower-left corner of the lower-left cell.
     pub xll: f64,
+    /// The lower edge, as `xll` is the left one.
     pub yll: f64,
+    /// The cells' side, metres.
     pub cell: f64,
     z: Vec<f64>,
     /// Cells whose value no ground has (outside [`super::ELEVATION_RANGE`]), read as
@@ -27,7 +32,9 @@ pub struct Dem {
 /// An elevation, and whether the point lay outside the grid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sample {
+    /// The elevation, metres.
     pub z: f64,
+    /// Whether the point lay outside the grid (it got the nearest edge's elevation).
     pub outside: bool,
 }
 

@@ -86,9 +86,11 @@ pub struct Lot {
     pub record: usize,
     /// Outline in projected metres, exterior ring counter-clockwise, closed.
     pub outline: Polygon<f64>,
+    /// What the lot is used for.
     pub lot_use: LotUse,
     /// Raw machiya type (`mtype`), resolved against the templates during analysis.
     pub mtype: Option<String>,
+    /// The district it belongs to (its attribute, else the district polygon holding it).
     pub district: Option<String>,
     /// A tile id given in the data; wins over the computed one.
     pub tile: Option<String>,
@@ -101,8 +103,11 @@ pub struct Lot {
 /// A free-standing fence or wall from a line layer.
 #[derive(Debug, Clone)]
 pub struct FenceLine {
+    /// The line's id (its field, else its record number from 1; parts `<id>-<n>`).
     pub id: String,
+    /// Its record in the file.
     pub record: usize,
+    /// The line, in the output CRS; a closed one walls in its inside.
     pub line: LineString<f64>,
     /// Every attribute of the feature.
     pub attrs: BTreeMap<String, String>,
@@ -111,8 +116,11 @@ pub struct FenceLine {
 /// A person or a tree given as a point (`people.shp`, `trees.shp`).
 #[derive(Debug, Clone)]
 pub struct PointFeature {
+    /// The point's id.
     pub id: String,
+    /// Its record in the file.
     pub record: usize,
+    /// Where it stands, in the output CRS.
     pub at: Coord<f64>,
     /// The `height` field, metres, when given.
     pub height: Option<f64>,
@@ -123,29 +131,42 @@ pub struct PointFeature {
 /// A building footprint from the data, built as a house of its own height.
 #[derive(Debug, Clone)]
 pub struct Footprint {
+    /// The footprint's id, unique within the layer.
     pub id: String,
+    /// Its record in the file.
     pub record: usize,
+    /// Its outline in the output CRS, exterior counter-clockwise.
     pub outline: Polygon<f64>,
+    /// Its machiya type as the data names it (else `default_type`).
     pub mtype: Option<String>,
+    /// The district polygon holding it.
     pub district: Option<String>,
     /// Total height, ground to ridge, metres.
     pub height: f64,
+    /// Ground elevation, metres.
     pub ground: f64,
 }
 
 /// What was read from one layer, for the report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LayerInfo {
+    /// The layer's role: lots, footprints, streets, blocks, street_widths, districts,
+    /// fences, people, trees.
     pub role: String,
+    /// The file, as the user named it.
     pub file: String,
+    /// Records in the file (deleted ones included).
     pub features: usize,
+    /// The text encoding its DBF was read in, and how it was chosen.
     pub encoding: String,
     /// The layer's CRS as a proj string, or how it was assumed.
     pub crs: String,
+    /// Whether its coordinates were reprojected into the output CRS.
     pub reprojected: bool,
     /// Vertices read and left after generalisation (`simplify.tolerance`).
     #[serde(default)]
     pub vertices_before: usize,
+    /// Vertices left after generalisation.
     #[serde(default)]
     pub vertices_after: usize,
 }
@@ -153,48 +174,63 @@ pub struct LayerInfo {
 /// A street centreline with its full width in metres.
 #[derive(Debug, Clone)]
 pub struct Street {
+    /// The street's id (its record in the file).
     pub id: String,
+    /// The centreline, in the output CRS.
     pub line: LineString<f64>,
+    /// Full width, metres.
     pub width: f64,
 }
 
 /// A feature left out of the build, with the reason, for `report.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Skipped {
+    /// The layer's role (`lots`, `lots table`, `people`, ...).
     pub layer: String,
+    /// The file the feature came from.
     pub file: String,
+    /// The feature's id (`record N` when it has none).
     pub id: String,
     /// The record number in the file (from 0, as the FID of QGIS and ArcGIS), where the
     /// feature came from one; for a row of an attribute table, its row as the spreadsheet
     /// numbers it (the header is row 1). Kept apart from `reason` so skips group by cause.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub record: Option<usize>,
+    /// Why it was left out, and what to do.
     pub reason: String,
 }
 
 /// Everything read from the input directory, in input order.
 #[derive(Debug, Clone, Default)]
 pub struct Dataset {
+    /// Lot polygons, parts of multipart lots split.
     pub lots: Vec<Lot>,
     /// Free-standing fence lines.
     pub fence_lines: Vec<FenceLine>,
     /// People and trees from point layers; `None` when the layer is absent (then they are
     /// generated).
     pub people: Option<Vec<PointFeature>>,
+    /// Trees from a point layer, as `people`.
     pub trees: Option<Vec<PointFeature>>,
     /// The terrain, when the input has one.
     pub dem: Option<dem::Dem>,
     /// City blocks (machi 町 / gaiku 街区): their boundaries are street edges.
     pub blocks: Vec<Polygon<f64>>,
+    /// Street centrelines with their widths.
     pub streets: Vec<Street>,
+    /// Building footprints, each built to its own height.
     pub footprints: Vec<Footprint>,
     /// Contents of the lots layer's `.prj`, if any, carried to the manifest.
     pub crs_wkt: Option<String>,
     /// The CRS all coordinates are in (proj string); empty when unknown (no `.prj` anywhere).
     pub crs: String,
+    /// Every layer read, for the report.
     pub layers: Vec<LayerInfo>,
+    /// Features left out while reading, with their reasons.
     pub skipped: Vec<Skipped>,
+    /// What reading noticed.
     pub warnings: Vec<Warning>,
+    /// How each attribute table matched its layer.
     pub joins: Vec<TableJoin>,
     /// For the layers whose features keep no record number (blocks, streets, districts,
     /// street widths): the records that gave at least one usable feature, by role. The
@@ -205,13 +241,19 @@ pub struct Dataset {
 /// How an attribute table matched its layer.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TableJoin {
+    /// The layer the table joins (`lots`).
     pub layer: String,
+    /// The table's file.
     pub file: String,
+    /// Rows in the table.
     pub rows: usize,
+    /// Rows whose id matched a feature.
     pub matched: usize,
     /// Row ids with no feature of that id (first few kept for the report).
     pub rows_without_feature: usize,
+    /// The first of them, for the report.
     pub rows_without_feature_ids: Vec<String>,
+    /// Features with no row.
     pub features_without_row: usize,
 }
 
@@ -220,12 +262,14 @@ pub struct TableJoin {
 pub struct Frontage {
     /// Start and end vertex; walking a -> b the lot lies on the left.
     pub a: Coord<f64>,
+    /// End vertex.
     pub b: Coord<f64>,
     /// True when no pair passed the paper's test and the nearest edge was taken.
     pub fallback: bool,
 }
 
 impl Frontage {
+    /// Its length, metres (the frontage width, maguchi).
     pub fn width(&self) -> f64 {
         ((self.b.x - self.a.x).powi(2) + (self.b.y - self.a.y).powi(2)).sqrt()
     }
@@ -256,7 +300,10 @@ pub enum HouseSource {
     /// A lot-filling machiya on a town lot: its template decides its height.
     Lot,
     /// A building footprint of the data (PLATEAU, OSM), built to its own total height, metres.
-    Footprint { height: f64 },
+    Footprint {
+        /// Ground to top, metres.
+        height: f64,
+    },
 }
 
 impl PlannedHouse {
@@ -277,15 +324,21 @@ impl PlannedHouse {
 /// A machiya lot after analysis: everything generation needs, nothing more.
 #[derive(Debug, Clone)]
 pub struct PlannedHouse {
+    /// The lot's or footprint's id.
     pub id: String,
+    /// Its record in its file.
     pub record: usize,
+    /// Its outline in the output CRS.
     pub outline: Polygon<f64>,
+    /// The frontage Fig.4 found.
     pub frontage: Frontage,
     /// Template name of the resolved type.
     pub mtype: String,
     /// True when the type came from the data, false when drawn from the type mix.
     pub type_given: bool,
+    /// Its district.
     pub district: Option<String>,
+    /// The tile it is written to.
     pub tile: TileId,
     /// Ground elevation under the house, metres.
     pub ground: f64,
@@ -300,7 +353,9 @@ pub struct PlannedHouse {
 /// A wall segment or a gate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum FenceKind {
+    /// A length of wall.
     Wall,
+    /// A gate (Fig.11), the wall split at its sides.
     Gate,
 }
 
@@ -310,25 +365,34 @@ pub enum FenceKind {
 pub struct PlannedFence {
     /// The lot's (or fence line's) id.
     pub id: String,
+    /// The lot's or line's record in its file.
     pub record: usize,
     /// "lots" or "fences": the layer it came from.
     pub layer: String,
+    /// The fence template (`fence`, `tsuiji`, or the gate's).
     pub template: String,
+    /// Wall or gate.
     pub kind: FenceKind,
     /// The edge of the outline (from 0) it stands on.
     pub edge: usize,
+    /// Start, map metres.
     pub a: Coord<f64>,
+    /// End, map metres.
     pub b: Coord<f64>,
     /// Mitres at the two ends (cot of half the interior angle; 0 = a square end).
     pub start_mitre: f64,
+    /// The mitre at `b`.
     pub end_mitre: f64,
     /// Ground elevation at `a` and at `b` (the same without a DEM).
     pub ground: f64,
+    /// Ground elevation at `b`.
     pub ground_end: f64,
     /// How deep a wall on the segment may be and stay inside its lot (a free-standing line:
     /// `analyse::room::MAX_ROOM`): the template's `lot_depth`.
     pub room: f64,
+    /// The lot's district.
     pub district: Option<String>,
+    /// The tile it is written to (its lot's or line's).
     pub tile: TileId,
     /// Numeric attributes for the template (`height`).
     pub attrs: Vec<(String, f64)>,
@@ -337,7 +401,9 @@ pub struct PlannedFence {
 /// A billboard: a person or a tree (section 4.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum BillboardKind {
+    /// A person: one quad facing along the street.
     Person,
+    /// A tree: two crossed quads.
     Tree,
 }
 
@@ -354,18 +420,24 @@ impl BillboardKind {
 /// One person or tree to build.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlannedBillboard {
+    /// Person or tree.
     pub kind: BillboardKind,
     /// The point's id, or for a generated point `<street or lot id>/<n>`.
     pub id: String,
+    /// Where it stands, map metres.
     pub at: Coord<f64>,
     /// The direction the picture faces, radians counter-clockwise from map east: along its
     /// street for a person, any for a tree.
     pub facing: f64,
+    /// Its height, metres.
     pub height: f64,
     /// Library material of the picture.
     pub texture: String,
+    /// Ground elevation under it.
     pub ground: f64,
+    /// The district it stands in.
     pub district: Option<String>,
+    /// The tile it is written to.
     pub tile: TileId,
 }
 
@@ -387,6 +459,7 @@ pub enum KuraDecision {
 }
 
 impl KuraDecision {
+    /// Whether the machiya was a kura candidate (frontage and depth rule).
     pub fn is_candidate(&self) -> bool {
         !matches!(self, KuraDecision::NotCandidate)
     }
@@ -421,6 +494,7 @@ pub struct KuraCounts {
 }
 
 impl KuraCounts {
+    /// Adds another tile's or district's counts.
     pub fn add(&mut self, o: &KuraCounts) {
         self.machiya += o.machiya;
         self.candidates += o.candidates;
@@ -449,10 +523,13 @@ pub struct Plan {
     /// Every tile with something to build (houses, fences or given people and trees): the
     /// tiles a full build writes.
     pub tiles: std::collections::BTreeSet<TileId>,
+    /// Lots where no edge pair passed Fig.4 and the nearest edge was taken.
     pub frontage_fallback: usize,
     /// Footprints planned (they share the tiles with the machiya).
     pub footprints: usize,
+    /// Features analysis left out, with their reasons.
     pub skipped: Vec<Skipped>,
+    /// What analysis noticed.
     pub warnings: Vec<Warning>,
     /// Time spent placing kura and testing their provisional plots (for `--timings`).
     pub kura_time: std::time::Duration,
@@ -469,11 +546,17 @@ pub struct Plan {
 /// What generation found in one tile.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct TileStats {
+    /// Machiya built in the tile.
     pub machiya: usize,
+    /// Footprint houses built in the tile.
     pub footprints: usize,
+    /// Machiya per type.
     pub by_type: BTreeMap<String, usize>,
+    /// Footprint houses per type.
     pub footprints_by_type: BTreeMap<String, usize>,
+    /// Houses per district ("" = none).
     pub by_district: BTreeMap<String, usize>,
+    /// Machiya whose type the data gave (the rest were drawn from `type_mix`).
     pub type_given: usize,
     /// Types drawn from a type mix (not given by the data), per district: to check a
     /// district's mix against its parameter.
@@ -486,19 +569,24 @@ pub struct TileStats {
     /// millimetres (integers, so a manifest read back and written again is byte-identical).
     #[serde(default)]
     pub fence_segments: usize,
+    /// Gates built.
     #[serde(default)]
     pub gates: usize,
+    /// Millimetres of wall per fence template.
     #[serde(default)]
     pub wall_mm: BTreeMap<String, u64>,
     /// People and trees built, per district ("" = none), and per texture.
     #[serde(default)]
     pub people_by_district: BTreeMap<String, usize>,
+    /// Trees built, per district.
     #[serde(default)]
     pub trees_by_district: BTreeMap<String, usize>,
+    /// Billboards per texture.
     #[serde(default)]
     pub billboard_textures: BTreeMap<String, usize>,
     /// Table 2 counts per district ("" = none).
     #[serde(default)]
     pub kura_counts: BTreeMap<String, KuraCounts>,
+    /// Features generation left out (a template check failed), with their reasons.
     pub skipped: Vec<Skipped>,
 }

@@ -23,6 +23,7 @@ pub enum WarningClass {
 /// One warning.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Warning {
+    /// What the warning is about.
     pub class: WarningClass,
     /// The layer's role (`lots`, `streets`, ...), when the warning is about a layer's data.
     #[serde(default, skip_serializing_if = "Option::is_none")]

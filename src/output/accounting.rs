@@ -15,7 +15,9 @@ use crate::model::{Dataset, Skipped};
 /// What one layer's records became, as far as reading and analysis know.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Ledger {
+    /// The layer's role (`lots`, `streets`, ...).
     pub role: String,
+    /// The layer's file.
     pub file: String,
     /// Records in the file.
     pub read: usize,
@@ -33,8 +35,11 @@ pub struct Ledger {
 /// A layer's closed account, for the report.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Account {
+    /// The layer's role.
     pub role: String,
+    /// The layer's file.
     pub file: String,
+    /// Records in the file.
     pub read: usize,
     /// Records with at least one feature built.
     pub built: usize,

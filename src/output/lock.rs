@@ -27,13 +27,25 @@ pub struct OutLock {
 /// Why the lock could not be taken.
 #[derive(Debug, thiserror::Error)]
 pub enum LockError {
+    /// Another run holds the directory.
     #[error(
         "{dir} is in use by another edo-city run{holder}: wait for it to finish, or build \
          into another --out"
     )]
-    Busy { dir: String, holder: String },
+    Busy {
+        /// The output directory.
+        dir: String,
+        /// " (process N)" when the holder wrote its pid, else empty.
+        holder: String,
+    },
+    /// The lock file cannot be made or locked (permissions, a read-only disk).
     #[error("cannot lock {path}: {cause}")]
-    Io { path: String, cause: std::io::Error },
+    Io {
+        /// The lock file.
+        path: String,
+        /// What the operating system said.
+        cause: std::io::Error,
+    },
 }
 
 impl OutLock {

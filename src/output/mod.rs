@@ -21,6 +21,7 @@ use crate::generate::mesh::Mesh;
 use crate::materials::TEXTURES;
 use report::ManifestFile;
 
+/// The sha256 of `bytes` in lower-case hex, as the manifest lists every file.
 pub fn sha256_hex(bytes: &[u8]) -> String {
     let digest = Sha256::digest(bytes);
     digest.iter().map(|b| format!("{b:02x}")).collect()

@@ -28,15 +28,25 @@ pub const TYPE_COLOURS: &[[u8; 3]] = &[
     [100, 150, 170],
     [190, 190, 90],
 ];
+/// Houses built from a footprint layer.
 pub const FOOTPRINT: [u8; 3] = [140, 155, 175];
+/// Lots skipped (with a reason in the report).
 pub const SKIPPED: [u8; 3] = [220, 90, 80];
+/// Lots of other uses, with no house.
 pub const OTHER_USE: [u8; 3] = [200, 215, 190];
+/// The frontage Fig.4 chose for each house.
 pub const FRONTAGE: [u8; 3] = [200, 30, 30];
+/// Kura built.
 pub const KURA: [u8; 3] = [70, 70, 78];
+/// Walls.
 pub const FENCE: [u8; 3] = [95, 60, 35];
+/// Gates.
 pub const GATE: [u8; 3] = [210, 40, 40];
+/// Kura the collision avoidance refused (outlined).
 pub const KURA_REFUSED: [u8; 3] = [235, 120, 30];
+/// Trees, as wide as their crowns.
 pub const TREE: [u8; 3] = [40, 130, 50];
+/// People.
 pub const PERSON: [u8; 3] = [30, 40, 120];
 
 /// What the image shows and how metres map to pixels.

@@ -14,6 +14,7 @@ pub use crate::model::TileStats;
 use crate::model::{KuraCounts, LayerInfo, Skipped, TableJoin};
 use crate::params::Params;
 
+/// The counts of a build, as report.json and the summary give them.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Counts {
     /// Lots read (after multipart lots were split), of every use.
@@ -22,13 +23,17 @@ pub struct Counts {
     pub lots_by_use: BTreeMap<String, usize>,
     /// Machiya written (lot-filling houses).
     pub machiya: usize,
+    /// Machiya per type.
     pub by_type: BTreeMap<String, usize>,
     /// Footprints read, and built as houses.
     pub footprints_read: usize,
+    /// Footprint houses built.
     pub footprints: usize,
+    /// Footprint houses per type.
     pub footprints_by_type: BTreeMap<String, usize>,
     /// Machiya whose type came from the data / was drawn from `type_mix`.
     pub type_given: usize,
+    /// Machiya whose type was drawn from `type_mix`.
     pub type_drawn: usize,
     /// Houses (machiya and footprints) per district; "" = no district.
     pub by_district: BTreeMap<String, usize>,
@@ -36,31 +41,44 @@ pub struct Counts {
     pub drawn_by_district: BTreeMap<String, BTreeMap<String, usize>>,
     /// Lots where no pair passed the Fig.4 test and the nearest edge was taken.
     pub frontage_fallback: usize,
+    /// Tiles written.
     pub tiles: usize,
     /// Kura (storehouses) built.
     pub kura: usize,
     /// Fence segments and gates built, and metres of wall per fence template (to the mm).
     pub fence_segments: usize,
+    /// Gates built.
     pub gates: usize,
+    /// Metres of wall per fence template, to the millimetre.
     pub wall_metres: BTreeMap<String, f64>,
     /// People and trees built (billboards), per district ("" = none) and per texture.
     pub people: usize,
+    /// Trees built.
     pub trees: usize,
+    /// People per district ("" = none).
     pub people_by_district: BTreeMap<String, usize>,
+    /// Trees per district.
     pub trees_by_district: BTreeMap<String, usize>,
+    /// Billboards per texture.
     pub billboard_textures: BTreeMap<String, usize>,
+    /// Features left out, of every stage (each listed in `skipped`).
     pub skipped: usize,
 }
 
 /// The paper's Table 2: kura per machiya, without and with collision avoidance.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Table2 {
+    /// Machiya built.
     pub machiya: usize,
+    /// Of them candidates for a kura (frontage and depth rule).
     pub kura_candidates: usize,
+    /// Kura built with `kura.collision = false`.
     pub kura_without_avoidance: usize,
+    /// Kura built with the collision avoidance of Fig.7.
     pub kura_with_avoidance: usize,
     /// kura / machiya.
     pub ratio_without: f64,
+    /// kura with avoidance / machiya.
     pub ratio_with: f64,
 }
 
@@ -88,8 +106,10 @@ impl Table2 {
 /// Table 2 for the whole city and per district ("" = lots without a district).
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Table2Report {
+    /// The whole city (its keys at the top of `table2`).
     #[serde(flatten)]
     pub all: Table2,
+    /// Per district.
     pub by_district: BTreeMap<String, Table2>,
     /// The paper's figures, for comparison.
     pub paper: PaperTable2,
@@ -98,13 +118,21 @@ pub struct Table2Report {
 /// Table 2 of Kosaka et al. 2008: all of Kyoto, and the Rakuchu-rakugai-zu screen.
 #[derive(Debug, Clone, Serialize)]
 pub struct PaperTable2 {
+    /// Machiya of all Kyoto.
     pub machiya: usize,
+    /// Kura without avoidance.
     pub kura_without_avoidance: usize,
+    /// Kura with avoidance.
     pub kura_with_avoidance: usize,
+    /// kura / machiya without avoidance.
     pub ratio_without: f64,
+    /// kura / machiya with avoidance.
     pub ratio_with: f64,
+    /// Machiya on the Rakuchu-rakugai-zu screen.
     pub painting_machiya: usize,
+    /// Kura on the screen.
     pub painting_kura: usize,
+    /// kura / machiya on the screen.
     pub painting_ratio: f64,
 }
 
@@ -123,90 +151,135 @@ impl Default for PaperTable2 {
     }
 }
 
+/// report.json: what a build read, built and left out, assembled from its manifest.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Report {
+    /// `edo-city`.
     pub tool: String,
+    /// The tool's version.
     pub version: String,
+    /// The input directory, absolute.
     pub input: String,
     /// The CRS of the output (proj string); empty when no layer had a `.prj`.
     pub crs: String,
+    /// Every layer read.
     pub layers: Vec<LayerInfo>,
+    /// The counts.
     pub counts: Counts,
+    /// The paper's Table 2, for this build and as published.
     pub table2: Table2Report,
     /// Every feature left out, with file, id and reason.
     pub skipped: Vec<Skipped>,
+    /// Skips per cause (the reason up to its first number).
     pub skipped_by_reason: BTreeMap<String, usize>,
+    /// How each attribute table matched its layer.
     pub tables: Vec<TableJoin>,
+    /// What the build noticed.
     pub warnings: Vec<crate::model::Warning>,
     /// Per layer: records read, built, skipped, and unaccounted (always 0; see
     /// [`super::accounting`]).
     pub accounting: Vec<super::accounting::Account>,
+    /// Per tile: houses and bytes.
     pub tiles: Vec<TileReport>,
 }
 
+/// One tile of the report.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct TileReport {
+    /// The tile's id.
     pub id: String,
+    /// Machiya in it.
     pub machiya: usize,
+    /// Footprint houses in it.
     pub footprints: usize,
+    /// Bytes of its OBJ.
     pub obj_bytes: u64,
 }
 
 /// The part of the report that comes from reading and analysis, the same for every tile.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct InputSummary {
+    /// The input directory, absolute.
     pub input: String,
     /// The `--templates` directory of the build, as typed, so that `edo-city plan` can load
     /// the same types again.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub templates: Option<String>,
+    /// The output CRS (proj string).
     pub crs: String,
+    /// Every layer read.
     pub layers: Vec<LayerInfo>,
+    /// Lots read (parts of multipart lots split).
     pub lots: usize,
+    /// Lots per use.
     pub lots_by_use: BTreeMap<String, usize>,
+    /// Footprints read.
     pub footprints_read: usize,
+    /// Lots where Fig.4 fell back to the nearest edge.
     pub frontage_fallback: usize,
+    /// Features reading and analysis left out.
     pub skipped: Vec<Skipped>,
+    /// How each attribute table matched its layer.
     pub tables: Vec<TableJoin>,
+    /// What reading and analysis noticed.
     pub warnings: Vec<crate::model::Warning>,
     /// What each layer's records became in reading and analysis, closed in the report.
     #[serde(default)]
     pub ledgers: Vec<super::accounting::Ledger>,
 }
 
+/// manifest.json, written last: what the build is (tool, parameters, input, frame) and
+/// every file it wrote with its size and sha256.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Manifest {
+    /// `edo-city`.
     pub tool: String,
+    /// The tool's version.
     pub version: String,
     /// Set on a shard's manifest: [index, count], index from 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shard: Option<[usize; 2]>,
     /// Output coordinates are relative to this point, in the input's projected metres.
     pub origin: [f64; 2],
+    /// The output frame, in words (axes and units).
     pub frame: String,
     /// The output CRS as a proj string; empty when no layer had a `.prj`.
     pub crs: String,
     /// The lots (else footprints) layer's `.prj`, if it had one.
     pub crs_wkt: Option<String>,
+    /// Tile edge, metres.
     pub tile_size: f64,
+    /// The resolved parameters of the build.
     pub params: Params,
+    /// What reading and analysis found, the same for every tile.
     pub input: InputSummary,
+    /// Every tile written, with its files and statistics.
     pub tiles: Vec<ManifestTile>,
+    /// The texture files.
     pub textures: Vec<ManifestFile>,
 }
 
+/// One tile of the manifest.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ManifestTile {
+    /// The tile's id.
     pub id: String,
+    /// Its OBJ file.
     pub obj: ManifestFile,
+    /// Its MTL file.
     pub mtl: ManifestFile,
+    /// What generation found in it.
     pub stats: TileStats,
 }
 
+/// One file written by the build.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ManifestFile {
+    /// Its path, relative to the output directory.
     pub path: String,
+    /// Its size in bytes.
     pub bytes: u64,
+    /// Its sha256, lower-case hex.
     pub sha256: String,
 }
 

@@ -11,9 +11,12 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PointsLayer {
+    /// The point layer's file (`people.shp`, `trees.shp`); "" for none.
     pub file: String,
+    /// Its text encoding, when the `.cpg` is wrong or missing.
     #[serde(default)]
     pub encoding: String,
+    /// Its id field.
     pub id_field: String,
     /// Height of the billboard, metres; empty or missing = drawn from the height range.
     pub height_field: String,
@@ -25,7 +28,9 @@ pub struct PointsLayer {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PeopleParams {
+    /// Whether people are placed at all.
     pub enabled: bool,
+    /// The person template.
     pub template: String,
     /// Expected people per 100 m of street centreline (`[district.<id>] people_per_100m`).
     pub per_100m: f64,
@@ -49,7 +54,9 @@ pub struct PeopleParams {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TreesParams {
+    /// Whether trees are placed at all.
     pub enabled: bool,
+    /// The tree template.
     pub template: String,
     /// Lot uses planted at `per_ha` over the whole lot (estates, temples).
     pub uses: Vec<String>,
@@ -58,11 +65,15 @@ pub struct TreesParams {
     /// Expected trees per hectare of the open back part of a town lot: behind the house,
     /// outside its kura (`[district.<id>] trees_per_ha_machiya`).
     pub per_ha_machiya: f64,
+    /// [low, high] metres, a tree's height drawn uniformly between.
     pub height: [f64; 2],
+    /// No two trees nearer than this, metres (Poisson-disk thinning).
     pub min_spacing: f64,
     /// Distance of a trunk from buildings, kura, fences and the lot's edge.
     pub clearance: f64,
+    /// Library materials drawn from, one per tree.
     pub textures: Vec<String>,
+    /// The most trees one tile may hold; a denser tile is scaled down, with a warning.
     pub max_points_per_tile: usize,
 }
 

@@ -12,29 +12,50 @@ use evalexpr::{DefaultNumericTypes, Node, Operator, Value};
 /// A compiled expression.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Expr {
+    /// A number.
     Const(f64),
+    /// The value of a slot (an input, parameter, attribute, derived value, `u` or `v`).
     Slot(usize),
+    /// Minus its operand.
     Neg(Box<Expr>),
+    /// 1 when its operand is 0, else 0.
     Not(Box<Expr>),
+    /// A binary operator on two operands.
     Bin(Bin, Box<Expr>, Box<Expr>),
+    /// A function call.
     Call(Func, Vec<Expr>),
 }
 
+/// The binary operators (comparisons and logic give 1 or 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Bin {
+    /// `a + b`
     Add,
+    /// `a - b`
     Sub,
+    /// `a * b`
     Mul,
+    /// `a / b`
     Div,
+    /// `a % b`
     Rem,
+    /// `a ^ b`
     Pow,
+    /// `a == b`
     Eq,
+    /// `a != b`
     Ne,
+    /// `a > b`
     Gt,
+    /// `a < b`
     Lt,
+    /// `a >= b`
     Ge,
+    /// `a <= b`
     Le,
+    /// `a && b`
     And,
+    /// `a || b`
     Or,
 }
 
@@ -42,20 +63,35 @@ pub enum Bin {
 /// street at depth `v`, so a part can follow a lot whose sides are not square to the street.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Func {
+    /// `min(a, b, ...)`
     Min,
+    /// `max(a, b, ...)`
     Max,
+    /// `floor(x)`
     Floor,
+    /// `ceil(x)`
     Ceil,
+    /// `round(x)`
     Round,
+    /// `abs(x)`
     Abs,
+    /// `sqrt(x)`
     Sqrt,
+    /// `sin(x)`, radians
     Sin,
+    /// `cos(x)`
     Cos,
+    /// `tan(x)`
     Tan,
+    /// `atan2(y, x)`
     Atan2,
+    /// `if(c, a, b)`: `a` when `c` is not 0, else `b`
     If,
+    /// `clamp(x, lo, hi)`
     Clamp,
+    /// `lot_u0(v)`: where the lot begins along the street at depth `v`
     LotU0,
+    /// `lot_u1(v)`: where it ends
     LotU1,
 }
 

@@ -112,7 +112,9 @@ impl std::fmt::Display for Loc {
 /// A value as written, with its place.
 #[derive(Debug, Clone)]
 pub struct Src<T> {
+    /// The value.
     pub value: T,
+    /// Where it was written.
     pub loc: Loc,
 }
 
@@ -122,61 +124,104 @@ pub type Text = Src<String>;
 /// A template file, read but not yet compiled or merged with the template it extends.
 #[derive(Debug, Clone)]
 pub struct Source {
+    /// The file it was read from.
     pub file: String,
+    /// The template's name (`name`, else the file's stem).
     pub name: Src<String>,
+    /// Its name in kanji.
     pub kanji: String,
+    /// Its kind (machiya, kura, fence, gate, tree, person).
     pub kind: Option<Src<String>>,
+    /// What it models, for `edo-city template`.
     pub description: String,
+    /// Other spellings of a machiya type's name in the data.
     pub aliases: Vec<String>,
+    /// The template it extends.
     pub extends: Option<Src<String>>,
+    /// Whether it only serves to be extended (never built itself).
     pub is_abstract: bool,
+    /// The height the model declares (tests hold the mesh to it).
     pub height: Option<Text>,
+    /// Parameters with their defaults (a parameter file may set them).
     pub params: Vec<(String, Src<f64>)>,
+    /// Attributes with their defaults (a lot's field of the same name sets them).
     pub attributes: Vec<(String, Src<f64>)>,
+    /// Derived values, as expressions.
     pub derived: Vec<(String, Text)>,
     /// Material slots: a part's material may name a slot, which names a library material.
     pub materials: Vec<(String, Src<String>)>,
+    /// Conditions every feature must meet, with the reason given when one fails.
     pub checks: Vec<(Text, String)>,
+    /// The parts, in file order.
     pub parts: Vec<PartSource>,
 }
 
+/// One `[[part]]` as written.
 #[derive(Debug, Clone)]
 pub struct PartSource {
+    /// Its name, unique in the template.
     pub name: Src<String>,
+    /// Built only where this is not 0.
     pub when: Option<Text>,
+    /// `lot` or a list of (u, v) points.
     pub outline: Option<Src<OutlineSource>>,
+    /// The band it is cut to: from depth `v0` ...
     pub v0: Option<Text>,
+    /// ... to `v1` ...
     pub v1: Option<Text>,
+    /// ... and along the street from `u0` ...
     pub u0: Option<Text>,
+    /// ... to `u1`.
     pub u1: Option<Text>,
+    /// Height of its underside, a function of u and v.
     pub bottom: Option<Text>,
+    /// Height of its top.
     pub top: Option<Text>,
+    /// Depths where the top bends (a ridge).
     pub split: Vec<Text>,
+    /// Positions along the street where it bends.
     pub split_u: Vec<Text>,
+    /// Material of the top faces.
     pub top_material: Option<Src<String>>,
+    /// Material of the bottom faces.
     pub bottom_material: Option<Src<String>>,
+    /// Material of the side walls.
     pub side_material: Option<Src<String>>,
+    /// Material of the front wall, textured as a facade.
     pub front_material: Option<Src<String>>,
+    /// The facade texture's width, metres (one repeat).
     pub front_base: Option<Text>,
+    /// The facade texture's height, metres.
     pub front_height: Option<Text>,
+    /// Explicit vertices (u, v, h).
     pub vertices: Vec<Src<Vec<Text>>>,
+    /// Explicit faces over them.
     pub faces: Vec<FaceSource>,
+    /// Whether the part must be a closed shell.
     pub closed: Option<bool>,
 }
 
+/// A prism's outline as written.
 #[derive(Debug, Clone)]
 pub enum OutlineSource {
+    /// The lot itself.
     Lot,
     /// A name other than `lot` (reported when compiled).
     Unknown(String),
+    /// (u, v) points.
     Points(Vec<Vec<Text>>),
 }
 
+/// One explicit face as written.
 #[derive(Debug, Clone)]
 pub struct FaceSource {
+    /// Its vertices, 1-based.
     pub corners: Src<Vec<Src<i64>>>,
+    /// Its material (a slot or a library name).
     pub material: Src<String>,
+    /// Texture coordinates per corner.
     pub uv: Option<Src<Vec<Vec<Text>>>>,
+    /// The texture repeat, metres, when the coordinates are projected.
     pub base: Option<Text>,
 }
 

@@ -65,18 +65,26 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("person.toml", include_str!("../../templates/person.toml")),
 ];
 
+/// Why the templates cannot be used: the build stops before it reads any data.
 #[derive(Debug, Error)]
 pub enum TemplateError {
     /// Already `file:line:column: message`.
     #[error("{0}")]
     Invalid(String),
+    /// A `--templates` directory cannot be read.
     #[error("cannot read template directory {dir}: {cause}")]
-    Io { dir: String, cause: std::io::Error },
+    Io {
+        /// The directory.
+        dir: String,
+        /// What the operating system said.
+        cause: std::io::Error,
+    },
 }
 
 /// All loaded templates, by name.
 #[derive(Debug, Clone, Default)]
 pub struct Catalog {
+    /// Every template, by name.
     pub templates: BTreeMap<String, Template>,
     /// Normalised spelling -> machiya type name.
     aliases: BTreeMap<String, String>,

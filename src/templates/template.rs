@@ -13,15 +13,22 @@ use crate::materials;
 /// What a template models; `type_mix` may name only machiya.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Kind {
+    /// A townhouse on a town lot (or a footprint).
     Machiya,
+    /// A storehouse behind a machiya.
     Kura,
+    /// A wall segment.
     Fence,
+    /// A gate in a wall.
     Gate,
+    /// A tree billboard.
     Tree,
+    /// A person billboard.
     Person,
 }
 
 impl Kind {
+    /// Every kind with the name template files use.
     pub const ALL: [(&'static str, Kind); 6] = [
         ("machiya", Kind::Machiya),
         ("kura", Kind::Kura),
@@ -30,6 +37,7 @@ impl Kind {
         ("tree", Kind::Tree),
         ("person", Kind::Person),
     ];
+    /// The name template files use.
     pub fn name(self) -> &'static str {
         Kind::ALL.iter().find(|k| k.1 == self).map_or("", |k| k.0)
     }
@@ -79,27 +87,42 @@ pub const INPUTS: &[(&str, &str)] = &[
     ),
 ];
 
+/// How many inputs there are (their slots come first).
 pub const N_INPUTS: usize = INPUTS.len();
 
 /// What a template is told about the site it is built on (the [`INPUTS`]); fields a kind of
 /// model does not have stay at their default.
 #[derive(Debug, Clone, Default)]
 pub struct SiteInputs<'a> {
+    /// Frontage width: the frontage runs from u = 0 to u = width.
     pub width: f64,
+    /// The lot's deepest point behind the frontage (largest v).
     pub lot_depth: f64,
     /// The frontage's two vertices and the site's centroid, map coordinates.
     pub a: Coord<f64>,
+    /// The second frontage vertex.
     pub b: Coord<f64>,
+    /// The site's centroid.
     pub centroid: Coord<f64>,
+    /// Ground elevation: h = 0 stands on it.
     pub ground: f64,
+    /// The feature's id.
     pub id: &'a str,
+    /// The feature's district.
     pub district: Option<&'a str>,
+    /// A footprint building's height from the data; 0 for a lot.
     pub building_height: f64,
+    /// `machiya.depth` of the parameter file.
     pub machiya_depth: f64,
+    /// `machiya.min_depth` of the parameter file.
     pub min_depth: f64,
+    /// A number in [0, 1) fixed per feature by (seed, layer, feature id).
     pub random: f64,
+    /// Fences: cot of half the interior angle at the segment's start.
     pub start_mitre: f64,
+    /// Fences: the same at its end.
     pub end_mitre: f64,
+    /// People and trees: their drawn height.
     pub billboard_height: f64,
 }
 
@@ -148,21 +171,31 @@ pub fn input(name: &str) -> usize {
         .unwrap_or_else(|| panic!("no template input `{name}`"))
 }
 
+/// A compiled template: every name a slot, every expression compiled, every check and
+/// material resolved; evaluated per feature without parsing.
 #[derive(Debug, Clone)]
 pub struct Template {
+    /// Its name.
     pub name: String,
+    /// Its name in kanji.
     pub kanji: String,
+    /// Its kind.
     pub kind: Kind,
+    /// What it models.
     pub description: String,
+    /// Other spellings of a machiya type.
     pub aliases: Vec<String>,
     /// The file the template was read from.
     pub file: String,
+    /// Whether it only serves to be extended.
     pub is_abstract: bool,
     /// Name of every slot: inputs, params, attributes, derived values, then `v`.
     pub names: Vec<String>,
     /// Default values of params and attributes (indexed by slot - N_INPUTS).
     pub defaults: Vec<f64>,
+    /// The slots of its parameters.
     pub params: Range<usize>,
+    /// The slots of its attributes.
     pub attributes: Range<usize>,
     /// Derived values in an order where each needs only earlier ones.
     pub derived: Vec<(usize, Expr, Loc)>,
@@ -173,6 +206,7 @@ pub struct Template {
     pub checks: Vec<(Expr, String)>,
     /// The height the model declares (checked by tests against the mesh).
     pub height: Option<(Expr, Loc)>,
+    /// Its parts, in file order.
     pub parts: Vec<Part>,
     /// The `[materials]` slots and the library material each names: a billboard's drawn
     /// texture replaces its `picture` slot.
@@ -189,17 +223,25 @@ impl Template {
     }
 }
 
+/// One compiled part.
 #[derive(Debug, Clone)]
 pub struct Part {
+    /// Its name.
     pub name: String,
+    /// Where it is written (for messages).
     pub loc: Loc,
+    /// Built only where this is not 0.
     pub when: Option<Expr>,
+    /// A prism or explicit faces.
     pub shape: Shape,
 }
 
+/// What a part is made of.
 #[derive(Debug, Clone)]
 pub enum Shape {
+    /// An outline extruded between two heights.
     Prism(Box<Prism>),
+    /// Explicit vertices and faces.
     Faces(Faces),
 }
 
@@ -208,40 +250,61 @@ pub enum Shape {
 /// between the `split` depths.
 #[derive(Debug, Clone)]
 pub struct Prism {
+    /// The part's own (u, v) outline; `None` = the lot.
     pub outline: Option<Vec<[Expr; 2]>>,
+    /// The band: from depth `v0` ...
     pub v0: Option<Expr>,
+    /// ... to `v1` ...
     pub v1: Option<Expr>,
+    /// ... along the street from `u0` ...
     pub u0: Option<Expr>,
+    /// ... to `u1`.
     pub u1: Option<Expr>,
+    /// Height of the underside.
     pub bottom: Expr,
+    /// Height of the top.
     pub top: Expr,
+    /// Depths where the top bends.
     pub split: Vec<Expr>,
+    /// Positions along the street where it bends.
     pub split_u: Vec<Expr>,
+    /// Material of the top faces.
     pub top_material: u16,
+    /// Material of the bottom faces.
     pub bottom_material: u16,
+    /// Material of the side walls.
     pub side_material: u16,
     /// Walls on the front line `v = v0` with facade texture coordinates.
     pub front_material: Option<u16>,
+    /// The facade texture's width, metres.
     pub front_base: Expr,
+    /// The facade texture's height, metres.
     pub front_height: Expr,
+    /// Whether the part must be a closed shell.
     pub closed: bool,
 }
 
 /// Explicit vertices (u, v, h) and faces over them.
 #[derive(Debug, Clone)]
 pub struct Faces {
+    /// The vertices (u, v, h).
     pub vertices: Vec<[Expr; 3]>,
+    /// The faces.
     pub faces: Vec<FaceSpec>,
+    /// Whether the part must be a closed shell.
     pub closed: bool,
 }
 
+/// One explicit face.
 #[derive(Debug, Clone)]
 pub struct FaceSpec {
     /// 0-based vertex indices (written 1-based in the file, like OBJ and the paper).
     pub corners: Vec<usize>,
+    /// Its material.
     pub material: u16,
     /// Texture coordinates per corner; `None` = projected onto the face, one repeat per `base`.
     pub uv: Option<Vec<[Expr; 2]>>,
+    /// The texture repeat, metres, when coordinates are projected.
     pub base: Expr,
 }
 
