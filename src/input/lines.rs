@@ -107,23 +107,11 @@ pub(super) fn read_streets(
                 });
             }
         }
-        if usable {
-            data.records
-                .entry(o.role.into())
-                .or_default()
-                .insert(f.record);
-        } else {
-            data.skipped.push(Skipped {
-                layer: o.role.into(),
-                file: o.file.clone(),
-                id: format!("record {}", f.record),
-                record: Some(f.record),
-                reason: "the centreline has fewer than 2 usable points (or a coordinate that is \
-                         not a finite number within 1e8 m of the CRS's origin): redraw it or \
-                         delete it"
-                    .into(),
-            });
-        }
+        o.kept_or_skipped(data, f.record, usable, || {
+            "the centreline has fewer than 2 usable points (or a coordinate that is not a \
+             finite number within 1e8 m of the CRS's origin): redraw it or delete it"
+                .into()
+        });
     }
     if bad_width > 0 {
         data.warnings.push(crate::model::Warning::layer(
@@ -162,24 +150,13 @@ pub(super) fn read_streets(
                     }
                 }
             }
-            if usable {
-                data.records
-                    .entry(wl.role.into())
-                    .or_default()
-                    .insert(f.record);
-            } else {
-                data.skipped.push(Skipped {
-                    layer: wl.role.into(),
-                    file: wl.file.clone(),
-                    id: format!("record {}", f.record),
-                    record: Some(f.record),
-                    reason: reason.unwrap_or_else(|| {
-                        "the line has fewer than 2 usable points (or a null shape): redraw it \
-                         or delete it"
-                            .into()
-                    }),
-                });
-            }
+            wl.kept_or_skipped(data, f.record, usable, || {
+                reason.unwrap_or_else(|| {
+                    "the line has fewer than 2 usable points (or a null shape): redraw it or \
+                     delete it"
+                        .into()
+                })
+            });
         }
         let (pieces, matched) = widths::apply_widths(streets, &lines, wp.max_distance);
         data.warnings.push(crate::model::Warning::layer(

@@ -80,6 +80,31 @@ impl Opened {
         self.against_winding.set(self.against_winding.get() + n);
     }
 
+    /// Records what became of `record` for the ledger: it gave a usable feature (`kept`), or
+    /// it is skipped with the reason `why` gives.
+    fn kept_or_skipped(
+        &self,
+        data: &mut Dataset,
+        record: usize,
+        kept: bool,
+        why: impl FnOnce() -> String,
+    ) {
+        if kept {
+            data.records
+                .entry(self.role.into())
+                .or_default()
+                .insert(record);
+        } else {
+            data.skipped.push(Skipped {
+                layer: self.role.into(),
+                file: self.file.clone(),
+                id: format!("record {record}"),
+                record: Some(record),
+                reason: why(),
+            });
+        }
+    }
+
     /// The warning for the rings wound against the standard, if any.
     fn winding_warning(&self) -> Option<crate::model::Warning> {
         let n = self.against_winding.get();
@@ -326,10 +351,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
                     }
                 })?;
                 data.blocks.push(p);
-                data.records
-                    .entry(o.role.into())
-                    .or_default()
-                    .insert(f.record);
+                o.kept_or_skipped(&mut data, f.record, true, String::new);
             }
         }
     }

@@ -291,28 +291,12 @@ pub(super) fn assign_districts(
                 }
             }
         }
-        if usable {
-            data.records
-                .entry(o.role.into())
-                .or_default()
-                .insert(f.record);
-        } else {
-            data.skipped.push(Skipped {
-                layer: o.role.into(),
-                file: o.file.clone(),
-                id: format!("record {}", f.record),
-                record: Some(f.record),
-                reason: match id.is_empty() {
-                    true => format!(
-                        "no value in the district id field `{field}`: give the \
-                                     district an id"
-                    ),
-                    false => "null shape or no usable outline: draw the district or delete the \
-                              record"
-                        .into(),
-                },
-            });
-        }
+        o.kept_or_skipped(data, f.record, usable, || match id.is_empty() {
+            true => format!("no value in the district id field `{field}`: give the district an id"),
+            false => {
+                "null shape or no usable outline: draw the district or delete the record".into()
+            }
+        });
     }
     let find = |poly: &geo_types::Polygon<f64>| -> Option<String> {
         let c = poly.centroid()?;
