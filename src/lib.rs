@@ -16,6 +16,7 @@ pub mod build;
 pub mod compare;
 pub mod generate;
 pub mod geom;
+pub mod growers;
 pub mod init;
 pub mod input;
 pub mod materials;

@@ -60,6 +60,9 @@ enum Command {
     Template(TemplateArgs),
     /// Inspect a directory of shapefiles and write a starting parameter file with guesses.
     Init(InitArgs),
+    /// Simulate the crowd model alone (boids of Oyama et al., seed 004) and write its order
+    /// parameters lambda1-3 per step: the seed's demo.
+    Boids(BoidsArgs),
 }
 
 fn main() -> ExitCode {
@@ -95,6 +98,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Compare(args) => compare_command(args),
         Command::Plan(args) => plan_command(args),
         Command::Merge(args) => merge_command(args),
+        Command::Boids(args) => boids_command(args),
         Command::Init(args) => init_command(args),
         Command::Params => params_command(),
         Command::Template(args) => template_command(args),

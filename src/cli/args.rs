@@ -178,3 +178,44 @@ pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
     }
     Ok((i, n))
 }
+
+/// The flags of `edo-city boids`.
+#[derive(Args)]
+pub struct BoidsArgs {
+    /// Seed of the starting places and every agent's random motion.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Time steps to simulate.
+    #[arg(long, default_value_t = 1000)]
+    pub steps: usize,
+    /// Number of agents (the seed's Table 1: 10).
+    #[arg(long, default_value_t = 10)]
+    pub agents: usize,
+    /// Width of the space.
+    #[arg(long, default_value_t = 500.0)]
+    pub width: f64,
+    /// Height of the space.
+    #[arg(long, default_value_t = 300.0)]
+    pub height: f64,
+    /// Separation zone.
+    #[arg(long, default_value_t = 20.0)]
+    pub r0: f64,
+    /// Alignment zone (also the distance scale of lambda2 and lambda3).
+    #[arg(long, default_value_t = 80.0)]
+    pub r1: f64,
+    /// Cohesion zone; beyond it agents move at random.
+    #[arg(long, default_value_t = 100.0)]
+    pub r2: f64,
+    /// The seed's random system: no rules, every agent moves at random (its R-lambdas).
+    #[arg(long)]
+    pub no_rules: bool,
+    /// Write `step,lambda1,lambda2,lambda3` per step here (else to standard output).
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Draw lambda1-3 of the BOID system and of the random system over the steps (fig. 8).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Write the crowd after the last step as SVG.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+}

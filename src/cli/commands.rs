@@ -332,3 +332,139 @@ fn template_alone(
     );
     Ok(())
 }
+
+/// The most agents and steps `boids` simulates (a million agents would take hours a step in
+/// the exact order parameters' sample; the city runs far fewer per street).
+const MAX_BOIDS: usize = 100_000;
+const MAX_BOID_STEPS: usize = 1_000_000;
+
+/// `edo-city boids`: the seed's demo of Oyama et al., its order parameters per step.
+pub fn boids_command(args: BoidsArgs) -> Result<()> {
+    use edo_city::growers::boids::{BoidParams, Flock, Lambdas};
+    if args.agents > MAX_BOIDS || args.steps > MAX_BOID_STEPS {
+        anyhow::bail!("--agents must be at most {MAX_BOIDS} and --steps at most {MAX_BOID_STEPS}");
+    }
+    let space_ok = |v: f64| v.is_finite() && v > 0.0 && v <= 1e7;
+    if !(space_ok(args.width) && space_ok(args.height)) {
+        anyhow::bail!("--width and --height must be positive numbers up to 1e7");
+    }
+    let params = BoidParams {
+        r0: args.r0,
+        r1: args.r1,
+        r2: args.r2,
+        ..BoidParams::seed()
+    };
+    if let Some(why) = params.problem() {
+        anyhow::bail!("{why} (--r0, --r1, --r2)");
+    }
+    // Each system's lambdas at step 0 (the random start) and after every step.
+    let run = |rules: bool| -> (Vec<Lambdas>, Flock) {
+        let mut f = Flock::random(
+            args.agents,
+            args.width,
+            args.height,
+            params,
+            rules,
+            args.seed,
+        );
+        let mut out = Vec::with_capacity(args.steps + 1);
+        out.push(f.lambdas());
+        for _ in 0..args.steps {
+            f.step();
+            out.push(f.lambdas());
+        }
+        (out, f)
+    };
+    let (series, flock) = run(!args.no_rules);
+    let mut csv = String::from("step,lambda1,lambda2,lambda3\n");
+    for (i, l) in series.iter().enumerate() {
+        csv.push_str(&format!(
+            "{i},{:.6},{:.6},{:.6}\n",
+            l.lambda1, l.lambda2, l.lambda3
+        ));
+    }
+    match &args.csv {
+        Some(path) => edo_city::output::atomic::write_atomic(path, csv.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?,
+        None => print!("{csv}"),
+    }
+    if let Some(path) = &args.plot {
+        // Both systems from the same seed, as fig. 8 shows them.
+        let (boid_series, random_series) = match args.no_rules {
+            false => (series.clone(), run(false).0),
+            true => (run(true).0, series.clone()),
+        };
+        let pick = |s: &[Lambdas], k: usize| -> Vec<f64> {
+            s.iter()
+                .map(|l| [l.lambda1, l.lambda2, l.lambda3][k])
+                .collect()
+        };
+        let colours = [[200, 60, 40], [40, 110, 200], [40, 150, 70]];
+        let values: Vec<(String, [u8; 3], bool, Vec<f64>)> = (0..3)
+            .flat_map(|k| {
+                [
+                    (
+                        format!("B-lambda{}", k + 1),
+                        colours[k],
+                        false,
+                        pick(&boid_series, k),
+                    ),
+                    (
+                        format!("R-lambda{}", k + 1),
+                        colours[k],
+                        true,
+                        pick(&random_series, k),
+                    ),
+                ]
+            })
+            .collect();
+        let lines: Vec<edo_city::output::chart::Series> = values
+            .iter()
+            .map(|(label, rgb, dashed, v)| edo_city::output::chart::Series {
+                label,
+                rgb: *rgb,
+                dashed: *dashed,
+                values: v,
+            })
+            .collect();
+        let title = format!(
+            "lambda1-3, {} agents, seed {} (B: boids, R: random)",
+            args.agents, args.seed
+        );
+        let png = edo_city::output::chart::line_chart(&title, &lines, -1.0, 1.0)
+            .context("cannot draw the plot")?;
+        edo_city::output::atomic::write_atomic(path, &png)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(path) = &args.svg {
+        let svg = edo_city::output::chart::flock_svg(
+            &flock.boids,
+            args.width,
+            args.height,
+            args.r0,
+            args.r1,
+        );
+        edo_city::output::atomic::write_atomic(path, svg.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if args.csv.is_some() {
+        let tail = &series[series.len().saturating_sub(100)..];
+        let mean = |k: usize| {
+            tail.iter()
+                .map(|l| [l.lambda1, l.lambda2, l.lambda3][k])
+                .sum::<f64>()
+                / tail.len().max(1) as f64
+        };
+        say!(
+            "{} agents, {} steps ({}): mean over the last {} steps lambda1 {:.3}, lambda2 {:.3}, lambda3 {:.3}",
+            args.agents,
+            args.steps,
+            if args.no_rules { "random system" } else { "boids" },
+            tail.len(),
+            mean(0),
+            mean(1),
+            mean(2)
+        );
+    }
+    Ok(())
+}

@@ -5,6 +5,7 @@
 
 pub mod accounting;
 pub mod atomic;
+pub mod chart;
 pub mod lock;
 pub mod mtl;
 pub mod obj;

@@ -1,0 +1,8 @@
+//! The procedural growers: models that know nothing of GIS, lots or files. Each takes plain
+//! numbers and a seed and returns positions, skeletons or layouts; the city side of each
+//! (where it goes, what it is given) is in `analyse/`, its meshes in `generate/`.
+//!
+//! - [`boids`]: crowds by the boids of Reynolds with the three zones of Oyama et al.
+//!   (seed 004), measured by their order parameters lambda1-3.
+
+pub mod boids;
