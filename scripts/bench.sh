@@ -39,7 +39,7 @@ build 120000 1
 
 echo "== the limit: raw fixed-point write of the same bytes (30,052 lots)"
 bytes=$(du -sb --apparent-size "$work/out-30052/tiles" | cut -f1)
-raw=$(target/release/examples/raw_write "$bytes" "$work/raw.obj")
+raw=$(${CARGO_TARGET_DIR:-target}/release/examples/raw_write "$bytes" "$work/raw.obj")
 rm -f "$work/raw.obj"
 echo "tiles: $bytes bytes; raw write: $raw s ($(echo "$bytes / $raw / 1000000" | bc -l | cut -c1-6) MB/s)"
 
@@ -50,4 +50,12 @@ for i in $(seq 1 "$RUNS"); do
   $bin build "$work/town-30052" --out "$work/out-30052" --tiles "$tile" --quiet
   end=$(date +%s.%N)
   printf 'tile %s run %d: %.3f s\n' "$tile" "$i" "$(echo "$end - $start" | bc -l)"
+done
+
+echo "== the crowd model (edo-city boids, 100 steps, order parameters at every step)"
+for agents in 10 1000 10000; do
+  start=$(date +%s.%N)
+  $bin boids --agents "$agents" --steps 100 --width 5000 --height 3000 --csv "$work/boids.csv" > /dev/null
+  end=$(date +%s.%N)
+  printf '%6d agents: %.3f s for 100 steps\n' "$agents" "$(echo "$end - $start" | bc -l)"
 done
