@@ -648,6 +648,7 @@ fn input_summary(
     s.skipped.extend(plan.skipped.iter().cloned());
     s.warnings.extend(plan.warnings.iter().cloned());
     s.ledgers = output::accounting::ledgers(data);
+    s.crowds = plan.crowds.clone();
     // A skip that names only its feature gets its record, so the ledger closes after the
     // manifest's round trip too (`--tiles`, `merge`).
     for skip in s.skipped.iter_mut().filter(|k| k.record.is_none()) {

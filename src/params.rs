@@ -11,8 +11,10 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 mod billboards;
+mod crowd;
 mod partial;
 pub use billboards::{PeopleParams, PointsLayer, TreesParams};
+pub use crowd::CrowdParams;
 
 /// The default parameter file, shipped inside the binary.
 pub const DEFAULT_TOML: &str = include_str!("../params/default.toml");
@@ -83,6 +85,8 @@ pub struct Params {
     pub people: PeopleParams,
     /// Trees, section 4.4.
     pub trees: TreesParams,
+    /// Street crowds (`people.motion = "boids"`, seed 004).
+    pub crowd: CrowdParams,
     /// Relative weights of the machiya types drawn for lots of unknown type.
     pub type_mix: BTreeMap<String, f64>,
     /// Directory of textures that replace the shipped ones by file name (a texture set, as
@@ -637,6 +641,7 @@ impl Params {
         }
         self.people.validate().map_err(bad)?;
         self.trees.validate().map_err(bad)?;
+        self.crowd.validate().map_err(bad)?;
         Ok(())
     }
 }

@@ -15,7 +15,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("rng", &[]),
     // The procedural growers know nothing of GIS: plane geometry and the RNG only.
     ("growers", &["geom", "rng"]),
-    ("params", &["model"]),
+    ("params", &["model", "growers"]),
     ("templates", &["materials", "geom", "model"]),
     ("input", &["model", "geom", "params"]),
     (

@@ -209,7 +209,15 @@ pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, param
                 drawn.into_iter().flatten().collect()
             }
         };
-        let kept = thin(candidates, spacing);
+        let mut kept = thin(candidates, spacing);
+        if kind == BillboardKind::Person && given.is_none() && params.people.motion == "boids" {
+            let (walked, stats) =
+                super::crowds::walk(kept, data, params, &|c| near.at(c, None).1, &|c| {
+                    obstacles.hit(c, k.clearance)
+                });
+            kept = keep_spaced(walked, spacing);
+            plan.crowds = stats;
+        }
         let capped = cap_tiles(kept, &k, &mut plan.warnings);
         all.extend(capped.into_iter().map(|b| (b, given.is_some())));
     }
@@ -625,8 +633,13 @@ fn texture_of(raw: &str, textures: &[String]) -> Option<String> {
 /// order the points were made in.
 fn thin(mut points: Vec<Candidate>, spacing: f64) -> Vec<PlannedBillboard> {
     points.sort_by(|a, b| a.key.cmp(&b.key).then_with(|| a.b.id.cmp(&b.b.id)));
+    keep_spaced(points.into_iter().map(|c| c.b).collect(), spacing)
+}
+
+/// The points in the order given, each kept when no kept point is nearer than `spacing`.
+fn keep_spaced(points: Vec<PlannedBillboard>, spacing: f64) -> Vec<PlannedBillboard> {
     if spacing <= 0.0 {
-        return points.into_iter().map(|c| c.b).collect();
+        return points;
     }
     let cell = |c: Coord<f64>| {
         (
@@ -636,19 +649,19 @@ fn thin(mut points: Vec<Candidate>, spacing: f64) -> Vec<PlannedBillboard> {
     };
     let mut grid: HashMap<(i64, i64), Vec<Coord<f64>>> = HashMap::new();
     let mut kept = Vec::new();
-    for c in points {
-        let (i, j) = cell(c.b.at);
+    for b in points {
+        let (i, j) = cell(b.at);
         let crowded = (i - 1..=i + 1).any(|x| {
             (j - 1..=j + 1).any(|y| {
                 grid.get(&(x, y)).is_some_and(|v| {
                     v.iter()
-                        .any(|q| (q.x - c.b.at.x).hypot(q.y - c.b.at.y) < spacing)
+                        .any(|q| (q.x - b.at.x).hypot(q.y - b.at.y) < spacing)
                 })
             })
         });
         if !crowded {
-            grid.entry((i, j)).or_default().push(c.b.at);
-            kept.push(c.b);
+            grid.entry((i, j)).or_default().push(b.at);
+            kept.push(b);
         }
     }
     kept

@@ -2,6 +2,7 @@
 //! frontage, type and tile. No I/O; every random choice through [`crate::rng`].
 
 pub mod billboards;
+pub mod crowds;
 pub mod fences;
 pub mod frontage;
 pub mod house;

@@ -4,6 +4,7 @@
 //! here (and not inside a stage) lets the stages depend on the data, never on each other:
 //! `model` depends on nothing of ours.
 
+pub mod crowd;
 pub mod dem;
 pub mod tile;
 pub mod warning;
@@ -291,6 +292,7 @@ impl Frontage {
 }
 
 /// A tile id `<col>_<row>` on the fixed grid.
+pub use crowd::{CrowdStat, MeanLambdas};
 pub use tile::TileId;
 pub use warning::{Warning, WarningClass};
 
@@ -541,6 +543,8 @@ pub struct Plan {
     /// People and trees per tile, only in tiles of `tiles`; people first, each kind in a
     /// fixed order.
     pub billboards: BTreeMap<TileId, Vec<PlannedBillboard>>,
+    /// The street crowds' order parameters, per street stretch (`people.motion = "boids"`).
+    pub crowds: Vec<CrowdStat>,
 }
 
 /// What generation found in one tile.

@@ -179,8 +179,76 @@ pub struct Report {
     /// Per layer: records read, built, skipped, and unaccounted (always 0; see
     /// [`super::accounting`]).
     pub accounting: Vec<super::accounting::Account>,
+    /// The street crowds, per street stretch and per district (`people.motion = "boids"`).
+    #[serde(skip_serializing_if = "Crowds::is_empty")]
+    pub crowds: Crowds,
     /// Per tile: houses and bytes.
     pub tiles: Vec<TileReport>,
+}
+
+/// The street crowds of a build: how busy and how grouped each street is (seed 004).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Crowds {
+    /// Per street stretch, in street order.
+    pub streets: Vec<crate::model::CrowdStat>,
+    /// Per district ("" = none): walkers, and each lambda averaged over its stretches
+    /// weighted by their walkers.
+    pub by_district: BTreeMap<String, DistrictCrowd>,
+}
+
+impl Crowds {
+    /// Whether the build walked no crowd (then report.json leaves the key out).
+    pub fn is_empty(&self) -> bool {
+        self.streets.is_empty()
+    }
+
+    /// The report of the stretches' statistics.
+    fn of(streets: &[crate::model::CrowdStat]) -> Crowds {
+        let mut by_district: BTreeMap<String, DistrictCrowd> = BTreeMap::new();
+        for s in streets {
+            let d = by_district
+                .entry(s.district.clone().unwrap_or_default())
+                .or_default();
+            let w = s.agents as f64;
+            d.agents += s.agents;
+            d.lambda1 += w * s.lambda1;
+            d.lambda2 += w * s.lambda2;
+            d.lambda3 += w * s.lambda3;
+            d.mean.lambda1 += w * s.mean.lambda1;
+            d.mean.lambda2 += w * s.mean.lambda2;
+            d.mean.lambda3 += w * s.mean.lambda3;
+        }
+        // Four decimals, as Table 2's ratios: stable bytes and readable.
+        let r = |v: f64, n: usize| (v / n.max(1) as f64 * 10_000.0).round() / 10_000.0;
+        for d in by_district.values_mut() {
+            let n = d.agents;
+            d.lambda1 = r(d.lambda1, n);
+            d.lambda2 = r(d.lambda2, n);
+            d.lambda3 = r(d.lambda3, n);
+            d.mean.lambda1 = r(d.mean.lambda1, n);
+            d.mean.lambda2 = r(d.mean.lambda2, n);
+            d.mean.lambda3 = r(d.mean.lambda3, n);
+        }
+        Crowds {
+            streets: streets.to_vec(),
+            by_district,
+        }
+    }
+}
+
+/// One district's crowds.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct DistrictCrowd {
+    /// Walkers simulated in the district.
+    pub agents: usize,
+    /// lambda1 after the last step, weighted by walkers.
+    pub lambda1: f64,
+    /// lambda2 after the last step.
+    pub lambda2: f64,
+    /// lambda3 after the last step.
+    pub lambda3: f64,
+    /// The same averaged over the last steps.
+    pub mean: crate::model::MeanLambdas,
 }
 
 /// One tile of the report.
@@ -226,6 +294,9 @@ pub struct InputSummary {
     /// What each layer's records became in reading and analysis, closed in the report.
     #[serde(default)]
     pub ledgers: Vec<super::accounting::Ledger>,
+    /// The street crowds' order parameters (`people.motion = "boids"`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub crowds: Vec<crate::model::CrowdStat>,
 }
 
 /// manifest.json, written last: what the build is (tool, parameters, input, frame) and
@@ -359,6 +430,7 @@ pub fn assemble_report(m: &Manifest) -> Report {
     c.tiles = m.tiles.len();
     c.skipped = r.skipped.len();
     r.accounting = super::accounting::close(&i.ledgers, &r.skipped, &mut r.warnings);
+    r.crowds = Crowds::of(&i.crowds);
     for s in &r.skipped {
         *r.skipped_by_reason
             .entry(reason_class(&s.reason))

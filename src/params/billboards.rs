@@ -48,6 +48,9 @@ pub struct PeopleParams {
     pub textures: Vec<String>,
     /// More points than this in one tile are thinned to it, with a warning.
     pub max_points_per_tile: usize,
+    /// `scatter`: people stand where the Poisson process put them (section 4.4); `boids`:
+    /// they start there and walk as a crowd for `crowd.steps` (seed 004, `[crowd]`).
+    pub motion: String,
 }
 
 /// Trees (ki 木): two crossed alpha-textured quads each, in estates and back gardens.
@@ -98,6 +101,12 @@ impl PeopleParams {
             &self.textures,
             self.max_points_per_tile,
         )?;
+        if !["scatter", "boids"].contains(&self.motion.as_str()) {
+            return Err(format!(
+                "`people.motion` must be \"scatter\" or \"boids\", got \"{}\"",
+                self.motion
+            ));
+        }
         if !(0.0..=180.0).contains(&self.max_turn_deg) {
             return Err(format!(
                 "`people.max_turn_deg` must be in [0, 180], got {}",
@@ -181,6 +190,7 @@ pub(super) mod partial {
         per_100m: Option<f64>,
         height: Option<[f64; 2]>,
         max_turn_deg: Option<f64>,
+        motion: Option<String>,
         edge_margin: Option<f64>,
         min_spacing: Option<f64>,
         clearance: Option<f64>,

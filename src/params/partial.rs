@@ -24,6 +24,7 @@ pub struct Params {
     fence: Option<Fence>,
     people: Option<super::billboards::partial::People>,
     trees: Option<super::billboards::partial::Trees>,
+    crowd: Option<super::crowd::partial::Crowd>,
     type_mix: Option<BTreeMap<String, f64>>,
     textures: Option<String>,
     terrain: Option<bool>,
