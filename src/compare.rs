@@ -70,10 +70,52 @@ pub struct Comparison {
     pub table2: Vec<Row>,
     /// The tiles that changed.
     pub tiles: TileDiff,
+    /// The street crowds per district (`people.motion = "boids"`): walkers and the mean
+    /// lambda1-3 over the last steps, in each build.
+    pub crowds: Vec<CrowdRow>,
     /// Why the two builds' tiles are not the same places (another tile size, tile origin or
     /// CRS), when they are not: then a tile id names other ground in each.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grids_differ: Option<String>,
+}
+
+/// One district's crowd in both builds.
+#[derive(Debug, Clone, Serialize)]
+pub struct CrowdRow {
+    /// The district ("" = none).
+    pub district: String,
+    /// Walkers in build A and in build B.
+    pub agents: [usize; 2],
+    /// Mean lambda1 over the last steps, A and B.
+    pub lambda1: [f64; 2],
+    /// Mean lambda2, A and B.
+    pub lambda2: [f64; 2],
+    /// Mean lambda3, A and B.
+    pub lambda3: [f64; 2],
+}
+
+/// The crowd rows of two reports, every district either has.
+fn crowd_rows(
+    a: &crate::output::report::Crowds,
+    b: &crate::output::report::Crowds,
+) -> Vec<CrowdRow> {
+    let names: BTreeSet<&String> = a.by_district.keys().chain(b.by_district.keys()).collect();
+    names
+        .into_iter()
+        .map(|d| {
+            let (x, y) = (a.by_district.get(d), b.by_district.get(d));
+            let m = |c: Option<&crate::output::report::DistrictCrowd>, k: usize| {
+                c.map_or(0.0, |c| [c.mean.lambda1, c.mean.lambda2, c.mean.lambda3][k])
+            };
+            CrowdRow {
+                district: d.clone(),
+                agents: [x.map_or(0, |c| c.agents), y.map_or(0, |c| c.agents)],
+                lambda1: [m(x, 0), m(y, 0)],
+                lambda2: [m(x, 1), m(y, 1)],
+                lambda3: [m(x, 2), m(y, 2)],
+            }
+        })
+        .collect()
 }
 
 /// Why two builds' tile grids differ, if they do.
@@ -230,6 +272,7 @@ pub fn compare(dir_a: &Path, dir_b: &Path) -> Result<Comparison, BuildError> {
             .collect()
         },
         tiles,
+        crowds: crowd_rows(&ra.crowds, &rb.crowds),
         grids_differ: grids_differ(&ma, &mb),
     })
 }
@@ -257,6 +300,28 @@ pub fn render(c: &Comparison) -> String {
     table(&mut s, "machiya by type", &c.by_type);
     table(&mut s, "houses by district", &c.by_district);
     table(&mut s, "kura (Table 2)", &c.table2);
+    if !c.crowds.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n{:<24} {:>13} {:>15} {:>15} {:>15}",
+            "crowds (mean, last steps)", "walkers A/B", "lambda1 A/B", "lambda2 A/B", "lambda3 A/B"
+        );
+        for r in &c.crowds {
+            let _ = writeln!(
+                s,
+                "  {:<22} {:>6}/{:<6} {:>7.3}/{:<7.3} {:>7.3}/{:<7.3} {:>7.3}/{:<7.3}",
+                r.district,
+                r.agents[0],
+                r.agents[1],
+                r.lambda1[0],
+                r.lambda1[1],
+                r.lambda2[0],
+                r.lambda2[1],
+                r.lambda3[0],
+                r.lambda3[1]
+            );
+        }
+    }
     let t = &c.tiles;
     let list = |v: &[String]| {
         if v.is_empty() {

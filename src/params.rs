@@ -126,6 +126,10 @@ pub struct DistrictParams {
     /// Trees per hectare of open town-lot backs here, replacing `trees.per_ha_machiya`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trees_per_ha_machiya: Option<f64>,
+    /// How this district's people move, replacing `people.motion` there (`scatter` or
+    /// `boids`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub people_motion: Option<String>,
 }
 
 impl Params {
@@ -148,6 +152,16 @@ impl Params {
             .and_then(|d| self.district.get(d))
             .and_then(pick)
             .unwrap_or(default)
+    }
+
+    /// Whether the people of `district` walk as a crowd (`people.motion`, or the district's
+    /// `people_motion`).
+    pub fn crowd_walks(&self, district: Option<&str>) -> bool {
+        district
+            .and_then(|d| self.district.get(d))
+            .and_then(|d| d.people_motion.as_deref())
+            .unwrap_or(&self.people.motion)
+            == "boids"
     }
 
     /// `[district.<id>.template...]` of every district, as the catalog takes them.
@@ -637,6 +651,17 @@ impl Params {
                         "`district.{id}.{key}` must be from 0 to {high}, got {v}"
                     )));
                 }
+            }
+        }
+        for (id, d) in &self.district {
+            if let Some(m) = d
+                .people_motion
+                .as_deref()
+                .filter(|m| !["scatter", "boids"].contains(m))
+            {
+                return Err(bad(format!(
+                    "`district.{id}.people_motion` must be \"scatter\" or \"boids\", got \"{m}\""
+                )));
             }
         }
         self.people.validate().map_err(bad)?;

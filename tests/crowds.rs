@@ -174,3 +174,84 @@ fn crowds_are_byte_identical_for_any_thread_count_and_for_single_tiles() {
     );
     assert_eq!(tiles(&a), before, "the tile regenerated alone is the same");
 }
+
+#[test]
+fn a_district_that_scatters_keeps_its_people_where_the_process_put_them() {
+    let dir = tempfile::tempdir().unwrap();
+    synth(dir.path(), 1500, 5);
+    let text = "[people]\nmotion = \"boids\"\nper_100m = 12.0\n[district.\"中京\"]\npeople_motion = \"scatter\"\n";
+    let mixed = Params::from_toml_str(text, "mixed.toml").unwrap();
+    let scatter = Params::from_toml_str("[people]\nper_100m = 12.0\n", "scatter.toml").unwrap();
+    let (_, walkers) = people(dir.path(), &mixed);
+    let (_, scattered) = people(dir.path(), &scatter);
+    let still = |w: &PlannedBillboard| scattered.iter().any(|s| s.id == w.id && s.at == w.at);
+    let central: Vec<_> = walkers
+        .iter()
+        .filter(|w| w.district.as_deref() == Some("中京"))
+        .collect();
+    let others: Vec<_> = walkers
+        .iter()
+        .filter(|w| w.district.as_deref() != Some("中京"))
+        .collect();
+    assert!(!central.is_empty() && !others.is_empty());
+    assert!(central.iter().all(|w| still(w)), "中京 scatters");
+    assert!(
+        others.iter().filter(|w| still(w)).count() * 2 < others.len(),
+        "the rest walk"
+    );
+    // A misspelt motion is refused naming the key.
+    let e = Params::from_toml_str("[district.x]\npeople_motion = \"flock\"\n", "bad.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("district.x.people_motion"), "{e}");
+}
+
+#[test]
+fn compare_shows_the_crowds_of_two_hypotheses_side_by_side() {
+    let dir = tempfile::tempdir().unwrap();
+    let busy = dir.path().join("busy.toml");
+    std::fs::write(&busy, "[people]\nmotion = \"boids\"\nper_100m = 20.0\n").unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    build_ok(
+        &fixture("kyoto-small"),
+        &a,
+        &[
+            "--quiet",
+            "--no-plan",
+            "--params",
+            &boids_params(dir.path()),
+        ],
+    );
+    build_ok(
+        &fixture("kyoto-small"),
+        &b,
+        &["--quiet", "--no-plan", "--params", busy.to_str().unwrap()],
+    );
+    let o = common::edo_city()
+        .arg("compare")
+        .arg(&a)
+        .arg(&b)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let c: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rows = c["crowds"].as_array().unwrap();
+    assert!(!rows.is_empty());
+    let walkers = |k: usize| {
+        rows.iter()
+            .map(|r| r["agents"][k].as_u64().unwrap())
+            .sum::<u64>()
+    };
+    assert!(
+        walkers(1) > walkers(0),
+        "20 per 100 m walk more than 12: {rows:?}"
+    );
+    let text = common::edo_city()
+        .arg("compare")
+        .arg(&a)
+        .arg(&b)
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&text.stdout).contains("crowds (mean, last steps)"));
+}

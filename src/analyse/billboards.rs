@@ -210,7 +210,9 @@ pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, param
             }
         };
         let mut kept = thin(candidates, spacing);
-        if kind == BillboardKind::Person && given.is_none() && params.people.motion == "boids" {
+        let walks = |d: Option<&str>| params.crowd_walks(d);
+        let any_walk = walks(None) || params.district.keys().any(|d| walks(Some(d)));
+        if kind == BillboardKind::Person && given.is_none() && any_walk {
             let (walked, stats) =
                 super::crowds::walk(kept, data, params, &|c| near.at(c, None).1, &|c| {
                     obstacles.hit(c, k.clearance)

@@ -85,7 +85,9 @@ pub fn walk(
     let mut order: Vec<(String, usize)> = Vec::with_capacity(people.len());
     let mut alone = Vec::new();
     for b in people {
-        match stretch_of(&b.id).filter(|s| streets.contains_key(s)) {
+        // A district that scatters its people keeps them where they stand.
+        let walking = p.crowd_walks(b.district.as_deref());
+        match stretch_of(&b.id).filter(|s| walking && streets.contains_key(s)) {
             Some(s) => {
                 let g = groups.entry(s.clone()).or_default();
                 order.push((s, g.len()));
@@ -150,7 +152,10 @@ fn walk_stretch(
             }
         })
         .collect();
-    let seed = crate::rng::feature_rng(p.seed, "crowd", id).random::<u64>();
+    let mut rng = crate::rng::feature_rng(p.seed, "crowd", id);
+    let seed = rng.random::<u64>();
+    let mut boids = boids;
+    set_out_in_groups(&mut boids, p.crowd.group, &mut rng);
     let mut flock = Flock::from_boids(boids, s.len, 2.0 * s.half, model, true, seed);
     let steps = p.crowd.steps;
     let last = p.crowd.last_steps.min(steps);
@@ -171,7 +176,10 @@ fn walk_stretch(
     } = flock.lambdas();
     let stat = CrowdStat {
         street: id.to_string(),
-        district: group[0].district.clone(),
+        districts: group.iter().fold(BTreeMap::new(), |mut m, b| {
+            *m.entry(b.district.clone().unwrap_or_default()).or_default() += 1;
+            m
+        }),
         agents: group.len(),
         lambda1,
         lambda2,
@@ -196,6 +204,20 @@ fn walk_stretch(
     (moved, Some(stat))
 }
 
+/// Groups of a size drawn from `[smallest, largest]`, neighbours in the process's order,
+/// each member turned the way the group's first faces.
+fn set_out_in_groups(boids: &mut [Boid], size: [usize; 2], rng: &mut impl rand::Rng) {
+    let mut i = 0;
+    while i < boids.len() {
+        let n = rng.random_range(size[0]..=size[1]).max(1);
+        let heading = boids[i].heading;
+        for b in boids.iter_mut().skip(i).take(n) {
+            b.heading = heading;
+        }
+        i += n;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -204,5 +226,21 @@ mod tests {
     fn a_person_belongs_to_the_stretch_its_id_begins_with() {
         assert_eq!(stretch_of("12/3/4/5").as_deref(), Some("12/3"));
         assert_eq!(stretch_of("12"), None);
+    }
+
+    #[test]
+    fn groups_set_out_the_way_their_first_member_faces() {
+        let b = |a: f64| Boid {
+            pos: [0.0, 0.0],
+            heading: [a.cos(), a.sin()],
+            speed: 1.0,
+        };
+        let mut boids: Vec<Boid> = (0..10).map(|i| b(i as f64)).collect();
+        let mut rng = crate::rng::feature_rng(1, "t", "groups");
+        set_out_in_groups(&mut boids, [3, 3], &mut rng);
+        for g in boids.chunks(3) {
+            assert!(g.iter().all(|x| x.heading == g[0].heading));
+        }
+        assert_ne!(boids[0].heading, boids[3].heading);
     }
 }

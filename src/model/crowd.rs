@@ -7,9 +7,8 @@ use serde::{Deserialize, Serialize};
 pub struct CrowdStat {
     /// The stretch: `<street id>/<n>`, the n-th straight piece of the street's centreline.
     pub street: String,
-    /// The district of its first walker.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub district: Option<String>,
+    /// Its walkers per district ("" = none): a stretch may cross a district's border.
+    pub districts: std::collections::BTreeMap<String, usize>,
     /// Walkers simulated.
     pub agents: usize,
     /// lambda1 after the last step.

@@ -205,12 +205,14 @@ impl Crowds {
     /// The report of the stretches' statistics.
     fn of(streets: &[crate::model::CrowdStat]) -> Crowds {
         let mut by_district: BTreeMap<String, DistrictCrowd> = BTreeMap::new();
-        for s in streets {
-            let d = by_district
-                .entry(s.district.clone().unwrap_or_default())
-                .or_default();
-            let w = s.agents as f64;
-            d.agents += s.agents;
+        // Each stretch counts in every district it has walkers in, by their number.
+        for (s, (district, n)) in streets
+            .iter()
+            .flat_map(|s| s.districts.iter().map(move |d| (s, d)))
+        {
+            let d = by_district.entry(district.clone()).or_default();
+            let w = *n as f64;
+            d.agents += n;
             d.lambda1 += w * s.lambda1;
             d.lambda2 += w * s.lambda2;
             d.lambda3 += w * s.lambda3;

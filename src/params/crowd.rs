@@ -26,6 +26,10 @@ pub struct CrowdParams {
     pub weights: [f64; 3],
     /// Largest random turn per second of a person with nobody near (radians).
     pub wander: f64,
+    /// People set out in groups of a size drawn uniformly from [smallest, largest]: the
+    /// members of a group (neighbours in the process's order) start out the way the first
+    /// of them faces.
+    pub group: [usize; 2],
 }
 
 /// The most steps a build simulates per street (a typo of 1e9 steps would run for days).
@@ -55,6 +59,13 @@ impl CrowdParams {
         if self.r2 > 100.0 || self.speed[1] > 20.0 || self.dt > 60.0 {
             return Err("`[crowd]`: r2 up to 100 m, speeds up to 20 m/s and dt up to 60 s".into());
         }
+        if self.group[0] == 0 || self.group[0] > self.group[1] || self.group[1] > 100 {
+            return Err(format!(
+                "`crowd.group` must be [smallest, largest] with 1 <= smallest <= largest <= \
+                 100, got [{}, {}]",
+                self.group[0], self.group[1]
+            ));
+        }
         if self.steps > MAX_STEPS || self.last_steps > self.steps.max(1) {
             return Err(format!(
                 "`crowd.steps` must be at most {MAX_STEPS} and `crowd.last_steps` at most \
@@ -83,5 +94,6 @@ pub(super) mod partial {
         last_steps: Option<usize>,
         weights: Option<[f64; 3]>,
         wander: Option<f64>,
+        group: Option<[usize; 2]>,
     }
 }

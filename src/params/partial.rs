@@ -40,6 +40,7 @@ struct District {
     people_per_100m: Option<f64>,
     trees_per_ha: Option<f64>,
     trees_per_ha_machiya: Option<f64>,
+    people_motion: Option<String>,
 }
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
