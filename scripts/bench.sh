@@ -59,3 +59,10 @@ for agents in 10 1000 10000; do
   end=$(date +%s.%N)
   printf '%6d agents: %.3f s for 100 steps\n' "$agents" "$(echo "$end - $start" | bc -l)"
 done
+
+echo "== street crowds in the city (30,052 lots, people.motion = \"boids\"; compare the people and trees figure with the default runs above)"
+printf '[people]\nmotion = "boids"\n' > "$work/boids.toml"
+for i in $(seq 1 "$RUNS"); do
+  $bin build "$work/town-30052" --out "$work/out-boids" --params "$work/boids.toml" --quiet --force --timings 2>&1 \
+    | sed -n "s/^timings: /run $i: /p"
+done
