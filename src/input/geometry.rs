@@ -132,15 +132,18 @@ fn organise_rings(rings: Vec<Vec<Coord<f64>>>) -> (Vec<Polygon<f64>>, usize) {
             .filter(|&i| !wound_outer[i] && holder[i].is_none() && signed[i] != 0.0)
             .count(),
     };
+    let outer: Vec<bool> = (0..n).map(is_outer).collect();
+    let mut rings: Vec<Option<Vec<Coord<f64>>>> = rings.into_iter().map(Some).collect();
     let mut slot = vec![usize::MAX; n];
     let mut polygons: Vec<Polygon<f64>> = Vec::new();
-    for i in (0..n).filter(|&i| is_outer(i)) {
+    for i in (0..n).filter(|&i| outer[i]) {
         slot[i] = polygons.len();
-        polygons.push(Polygon::new(LineString(rings[i].clone()), vec![]));
+        let ring = rings[i].take().unwrap_or_default();
+        polygons.push(Polygon::new(LineString(ring), vec![]));
     }
-    for i in (0..n).filter(|&i| !is_outer(i)) {
-        if let Some(j) = holder[i] {
-            polygons[slot[j]].interiors_push(LineString(rings[i].clone()));
+    for i in (0..n).filter(|&i| !outer[i]) {
+        if let (Some(j), Some(ring)) = (holder[i], rings[i].take()) {
+            polygons[slot[j]].interiors_push(LineString(ring));
         }
     }
     // geo's orient compares coordinates with partial_cmp().unwrap(): a NaN would panic, so

@@ -74,21 +74,28 @@ fn sidecar(path: &Path) -> Result<Option<String>, String> {
 }
 
 /// The deletion flag of every record of a DBF, read from the file itself (byte 0 of each
-/// record is `*` for deleted, ` ` for live).
+/// record is `*` for deleted, ` ` for live), streamed a record at a time: a million-record
+/// DBF is not held in memory a second time.
 fn deletion_flags(path: &Path) -> std::io::Result<Vec<bool>> {
-    let bytes = std::fs::read(path)?;
-    if bytes.len() < 12 {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut f = BufReader::new(File::open(path)?);
+    let mut head = [0u8; 12];
+    if f.read_exact(&mut head).is_err() {
         return Ok(Vec::new());
     }
-    let n = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]) as usize;
-    let header = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let len = u16::from_le_bytes([bytes[10], bytes[11]]) as usize;
+    let n = u32::from_le_bytes([head[4], head[5], head[6], head[7]]) as usize;
+    let header = u16::from_le_bytes([head[8], head[9]]) as u64;
+    let len = u16::from_le_bytes([head[10], head[11]]) as usize;
     if len == 0 {
         return Ok(Vec::new());
     }
-    Ok((0..n)
-        .map_while(|i| bytes.get(header + i * len).map(|b| *b == b'*'))
-        .collect())
+    f.seek(SeekFrom::Start(header))?;
+    let mut record = vec![0u8; len];
+    let mut flags = Vec::with_capacity(n.min(1 << 24));
+    while flags.len() < n && f.read_exact(&mut record).is_ok() {
+        flags.push(record[0] == b'*');
+    }
+    Ok(flags)
 }
 
 /// Maps a code page name (from a `.cpg` or the parameter file) to an encoding.
