@@ -294,8 +294,12 @@ fn run(
     // run at a time in the directory, and never a second hypothesis in it.
     let existed = opts.out.exists();
     std::fs::create_dir_all(&opts.out).map_err(|e| write_err(&opts.out, e))?;
-    let lock =
-        output::lock::OutLock::acquire(&opts.out).map_err(|e| BuildError::Config(e.to_string()))?;
+    let lock = output::lock::OutLock::acquire(&opts.out).map_err(|e| {
+        if !existed {
+            let _ = std::fs::remove_dir(&opts.out);
+        }
+        BuildError::Config(e.to_string())
+    })?;
     let written = shards::check_out_dir(opts)
         .and_then(|()| shards::refuse_empty(opts, &plan))
         .and_then(|()| {

@@ -404,7 +404,11 @@ fn difference(first: &Manifest, m: &Manifest) -> Option<String> {
         ..s.clone()
     };
     if strip(&first.input) != strip(&m.input) {
-        return Some("what was read from the input differs".into());
+        return Some(
+            "what was read from the input differs (its layers, counts or skips, or the input \
+             path as typed, which names the layer files: give every shard the same input path)"
+                .into(),
+        );
     }
     (first.origin != m.origin).then(|| "the origin differs".into())
 }
