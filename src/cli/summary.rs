@@ -201,8 +201,8 @@ pub fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<(
     Ok(())
 }
 
-/// The paper's Table 2 beside this build's figures.
-/// People and trees: how many, from where, and per district when there are districts.
+/// People and trees: how many, from where, and per district when there are districts; the
+/// street crowds' order parameters when the people walked.
 fn print_billboards(r: &edo_city::output::report::Report) -> std::io::Result<()> {
     let c = &r.counts;
     for (name, n, by_district, drawn) in [
@@ -227,9 +227,32 @@ fn print_billboards(r: &edo_city::output::report::Report) -> std::io::Result<()>
         };
         say!("  {name:<10} {n:>7}  ({source}{districts})");
     }
+    let crowds = &r.crowds;
+    if !crowds.streets.is_empty() {
+        let walkers: usize = crowds.streets.iter().map(|s| s.agents).sum();
+        let list: Vec<String> = crowds
+            .by_district
+            .iter()
+            .map(|(d, c)| {
+                format!(
+                    "{} lambda1 {:.3} lambda2 {:.3} lambda3 {:.3}",
+                    if d.is_empty() { "(none)" } else { d },
+                    c.mean.lambda1,
+                    c.mean.lambda2,
+                    c.mean.lambda3
+                )
+            })
+            .collect();
+        say!(
+            "  crowds     {walkers:>7}  walked on {} street stretches (means of the last steps: {})",
+            crowds.streets.len(),
+            list.join("; ")
+        );
+    }
     Ok(())
 }
 
+/// The paper's Table 2 beside this build's figures.
 fn print_table2(
     r: &edo_city::output::report::Report,
     enabled: bool,
