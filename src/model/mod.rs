@@ -323,7 +323,8 @@ impl PlannedHouse {
     }
 }
 
-/// A machiya lot after analysis: everything generation needs, nothing more.
+/// A house after analysis (a machiya on its lot, or a building of a footprint layer):
+/// everything generation needs, nothing more.
 #[derive(Debug, Clone)]
 pub struct PlannedHouse {
     /// The lot's or footprint's id.
