@@ -104,17 +104,25 @@ fn organise_rings(rings: Vec<Vec<Coord<f64>>>) -> (Vec<Polygon<f64>>, usize) {
                     .flatten()
             })
             .collect();
+        // Each outer ring as a polygon once, for the point-in-ring tests of every hole.
+        let shells: Vec<Option<Polygon<f64>>> = (0..n)
+            .map(|j| {
+                (wound_outer[j] && boxes[j].is_some())
+                    .then(|| Polygon::new(LineString(rings[j].clone()), vec![]))
+            })
+            .collect();
         for i in (0..n).filter(|&i| !wound_outer[i]) {
             let Some(bi) = boxes[i] else { continue };
             holder[i] = (0..n)
-                .filter(|&j| wound_outer[j] && j != i)
+                .filter(|&j| j != i)
                 .filter(|&j| {
-                    let Some(bj) = boxes[j] else { return false };
+                    let (Some(bj), Some(shell)) = (boxes[j], &shells[j]) else {
+                        return false;
+                    };
                     let in_box = bj.min().x <= bi.min().x
                         && bj.min().y <= bi.min().y
                         && bj.max().x >= bi.max().x
                         && bj.max().y >= bi.max().y;
-                    let shell = Polygon::new(LineString(rings[j].clone()), vec![]);
                     in_box
                         && rings[i]
                             .iter()

@@ -197,10 +197,10 @@ struct Layers {
 }
 
 impl Layers {
-    /// Opens every role's layer (see [`open`]).
-    fn open(dir: &Path, params: &Params) -> Result<Layers, InputError> {
-        let defaults = Params::default();
-        let (l, d) = (&params.layers, &defaults.layers);
+    /// Opens every role's layer (see [`open`]); `d` are the default layers, whose files an
+    /// optional role may lack.
+    fn open(dir: &Path, params: &Params, d: &crate::params::Layers) -> Result<Layers, InputError> {
+        let l = &params.layers;
         // (role, file, encoding, the default file: an optional role's is allowed to be absent)
         let role = |role, file: &str, encoding: &str, default: &str| {
             open(dir, role, file, encoding, default)
@@ -308,8 +308,9 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         )));
     }
     let l = &params.layers;
-    let dl = &Params::default().layers;
-    let mut layers = Layers::open(dir, params)?;
+    let defaults = Params::default();
+    let dl = &defaults.layers;
+    let mut layers = Layers::open(dir, params, dl)?;
     let mut data = Dataset::default();
     let target = {
         let mut all: Vec<&mut Opened> = layers.all_mut().collect();
