@@ -5,6 +5,17 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// What the two middle stages, analyse and generate, may name.
+const STAGE: &[&str] = &[
+    "model",
+    "geom",
+    "params",
+    "templates",
+    "rng",
+    "materials",
+    "growers",
+];
+
 /// Every crate-level module and the modules of ours it may depend on. The pipeline reads in
 /// one direction: read inputs -> analyse -> generate -> write outputs, over `model` (plain
 /// data) and `geom` (plane geometry); `materials` and `rng` are libraries every stage may use.
@@ -18,30 +29,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("params", &["model", "growers"]),
     ("templates", &["materials", "geom", "model"]),
     ("input", &["model", "geom", "params"]),
-    (
-        "analyse",
-        &[
-            "model",
-            "geom",
-            "params",
-            "templates",
-            "rng",
-            "materials",
-            "growers",
-        ],
-    ),
-    (
-        "generate",
-        &[
-            "model",
-            "geom",
-            "params",
-            "templates",
-            "rng",
-            "materials",
-            "growers",
-        ],
-    ),
+    ("analyse", STAGE),
+    ("generate", STAGE),
     (
         "output",
         &[

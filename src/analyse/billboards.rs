@@ -349,7 +349,7 @@ fn street_sources<'a>(data: &'a Dataset, near: &Surroundings<'a>, p: &Params) ->
                 let density =
                     p.district_density(district, |d| d.people_per_100m, p.people.per_100m);
                 out.push(Source {
-                    id: format!("{}/{}/{}", s.id, k + 1, j + 1),
+                    id: format!("{}/{}", super::crowds::stretch_id(&s.id, k), j + 1),
                     tiles: vec![(tile_id(mid, p.tile_size, p.tile_origin), 1.0)],
                     district,
                     expected: len / pieces as f64 / 100.0 * density,

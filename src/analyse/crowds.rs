@@ -41,7 +41,13 @@ impl Stretch {
     }
 }
 
-/// Every stretch of every street, by `<street id>/<n>` (the people's ids begin so).
+/// The id of the `k`-th (from 0) straight stretch of a street: `<street id>/<k + 1>`. The
+/// people drawn on it have ids that begin so (`billboards::street_sources`).
+pub(super) fn stretch_id(street: &str, k: usize) -> String {
+    format!("{street}/{}", k + 1)
+}
+
+/// Every stretch of every street, by [`stretch_id`].
 fn stretches(data: &Dataset, p: &Params) -> BTreeMap<String, Stretch> {
     let mut out = BTreeMap::new();
     for s in &data.streets {
@@ -50,7 +56,7 @@ fn stretches(data: &Dataset, p: &Params) -> BTreeMap<String, Stretch> {
             let len = d.x.hypot(d.y);
             if len > 0.0 && len.is_finite() {
                 out.insert(
-                    format!("{}/{}", s.id, k + 1),
+                    stretch_id(&s.id, k),
                     Stretch {
                         a: line.start,
                         u: d / len,

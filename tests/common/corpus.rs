@@ -128,6 +128,14 @@ fn points(dir: &Path, file: &str, pts: &[(&str, [f64; 2])]) {
     std::fs::write(dir.join(file).with_extension("prj"), PRJ).unwrap();
 }
 
+/// A workbook with a fixed creation time, so the file is the same every time it is made.
+pub(super) fn workbook() -> rust_xlsxwriter::Workbook {
+    let mut book = rust_xlsxwriter::Workbook::new();
+    let date = rust_xlsxwriter::ExcelDateTime::from_ymd(2000, 1, 1).unwrap();
+    book.set_properties(&rust_xlsxwriter::DocProperties::new().set_creation_datetime(&date));
+    book
+}
+
 /// One case: its name, how to make its input, and its `expect.toml`.
 pub struct Case {
     pub name: &'static str,
@@ -199,12 +207,7 @@ fn base_cases() -> Vec<Case> {
             name: "xlsx_without_the_sheet",
             make: |d| {
                 good_town(d);
-                let mut book = rust_xlsxwriter::Workbook::new();
-                // A fixed creation time, so the file is the same every time it is made.
-                let date = rust_xlsxwriter::ExcelDateTime::from_ymd(2000, 1, 1).unwrap();
-                book.set_properties(
-                    &rust_xlsxwriter::DocProperties::new().set_creation_datetime(&date),
-                );
+                let mut book = workbook();
                 let sheet = book.add_worksheet().set_name("Sheet1").unwrap();
                 sheet.write(0, 0, "id").unwrap();
                 sheet.write(0, 1, "mtype").unwrap();

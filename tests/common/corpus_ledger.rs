@@ -8,7 +8,8 @@ use dbase::{FieldValue, Record, TableWriterBuilder};
 use shapefile::{Point, PointZ, Polygon, PolygonRing, PolygonZ, NO_DATA};
 
 use super::corpus::{
-    good_lots, good_town, name, ring, strip, town_with, write_lots, write_street, Case, PRJ,
+    good_lots, good_town, name, ring, strip, town_with, workbook, write_lots, write_street, Case,
+    PRJ,
 };
 
 /// Turns the last record of a `.shp` into a null shape (a record with attributes and no
@@ -66,14 +67,6 @@ fn lots_z(d: &Path, z: f64) {
     edo_city::synth::stamp_dbf_date(&d.join("lots.dbf")).unwrap();
     std::fs::write(d.join("lots.prj"), PRJ).unwrap();
     write_street(d);
-}
-
-/// A workbook with a fixed creation time, so the file is the same every time it is made.
-fn workbook() -> rust_xlsxwriter::Workbook {
-    let mut book = rust_xlsxwriter::Workbook::new();
-    let date = rust_xlsxwriter::ExcelDateTime::from_ymd(2000, 1, 1).unwrap();
-    book.set_properties(&rust_xlsxwriter::DocProperties::new().set_creation_datetime(&date));
-    book
 }
 
 pub fn cases() -> Vec<Case> {
