@@ -90,58 +90,135 @@ fn paint(c: &mut Canvas, inside: impl Fn(f32, f32) -> bool, colour: impl Fn(u32,
     }
 }
 
-/// One tree billboard: a trunk and a crown of overlapping blobs, `kind` choosing the shape
-/// (0 broad, 1 pine pads, 2 cone, 3 weeping) and `leaf` the colour.
-fn tree(name: &str, variant: u32, kind: u32, leaf: Px) {
-    let (w, h) = (128u32, 256u32);
-    let mut c = clear(w, h);
-    let cx = w as f32 / 2.0;
-    let trunk_w = 6.0 + (variant % 3) as f32 * 2.0;
-    let lean = (noise(variant, 1, 30)) * 6.0;
-    let trunk_top = if kind == 2 { 200.0 } else { 150.0 };
-    paint(
-        &mut c,
-        |x, y| y < trunk_top && (x - cx - lean * y / trunk_top).abs() < trunk_w * (1.0 - y / 400.0),
-        |x, y| shade([74, 52, 36], noise(x, y, 31) * 0.12),
-    );
-    // Crown: blobs placed by the variant's noise.
-    let blobs: Vec<(f32, f32, f32)> = (0..14u32)
+/// A leaf card: `count` leaves (ellipses `len` x `wid` pixels) scattered over a transparent
+/// 64 x 64 canvas by the golden angle, each turned its own way, in `colour` with some
+/// shading; `hang` makes them point down (willow), `flowers` draws five-petalled blossoms.
+fn leaf(name: &str, colour: Px, count: u32, len: f32, wid: f32, hang: bool, flowers: bool) {
+    let mut c = clear(64, 64);
+    let golden = 2.399_963_f32;
+    let leaves: Vec<(f32, f32, f32, f32)> = (0..count)
         .map(|i| {
-            let (nx, ny, nr) = (
-                noise(variant, i, 32),
-                noise(variant, i, 33),
-                noise(variant, i, 34),
-            );
-            match kind {
-                // Pine (matsu 松): flat pads in tiers.
-                1 => (
-                    cx + nx * 44.0,
-                    120.0 + (i % 4) as f32 * 30.0 + ny * 6.0,
-                    16.0 + nr * 4.0,
-                ),
-                // Cedar-like cone: radius shrinking upwards.
-                2 => {
-                    let t = i as f32 / 14.0;
-                    (cx + nx * 8.0, 40.0 + t * 190.0, 44.0 * (1.0 - t) + 8.0)
-                }
-                // Weeping (yanagi 柳): a high crown whose blobs hang down the sides.
-                3 => (cx + nx * 50.0, 90.0 + ny.abs() * 140.0, 14.0 + nr * 4.0),
-                _ => (cx + nx * 40.0, 170.0 + ny * 40.0, 26.0 + nr * 8.0),
-            }
+            let r = 26.0 * ((i as f32 + 0.5) / count as f32).sqrt();
+            let a = i as f32 * golden;
+            let turn = if hang {
+                std::f32::consts::FRAC_PI_2 + noise(i, 1, 90) * 0.3
+            } else {
+                a + noise(i, 2, 91) * 0.8
+            };
+            (
+                32.0 + r * a.cos(),
+                32.0 + r * a.sin(),
+                turn,
+                noise(i, 3, 92) * 0.2,
+            )
         })
         .collect();
-    let flat = kind == 1;
     paint(
         &mut c,
         |x, y| {
-            blobs.iter().any(|&(bx, by, r)| {
-                let dy = if flat { (y - by) * 2.2 } else { y - by };
-                (x - bx).powi(2) + dy.powi(2) < r * r
+            leaves.iter().any(|&(lx, ly, t, _)| {
+                let (dx, dy) = (x - lx, y - ly);
+                if flowers {
+                    // Five round petals around the centre.
+                    let r = (dx * dx + dy * dy).sqrt();
+                    let petal = (5.0 * (dy.atan2(dx) + t)).cos().abs();
+                    r < len * (0.55 + 0.45 * petal)
+                } else {
+                    let (u, v) = (dx * t.cos() + dy * t.sin(), -dx * t.sin() + dy * t.cos());
+                    (u / len).powi(2) + (v / wid).powi(2) < 1.0
+                }
             })
         },
-        |x, y| shade(leaf, noise(x / 3, y / 3, 35 + variant) * 0.22),
+        |x, y| {
+            shade(
+                colour,
+                noise(x / 2, y / 2, 93) * 0.18 + (y as f32 / 64.0 - 0.5) * 0.2,
+            )
+        },
     );
     c.save(name);
+}
+
+/// Bark: vertical furrows; tileable (period 64 across, 128 along).
+fn bark() {
+    let mut c = Canvas::new(64, 128);
+    c.band(0.0, 1.0, |x, y| {
+        let furrow = ((x as f32 / 64.0 * std::f32::consts::TAU * 5.0).sin()
+            + noise(x / 4, y / 16, 94) * 0.6)
+            * 0.16;
+        shade([92, 72, 54], furrow + noise(x, y, 95) * 0.08)
+    });
+    c.save("bark.png");
+}
+
+/// A bamboo culm: green, faint streaks, a node ring every 32 pixels (0.375 m of a 1.5 m
+/// repeat).
+fn bamboo_culm() {
+    let mut c = Canvas::new(64, 128);
+    c.band(0.0, 1.0, |x, y| {
+        if y % 32 < 3 {
+            shade([96, 118, 60], -0.25)
+        } else {
+            shade(
+                [110, 142, 70],
+                noise(x / 2, 0, 96) * 0.1 + noise(x, y, 97) * 0.04,
+            )
+        }
+    });
+    c.save("bamboo_culm.png");
+}
+
+/// The tree billboards, rendered from the species that name them (`billboard = "tree_NN"`
+/// in templates/trees/): LOD0 of a tree grown with seed 1 at the middle of its height range,
+/// in summer, seen from the south, framed as LOD2's crossed quads are (the farthest branch
+/// from the trunk to each side, ground to top). Binary alpha: no fringe of background colour.
+fn species_billboards() {
+    use edo_city::generate::mesh::{Frame, Mesh};
+    use edo_city::generate::tree::{self, Lod, Look, Placement};
+    let catalog = edo_city::templates::Catalog::load(None).expect("the shipped species load");
+    let from_disk = |name: &str| {
+        image::open(format!("textures/{name}"))
+            .ok()
+            .map(|i| i.to_rgba8())
+    };
+    for s in catalog.species.values() {
+        let h = s.nominal_height();
+        let mut rng = edo_city::rng::feature_rng(1, "tree", &s.name);
+        let grown = s.grow(h, &mut rng).expect("a shipped species grows");
+        let look = Look::of(s, h, "summer");
+        let mut mesh = Mesh::new(s.name.clone());
+        let place = Placement {
+            at: geo_types::Coord { x: 0.0, y: 0.0 },
+            ground: 0.0,
+            rotation: 0.0,
+        };
+        tree::mesh_tree(
+            &grown.skeleton,
+            &s.mesh,
+            look,
+            Lod::Full,
+            place,
+            Frame { origin: [0.0, 0.0] },
+            &mut mesh,
+        );
+        let (r, top) = tree::extent(&grown.skeleton, look.leaf.map_or(0.0, |_| look.leaf_size));
+        let r = r.max(top * 0.1);
+        let height = 256u32;
+        let width = ((f64::from(height) * 2.0 * r / top).round() as u32).clamp(96, 512);
+        let img = edo_city::output::render::render(
+            &[mesh],
+            edo_city::output::render::View::South,
+            [-r, r, 0.0, top],
+            (width, height),
+            &from_disk,
+        );
+        let name = edo_city::materials::MATERIALS[s.billboard as usize]
+            .texture
+            .expect("a billboard material has a texture");
+        let path = format!("textures/{name}");
+        img.save(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+        println!("wrote {path} (species {})", s.name);
+    }
 }
 
 /// One person billboard: head, hair, kimono with an obi, legs; `hat` adds a straw kasa,
@@ -410,23 +487,49 @@ fn main() {
     });
     c.save("namako.png");
 
-    // Ten tree billboards: broad trees, pines, cones and willows in several greens, a
-    // cherry in blossom and a maple in autumn.
-    let trees: [(u32, Px); 10] = [
-        (0, [62, 98, 52]),
-        (0, [80, 112, 60]),
-        (1, [46, 78, 50]),
-        (1, [54, 86, 44]),
-        (2, [40, 70, 48]),
-        (2, [50, 84, 56]),
-        (3, [110, 140, 70]),
-        (0, [232, 180, 196]),
-        (0, [180, 64, 40]),
-        (3, [92, 126, 64]),
-    ];
-    for (i, (kind, leaf)) in trees.iter().enumerate() {
-        tree(&format!("tree_{:02}.png", i + 1), i as u32, *kind, *leaf);
-    }
+    // Leaf cards and bark of the grown trees, then the billboards rendered from them.
+    leaf("leaf_broad.png", [70, 110, 54], 22, 7.0, 3.6, false, false);
+    leaf("leaf_needle.png", [44, 84, 50], 60, 9.0, 0.9, false, false);
+    leaf(
+        "leaf_blossom.png",
+        [240, 196, 210],
+        16,
+        6.0,
+        0.0,
+        false,
+        true,
+    );
+    leaf("leaf_red.png", [186, 58, 36], 22, 7.0, 3.6, false, false);
+    leaf(
+        "leaf_yellow.png",
+        [204, 160, 52],
+        22,
+        7.0,
+        3.6,
+        false,
+        false,
+    );
+    leaf(
+        "leaf_willow.png",
+        [120, 152, 72],
+        30,
+        10.0,
+        1.6,
+        true,
+        false,
+    );
+    leaf(
+        "leaf_bamboo.png",
+        [92, 136, 60],
+        14,
+        12.0,
+        2.2,
+        false,
+        false,
+    );
+    bark();
+    bamboo_culm();
+    species_billboards();
 
     // Eight people in kimono of the period's common dyes (indigo, brown, grey, persimmon).
     let people: [(Px, bool, bool); 8] = [

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use crate::generate::instance::{instantiate, Site};
 use crate::generate::mesh::{open_edges, Frame, Mesh};
-use crate::output::{atomic::write_atomic, mtl, obj, texture_library};
+
 use crate::params::Params;
 use crate::templates::template::{SiteInputs, N_INPUTS};
 use crate::templates::{Catalog, Template};
@@ -101,32 +101,7 @@ pub fn build_alone(
 
 /// Writes `<stem>.obj`, `<stem>.mtl` and `textures/` into the OBJ's directory.
 pub fn write(alone: &Alone, obj_path: &Path, texture_set: &str) -> Result<usize, String> {
-    let stem = obj_path
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .filter(|s| !s.is_empty())
-        .ok_or_else(|| format!("{}: give a file name ending in .obj", obj_path.display()))?;
-    let dir = obj_path.parent().unwrap_or(Path::new(""));
-    let io = |p: &Path, e: std::io::Error| format!("cannot write {}: {e}", p.display());
-    let textures = texture_library(texture_set)?;
-    let tex_dir = dir.join("textures");
-    std::fs::create_dir_all(&tex_dir).map_err(|e| io(&tex_dir, e))?;
-    for (name, bytes) in &textures {
-        let p = tex_dir.join(name);
-        write_atomic(&p, bytes).map_err(|e| io(&p, e))?;
-    }
-    let mut buf = Vec::new();
-    obj::write_tile(
-        &mut buf,
-        stem,
-        [0.0, 0.0],
-        std::slice::from_ref(&alone.mesh),
-    );
-    write_atomic(obj_path, &buf).map_err(|e| io(obj_path, e))?;
-    let mtl_path = dir.join(format!("{stem}.mtl"));
-    write_atomic(&mtl_path, mtl::mtl_text_at("textures/").as_bytes())
-        .map_err(|e| io(&mtl_path, e))?;
-    Ok(textures.len())
+    crate::output::write_model(obj_path, std::slice::from_ref(&alone.mesh), texture_set)
 }
 
 /// True when every edge of the mesh is shared by two faces (for the summary line).

@@ -394,7 +394,14 @@ fn write_city(
                     ground: terrain_of(&data, params, id),
                     ..generate::TilePlan::of(&plan, id)
                 };
-                let meshes = generate::generate_tile(&tile, catalog, params, plan.origin, &files);
+                let mut meshes =
+                    generate::generate_tile(&tile, catalog, params, plan.origin, &files);
+                meshes.stats.tree_bytes = output::obj_bytes(
+                    meshes
+                        .meshes
+                        .iter()
+                        .filter(|m| m.name == "trees" || m.name == "trees_grown"),
+                ) as u64;
                 gen_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
                 let t = Instant::now();
                 let written = output::write_tile(&opts.out, id, plan.origin, &meshes.meshes)

@@ -21,6 +21,7 @@ mod cli;
 
 use cli::args::*;
 use cli::commands::*;
+use cli::plants::*;
 use cli::Problems;
 
 #[derive(Parser)]
@@ -63,6 +64,12 @@ enum Command {
     /// Simulate the crowd model alone (boids of Oyama et al., seed 004) and write its order
     /// parameters lambda1-3 per step: the seed's demo.
     Boids(BoidsArgs),
+    /// Expand an L-system and read it with the 3D turtle (seed 003): print the string, write
+    /// the turtle's mesh or an SVG; `--preset` gives the seed's examples.
+    Lsystem(LsystemArgs),
+    /// Grow one tree of a species and write a level of detail (OBJ) and its numbers (JSON);
+    /// without `--species`, list the species.
+    Tree(TreeArgs),
 }
 
 fn main() -> ExitCode {
@@ -99,6 +106,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Plan(args) => plan_command(args),
         Command::Merge(args) => merge_command(args),
         Command::Boids(args) => boids_command(args),
+        Command::Lsystem(args) => lsystem_command(args),
+        Command::Tree(args) => tree_command(args),
         Command::Init(args) => init_command(args),
         Command::Params => params_command(),
         Command::Template(args) => template_command(args),

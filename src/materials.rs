@@ -216,6 +216,60 @@ pub const MATERIALS: &[Material] = &[
         alpha: false,
         texture: Some("ground.png"),
     },
+    Material {
+        name: "bark",
+        kd: [0.30, 0.24, 0.18],
+        alpha: false,
+        texture: Some("bark.png"),
+    },
+    Material {
+        name: "leaf_broad",
+        kd: [0.22, 0.38, 0.18],
+        alpha: true,
+        texture: Some("leaf_broad.png"),
+    },
+    Material {
+        name: "leaf_needle",
+        kd: [0.16, 0.30, 0.16],
+        alpha: true,
+        texture: Some("leaf_needle.png"),
+    },
+    Material {
+        name: "leaf_blossom",
+        kd: [0.93, 0.76, 0.80],
+        alpha: true,
+        texture: Some("leaf_blossom.png"),
+    },
+    Material {
+        name: "leaf_red",
+        kd: [0.70, 0.20, 0.12],
+        alpha: true,
+        texture: Some("leaf_red.png"),
+    },
+    Material {
+        name: "leaf_yellow",
+        kd: [0.78, 0.62, 0.20],
+        alpha: true,
+        texture: Some("leaf_yellow.png"),
+    },
+    Material {
+        name: "leaf_willow",
+        kd: [0.45, 0.58, 0.28],
+        alpha: true,
+        texture: Some("leaf_willow.png"),
+    },
+    Material {
+        name: "leaf_bamboo",
+        kd: [0.36, 0.52, 0.24],
+        alpha: true,
+        texture: Some("leaf_bamboo.png"),
+    },
+    Material {
+        name: "bamboo_culm",
+        kd: [0.42, 0.55, 0.28],
+        alpha: false,
+        texture: Some("bamboo_culm.png"),
+    },
 ];
 
 /// Texture files, compiled in: (file name, PNG bytes).
@@ -273,6 +327,36 @@ pub const TEXTURES: &[(&str, &[u8])] = &[
     ("person_07.png", include_bytes!("../textures/person_07.png")),
     ("person_08.png", include_bytes!("../textures/person_08.png")),
     ("ground.png", include_bytes!("../textures/ground.png")),
+    ("bark.png", include_bytes!("../textures/bark.png")),
+    (
+        "leaf_broad.png",
+        include_bytes!("../textures/leaf_broad.png"),
+    ),
+    (
+        "leaf_needle.png",
+        include_bytes!("../textures/leaf_needle.png"),
+    ),
+    (
+        "leaf_blossom.png",
+        include_bytes!("../textures/leaf_blossom.png"),
+    ),
+    ("leaf_red.png", include_bytes!("../textures/leaf_red.png")),
+    (
+        "leaf_yellow.png",
+        include_bytes!("../textures/leaf_yellow.png"),
+    ),
+    (
+        "leaf_willow.png",
+        include_bytes!("../textures/leaf_willow.png"),
+    ),
+    (
+        "bamboo_culm.png",
+        include_bytes!("../textures/bamboo_culm.png"),
+    ),
+    (
+        "leaf_bamboo.png",
+        include_bytes!("../textures/leaf_bamboo.png"),
+    ),
 ];
 
 /// Index of a material by name.

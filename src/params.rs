@@ -130,6 +130,12 @@ pub struct DistrictParams {
     /// `boids`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub people_motion: Option<String>,
+    /// How this district's trees are made, replacing `trees.style` there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trees_style: Option<String>,
+    /// Species weights per lot use here, replacing `trees.species` there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tree_species: Option<BTreeMap<String, BTreeMap<String, f64>>>,
 }
 
 impl Params {
@@ -162,6 +168,28 @@ impl Params {
             .and_then(|d| d.people_motion.as_deref())
             .unwrap_or(&self.people.motion)
             == "boids"
+    }
+
+    /// How the trees of `district` are made (`trees.style`, or the district's `trees_style`).
+    pub fn trees_style(&self, district: Option<&str>) -> &str {
+        district
+            .and_then(|d| self.district.get(d))
+            .and_then(|d| d.trees_style.as_deref())
+            .unwrap_or(&self.trees.style)
+    }
+
+    /// The species weights of a lot use in `district`: the district's table, else
+    /// `trees.species`; the use's own row, else its `default` row.
+    pub fn tree_species(
+        &self,
+        district: Option<&str>,
+        lot_use: &str,
+    ) -> Option<&BTreeMap<String, f64>> {
+        let table = district
+            .and_then(|d| self.district.get(d))
+            .and_then(|d| d.tree_species.as_ref())
+            .unwrap_or(&self.trees.species);
+        table.get(lot_use).or_else(|| table.get("default"))
     }
 
     /// `[district.<id>.template...]` of every district, as the catalog takes them.
@@ -662,6 +690,16 @@ impl Params {
                 return Err(bad(format!(
                     "`district.{id}.people_motion` must be \"scatter\" or \"boids\", got \"{m}\""
                 )));
+            }
+        }
+        for (id, d) in &self.district {
+            if let Some(style) = &d.trees_style {
+                billboards::check_style(&format!("district.{id}.trees_style"), style)
+                    .map_err(bad)?;
+            }
+            if let Some(table) = &d.tree_species {
+                billboards::check_species(&format!("district.{id}.tree_species"), table)
+                    .map_err(bad)?;
             }
         }
         self.people.validate().map_err(bad)?;

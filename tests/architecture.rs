@@ -27,7 +27,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     // The procedural growers know nothing of GIS: plane geometry and the RNG only.
     ("growers", &["geom", "rng"]),
     ("params", &["model", "growers"]),
-    ("templates", &["materials", "geom", "model"]),
+    ("templates", &["materials", "geom", "model", "growers"]),
     ("input", &["model", "geom", "params"]),
     ("analyse", STAGE),
     ("generate", STAGE),

@@ -319,6 +319,7 @@ impl<'a> Kind<'a> {
                 ground,
                 district,
                 tile: tile_of(at),
+                tree: None,
             },
         }
     }
@@ -596,6 +597,16 @@ fn from_points(
         if let Some(h) = f.height {
             c.b.height = h;
         }
+        if let Some(species) = &f.species {
+            // Resolved against the catalog, with the lot and crown, by `trees::plant`.
+            c.b.tree = Some(crate::model::TreeForm {
+                species: species.clone(),
+                grown: false,
+                lot: None,
+                crown: 0.0,
+                squeeze: 1.0,
+            });
+        }
         if let Some(t) = &f.texture {
             match texture_of(t, k.textures) {
                 Some(name) => c.b.texture = name,
@@ -746,6 +757,7 @@ mod tests {
                 ground: 0.0,
                 district: None,
                 tile: "0_0".into(),
+                tree: None,
             },
         }
     }

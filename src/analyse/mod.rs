@@ -11,6 +11,7 @@ pub mod obstacles;
 pub mod room;
 pub mod street;
 pub mod terrain;
+pub mod trees;
 
 use geo::Centroid;
 use geo_types::Coord;
@@ -130,6 +131,7 @@ pub fn analyse(
     }
     let t = std::time::Instant::now();
     billboards::plan_billboards(data, &mut plan, catalog, params);
+    trees::plant(data, &mut plan, catalog, params);
     plan.billboards_time = t.elapsed();
     if off_dem > 0 {
         if let Some(dem) = &data.dem {

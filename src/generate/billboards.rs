@@ -25,6 +25,16 @@ pub fn build(
     stats: &mut TileStats,
 ) -> Vec<Mesh> {
     let mut out = Vec::new();
+    let grown: Vec<&PlannedBillboard> = billboards
+        .iter()
+        .filter(|b| b.tree.as_ref().is_some_and(|t| t.grown))
+        .collect();
+    let planted = (!grown.is_empty())
+        .then(|| super::planted::build(grown, catalog, params, frame, &files.trees, stats));
+    let left: std::collections::HashSet<*const PlannedBillboard> = planted
+        .iter()
+        .flat_map(|p| p.billboards.iter().map(|b| *b as *const PlannedBillboard))
+        .collect();
     for kind in [BillboardKind::Person, BillboardKind::Tree] {
         let (template, file) = match kind {
             BillboardKind::Person => (&params.people.template, &files.people),
@@ -32,7 +42,23 @@ pub fn build(
         };
         let mut mesh = Mesh::new(kind.layer().to_string());
         for b in billboards.iter().filter(|b| b.kind == kind) {
-            match build_one(b, template, catalog, params.seed, frame, &mut mesh) {
+            let meshed = b.tree.as_ref().is_some_and(|t| t.grown)
+                && !left.contains(&(b as *const PlannedBillboard));
+            let built = match &b.tree {
+                _ if meshed => Ok(()),
+                Some(form) => {
+                    species_billboard(b, form, catalog, frame, &mut mesh);
+                    *stats
+                        .trees_by_species
+                        .entry(form.species.clone())
+                        .or_default()
+                        .entry("billboard".into())
+                        .or_default() += 1;
+                    Ok(())
+                }
+                None => build_one(b, template, catalog, params.seed, frame, &mut mesh),
+            };
+            match built {
                 Ok(()) => {
                     let district = b.district.clone().unwrap_or_default();
                     let by_district = match kind {
@@ -58,7 +84,30 @@ pub fn build(
             out.push(mesh.finish());
         }
     }
+    if let Some(m) = planted.and_then(|p| p.mesh) {
+        out.push(m);
+    }
     out
+}
+
+/// A tree of a species drawn as its species' billboard: crossed quads the size of its crown.
+fn species_billboard(
+    b: &PlannedBillboard,
+    form: &crate::model::TreeForm,
+    catalog: &Catalog,
+    frame: Frame,
+    mesh: &mut Mesh,
+) {
+    let material = catalog
+        .species
+        .get(&form.species)
+        .map_or_else(|| materials::id("tree_01"), |s| s.billboard);
+    let place = super::tree::Placement {
+        at: b.at,
+        ground: b.ground,
+        rotation: b.facing,
+    };
+    super::tree::billboard_of(form.crown, b.height, material, place, frame, mesh);
 }
 
 /// One billboard into `mesh`: the template on a site whose v axis is the facing direction,

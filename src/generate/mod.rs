@@ -10,7 +10,9 @@ pub mod instance;
 pub mod kura;
 pub mod machiya;
 pub mod mesh;
+pub mod planted;
 pub mod terrain;
+pub mod tree;
 
 use crate::model::{
     FenceKind, KuraDecision, PlannedBillboard, PlannedFence, PlannedHouse, Skipped, TileStats,

@@ -20,10 +20,11 @@ pub(super) fn read_points(
     warnings: &mut Vec<crate::model::Warning>,
 ) -> Result<Vec<PointFeature>, InputError> {
     let field = |name: &str| resolve_field(name, &o.layer.fields, o.layer.text_encoding);
-    let (id_field, height_field, texture_field) = (
+    let (id_field, height_field, texture_field, species_field) = (
         field(&settings.id_field),
         field(&settings.height_field),
         field(&settings.texture_field),
+        field(&settings.species_field),
     );
     let mut out = Vec::new();
     for f in &o.layer.features {
@@ -54,6 +55,7 @@ pub(super) fn read_points(
             },
         };
         let texture = value(texture_field);
+        let species = value(species_field);
         let parts = points.len();
         for (k, at) in points.into_iter().enumerate() {
             let id = if parts > 1 {
@@ -84,6 +86,7 @@ pub(super) fn read_points(
                 at,
                 height,
                 texture: texture.clone(),
+                species: species.clone(),
             });
         }
     }

@@ -127,6 +127,8 @@ pub struct PointFeature {
     pub height: Option<f64>,
     /// The `texture` field as written (a material name or a number), when given.
     pub texture: Option<String>,
+    /// The `species` field as written (trees), when given.
+    pub species: Option<String>,
 }
 
 /// A building footprint from the data, built as a house of its own height.
@@ -442,7 +444,31 @@ pub struct PlannedBillboard {
     pub district: Option<String>,
     /// The tile it is written to.
     pub tile: TileId,
+    /// For a tree of a species: which, and how it is drawn. `None` for a person and for a
+    /// tree of `trees.style = "billboard"` without a species.
+    pub tree: Option<TreeForm>,
 }
+
+/// A tree of a species (ki 木), as `analyse::trees` planted it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TreeForm {
+    /// The species (a file of templates/trees/).
+    pub species: String,
+    /// Grown (`lsystem` / `colonization`): meshed from its own skeleton when the tile's
+    /// budget allows; otherwise the species' billboard.
+    pub grown: bool,
+    /// The lot it stands in, if any (else a street margin).
+    pub lot: Option<String>,
+    /// The crown's radius at the planted height, metres: clear of buildings and inside the
+    /// lot by `trees.clearance`.
+    pub crown: f64,
+    /// How much the crown is narrowed to fit (1: as grown), as a gardener prunes a tree in a
+    /// narrow yard; below [`MIN_SQUEEZE`] the whole tree is made smaller instead.
+    pub squeeze: f64,
+}
+
+/// The narrowest a crown is pruned to fit its room (a share of its grown width).
+pub const MIN_SQUEEZE: f64 = 0.4;
 
 /// What section 4.2 decided for a machiya's kura (蔵). A rectangle is `[u0, v0, u1, v1]` in
 /// the machiya's frontage frame (u along the street, v into the lot).
@@ -586,6 +612,13 @@ pub struct TileStats {
     /// Trees built, per district.
     #[serde(default)]
     pub trees_by_district: BTreeMap<String, usize>,
+    /// Trees of a species, per species and how they were drawn: `lod1` (grown and meshed)
+    /// or `billboard` (the species' picture).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub trees_by_species: BTreeMap<String, BTreeMap<String, usize>>,
+    /// Bytes of the tile's OBJ taken by its trees (objects `trees` and `trees_grown`).
+    #[serde(default)]
+    pub tree_bytes: u64,
     /// Billboards per texture.
     #[serde(default)]
     pub billboard_textures: BTreeMap<String, usize>,

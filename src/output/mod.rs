@@ -10,7 +10,9 @@ pub mod lock;
 pub mod mtl;
 pub mod obj;
 pub mod plan;
+pub mod render;
 pub mod report;
+pub mod sketch;
 pub mod text;
 
 use std::borrow::Cow;
@@ -115,4 +117,39 @@ pub fn write_textures(out: &Path, library: &[Texture]) -> std::io::Result<Vec<Ma
             })
         })
         .collect()
+}
+
+/// Writes one model alone (a template, a tree): `<stem>.obj` with `meshes` as its objects,
+/// `<stem>.mtl` and the texture library in `textures/` beside it; returns the number of
+/// textures written.
+pub fn write_model(obj_path: &Path, meshes: &[Mesh], texture_set: &str) -> Result<usize, String> {
+    let stem = obj_path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| !s.is_empty())
+        .ok_or_else(|| format!("{}: give a file name ending in .obj", obj_path.display()))?;
+    let dir = obj_path.parent().unwrap_or(Path::new(""));
+    let io = |p: &Path, e: std::io::Error| format!("cannot write {}: {e}", p.display());
+    let textures = texture_library(texture_set)?;
+    let tex_dir = dir.join("textures");
+    std::fs::create_dir_all(&tex_dir).map_err(|e| io(&tex_dir, e))?;
+    for (name, bytes) in &textures {
+        let p = tex_dir.join(name);
+        atomic::write_atomic(&p, bytes).map_err(|e| io(&p, e))?;
+    }
+    let mut buf = Vec::new();
+    obj::write_tile(&mut buf, stem, [0.0, 0.0], meshes);
+    atomic::write_atomic(obj_path, &buf).map_err(|e| io(obj_path, e))?;
+    let mtl_path = dir.join(format!("{stem}.mtl"));
+    atomic::write_atomic(&mtl_path, mtl::mtl_text_at("textures/").as_bytes())
+        .map_err(|e| io(&mtl_path, e))?;
+    Ok(textures.len())
+}
+
+/// The bytes `meshes` take in an OBJ file, without the file's header.
+pub fn obj_bytes<'a>(meshes: impl IntoIterator<Item = &'a Mesh>) -> usize {
+    let (mut buf, mut header) = (Vec::new(), Vec::new());
+    obj::write_tile(&mut buf, "x", [0.0, 0.0], meshes);
+    obj::write_tile(&mut header, "x", [0.0, 0.0], std::iter::empty());
+    buf.len() - header.len()
 }

@@ -33,7 +33,12 @@ fn push_fixed(buf: &mut Vec<u8>, v: i64, scale: i64, digits: usize) {
 }
 
 /// Writes a whole tile into `buf`.
-pub fn write_tile(buf: &mut Vec<u8>, tile: &str, origin: [f64; 2], meshes: &[Mesh]) {
+pub fn write_tile<'a>(
+    buf: &mut Vec<u8>,
+    tile: &str,
+    origin: [f64; 2],
+    meshes: impl IntoIterator<Item = &'a Mesh>,
+) {
     let _ = write!(
         buf,
         "# edo-city {} tile {tile}\n\

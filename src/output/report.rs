@@ -182,8 +182,32 @@ pub struct Report {
     /// The street crowds, per street stretch and per district (`people.motion = "boids"`).
     #[serde(skip_serializing_if = "Crowds::is_empty")]
     pub crowds: Crowds,
+    /// Trees of a species: by species and how each was drawn, and bytes of tree geometry per
+    /// tile (absent when no tree has a species).
+    #[serde(skip_serializing_if = "TreesReport::is_empty")]
+    pub trees: TreesReport,
     /// Per tile: houses and bytes.
     pub tiles: Vec<TileReport>,
+}
+
+/// The trees of a species (`trees.style`, seeds 003 and 001).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct TreesReport {
+    /// Per species: how many were meshed (`lod1`) and how many drawn as its billboard.
+    pub by_species: BTreeMap<String, BTreeMap<String, usize>>,
+    /// The same summed over the species.
+    pub by_lod: BTreeMap<String, usize>,
+    /// Bytes of tree geometry (objects `trees` and `trees_grown`) per tile.
+    pub tile_bytes: BTreeMap<String, u64>,
+    /// The largest of them.
+    pub largest_tile_bytes: u64,
+}
+
+impl TreesReport {
+    /// Whether no tree had a species.
+    pub fn is_empty(&self) -> bool {
+        self.by_species.is_empty()
+    }
 }
 
 /// The street crowds of a build: how busy and how grouped each street is (seed 004).
@@ -264,6 +288,8 @@ pub struct TileReport {
     pub footprints: usize,
     /// Bytes of its OBJ.
     pub obj_bytes: u64,
+    /// Of them, bytes of its trees.
+    pub tree_bytes: u64,
 }
 
 /// The part of the report that comes from reading and analysis, the same for every tile.
@@ -414,7 +440,16 @@ pub fn assemble_report(m: &Manifest) -> Report {
             machiya: s.machiya,
             footprints: s.footprints,
             obj_bytes: t.obj.bytes,
+            tree_bytes: s.tree_bytes,
         });
+        for (species, lods) in &s.trees_by_species {
+            add(r.trees.by_species.entry(species.clone()).or_default(), lods);
+            add(&mut r.trees.by_lod, lods);
+        }
+        if !s.trees_by_species.is_empty() {
+            r.trees.tile_bytes.insert(t.id.clone(), s.tree_bytes);
+            r.trees.largest_tile_bytes = r.trees.largest_tile_bytes.max(s.tree_bytes);
+        }
     }
     r.table2 = Table2Report {
         all: Table2::of(&kura_all),

@@ -4,6 +4,8 @@
 //! spatial probability distribution; these are that distribution's parameters, per district
 //! where `[district.<id>]` gives its own density.
 
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 
 /// A point layer of people or trees (`people.shp`, `trees.shp`). When it is present its
@@ -22,6 +24,9 @@ pub struct PointsLayer {
     pub height_field: String,
     /// Texture (library material name, or its number in `textures`); else drawn.
     pub texture_field: String,
+    /// Tree species (a file of templates/trees/); else drawn from `[trees.species]`.
+    #[serde(default)]
+    pub species_field: String,
 }
 
 /// People (hito 人): one alpha-textured quad each, standing in the street.
@@ -78,6 +83,18 @@ pub struct TreesParams {
     pub textures: Vec<String>,
     /// The most trees one tile may hold; a denser tile is scaled down, with a warning.
     pub max_points_per_tile: usize,
+    /// `billboard`: crossed pictures (section 4.4); `lsystem` / `colonization`: trees grown
+    /// by that method (seeds 003, 001) from the species of `species`
+    /// (`[district.<id>] trees_style`).
+    pub style: String,
+    /// The leaves shown: spring, summer, autumn or winter (each species says what it wears).
+    pub season: String,
+    /// Bytes of grown-tree geometry one tile may hold: the tallest trees get meshes, the rest
+    /// of the tile's trees billboards of their species.
+    pub max_tile_bytes: u64,
+    /// Species weights per lot use (`machiya`, `buke`, ... or `default` for any other), the
+    /// species drawn per tree (`[district.<id>.tree_species]`).
+    pub species: BTreeMap<String, BTreeMap<String, f64>>,
 }
 
 /// The densest crowd a parameter may ask for: a person every 10 cm of street.
@@ -117,8 +134,58 @@ impl PeopleParams {
     }
 }
 
+/// The tree styles.
+pub const TREE_STYLES: [&str; 3] = ["billboard", "lsystem", "colonization"];
+/// The largest `trees.max_tile_bytes`: 1 GB.
+pub const MAX_TILE_BYTES: u64 = 1_000_000_000;
+
+/// A tree style is one of [`TREE_STYLES`].
+pub fn check_style(key: &str, style: &str) -> Result<(), String> {
+    if TREE_STYLES.contains(&style) {
+        Ok(())
+    } else {
+        Err(format!(
+            "`{key}` must be \"billboard\", \"lsystem\" or \"colonization\", got \"{style}\""
+        ))
+    }
+}
+
+/// Species weights are finite, from 0 to 1e9, and some weight of each use is above 0.
+pub fn check_species(
+    key: &str,
+    table: &BTreeMap<String, BTreeMap<String, f64>>,
+) -> Result<(), String> {
+    for (usage, mix) in table {
+        for (name, w) in mix {
+            if !(w.is_finite() && (0.0..=1e9).contains(w)) {
+                return Err(format!(
+                    "`{key}.{usage}.{name}` must be a weight from 0 to 1e9, got {w}"
+                ));
+            }
+        }
+        if mix.values().sum::<f64>() <= 0.0 {
+            return Err(format!("`{key}.{usage}` weights add up to 0"));
+        }
+    }
+    Ok(())
+}
+
 impl TreesParams {
     pub(super) fn validate(&self) -> Result<(), String> {
+        check_style("trees.style", &self.style)?;
+        if !["spring", "summer", "autumn", "winter"].contains(&self.season.as_str()) {
+            return Err(format!(
+                "`trees.season` must be spring, summer, autumn or winter, got \"{}\"",
+                self.season
+            ));
+        }
+        if self.max_tile_bytes > MAX_TILE_BYTES {
+            return Err(format!(
+                "`trees.max_tile_bytes` must be at most {MAX_TILE_BYTES}, got {}",
+                self.max_tile_bytes
+            ));
+        }
+        check_species("trees.species", &self.species)?;
         common(
             "trees",
             &[
@@ -179,6 +246,7 @@ pub(super) mod partial {
         id_field: Option<String>,
         height_field: Option<String>,
         texture_field: Option<String>,
+        species_field: Option<String>,
     }
 
     #[derive(Deserialize)]
@@ -212,5 +280,10 @@ pub(super) mod partial {
         clearance: Option<f64>,
         textures: Option<Vec<String>>,
         max_points_per_tile: Option<usize>,
+        style: Option<String>,
+        season: Option<String>,
+        max_tile_bytes: Option<u64>,
+        species:
+            Option<std::collections::BTreeMap<String, std::collections::BTreeMap<String, f64>>>,
     }
 }

@@ -41,6 +41,8 @@ struct District {
     trees_per_ha: Option<f64>,
     trees_per_ha_machiya: Option<f64>,
     people_motion: Option<String>,
+    trees_style: Option<String>,
+    tree_species: Option<BTreeMap<String, BTreeMap<String, f64>>>,
 }
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -10,6 +10,7 @@
 
 pub mod expr;
 pub mod file;
+pub mod species;
 pub mod template;
 
 use std::collections::BTreeMap;
@@ -17,6 +18,7 @@ use std::path::Path;
 
 use thiserror::Error;
 
+pub use species::Species;
 pub use template::{Kind, Template};
 
 /// The types shipped with the tool, compiled in so the binary works anywhere.
@@ -65,6 +67,29 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("person.toml", include_str!("../../templates/person.toml")),
 ];
 
+/// The tree species shipped with the tool (`templates/trees/`), compiled in.
+pub const BUILTIN_SPECIES: &[(&str, &str)] = &[
+    (
+        "matsu.toml",
+        include_str!("../../templates/trees/matsu.toml"),
+    ),
+    (
+        "momiji.toml",
+        include_str!("../../templates/trees/momiji.toml"),
+    ),
+    (
+        "yanagi.toml",
+        include_str!("../../templates/trees/yanagi.toml"),
+    ),
+    (
+        "sakura.toml",
+        include_str!("../../templates/trees/sakura.toml"),
+    ),
+    ("sugi.toml", include_str!("../../templates/trees/sugi.toml")),
+    ("take.toml", include_str!("../../templates/trees/take.toml")),
+    ("ume.toml", include_str!("../../templates/trees/ume.toml")),
+];
+
 /// Why the templates cannot be used: the build stops before it reads any data.
 #[derive(Debug, Error)]
 pub enum TemplateError {
@@ -92,6 +117,8 @@ pub struct Catalog {
     overrides: BTreeMap<String, Vec<(usize, f64)>>,
     /// The same per district: (district, template) -> (slot, value), on top of `overrides`.
     district_overrides: BTreeMap<(String, String), Vec<(usize, f64)>>,
+    /// The tree species, by name: the shipped ones, then a user's `trees/` directory.
+    pub species: BTreeMap<String, Species>,
 }
 
 /// Folds the spellings users write: case, hyphens, spaces, brackets.
@@ -108,6 +135,44 @@ fn normalise(s: &str) -> String {
         .collect()
 }
 
+/// The shipped species, then each `*.toml` of `<dir>/trees/` (replacing a shipped species of
+/// the same name).
+fn load_species(dir: Option<&Path>) -> Result<BTreeMap<String, Species>, TemplateError> {
+    let mut out = BTreeMap::new();
+    for (name, text) in BUILTIN_SPECIES {
+        let s = species::parse(&format!("templates/trees/{name}"), text)
+            .map_err(TemplateError::Invalid)?;
+        out.insert(s.name.clone(), s);
+    }
+    let Some(dir) = dir.map(|d| d.join("trees")).filter(|d| d.is_dir()) else {
+        return Ok(out);
+    };
+    let io = |cause| TemplateError::Io {
+        dir: dir.display().to_string(),
+        cause,
+    };
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .map_err(io)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    let mut seen = BTreeMap::new();
+    for p in paths {
+        let text = std::fs::read_to_string(&p).map_err(io)?;
+        let file = p.display().to_string();
+        let s = species::parse(&file, &text).map_err(TemplateError::Invalid)?;
+        if let Some(other) = seen.insert(s.name.clone(), file.clone()) {
+            return Err(TemplateError::Invalid(format!(
+                "{file}: species `{}` is already defined in {other}",
+                s.name
+            )));
+        }
+        out.insert(s.name.clone(), s);
+    }
+    Ok(out)
+}
+
 /// Every `*.toml` under `dir`, sorted, recursively.
 fn files_under(dir: &Path, out: &mut Vec<std::path::PathBuf>) -> std::io::Result<()> {
     let mut entries: Vec<_> = std::fs::read_dir(dir)?
@@ -115,6 +180,10 @@ fn files_under(dir: &Path, out: &mut Vec<std::path::PathBuf>) -> std::io::Result
         .collect();
     entries.sort();
     for p in entries {
+        // Tree species live in `trees/`, in their own format.
+        if p.is_dir() && p.file_name().is_some_and(|n| n == "trees") {
+            continue;
+        }
         if p.is_dir() {
             files_under(&p, out)?;
         } else if p.extension().is_some_and(|x| x == "toml") {
@@ -176,6 +245,7 @@ impl Catalog {
             }
             cat.templates.insert(t.name.clone(), t);
         }
+        cat.species = load_species(dir)?;
         Ok(cat)
     }
 

@@ -1,0 +1,89 @@
+//! The grown trees of a tile (`trees.style = "lsystem"` or `"colonization"`): tallest first,
+//! each grown from its own skeleton (`feature_rng(seed, "tree", id)`) and meshed at LOD1 while
+//! the tile's `trees.max_tile_bytes` allows; a tree that does not fit is drawn as its
+//! species' billboard. All grown trees of a tile are one object, `trees_grown`.
+
+use super::mesh::{Frame, Mesh};
+use super::tree::{self, Lod, Look, Placement};
+use crate::model::{PlannedBillboard, Skipped, TileStats};
+use crate::params::Params;
+use crate::templates::Catalog;
+
+/// What became of a tile's grown trees.
+pub struct Planted<'a> {
+    /// Their meshes, one object.
+    pub mesh: Option<Mesh>,
+    /// The trees the budget left to billboards (in no particular order).
+    pub billboards: Vec<&'a PlannedBillboard>,
+}
+
+/// Grows and meshes `trees` (all with a grown [`crate::model::TreeForm`]).
+pub fn build<'a>(
+    trees: Vec<&'a PlannedBillboard>,
+    catalog: &Catalog,
+    params: &Params,
+    frame: Frame,
+    file: &str,
+    stats: &mut TileStats,
+) -> Planted<'a> {
+    let mut order = trees;
+    order.sort_by(|a, b| b.height.total_cmp(&a.height).then_with(|| a.id.cmp(&b.id)));
+    let mut mesh = Mesh::new("trees_grown".into());
+    let mut used = 0u64;
+    let mut rest = Vec::new();
+    for b in order {
+        let Some(form) = &b.tree else { continue };
+        let Some(species) = catalog.species.get(&form.species) else {
+            rest.push(b);
+            continue;
+        };
+        let mut rng = crate::rng::feature_rng(params.seed, "tree", &b.id);
+        let mut grown = match species.grow(b.height, &mut rng) {
+            Ok(g) => g,
+            Err(reason) => {
+                stats.skipped.push(Skipped {
+                    layer: "trees".into(),
+                    file: file.to_string(),
+                    id: b.id.clone(),
+                    record: None,
+                    reason,
+                });
+                continue;
+            }
+        };
+        grown.skeleton.squeeze(form.squeeze);
+        let mut one = Mesh::new(String::new());
+        let place = Placement {
+            at: b.at,
+            ground: b.ground,
+            rotation: b.facing,
+        };
+        let look = Look::of(species, b.height, &params.trees.season);
+        tree::mesh_tree(
+            &grown.skeleton,
+            &species.mesh,
+            look,
+            Lod::Reduced,
+            place,
+            frame,
+            &mut one,
+        );
+        let bytes = one.obj_bytes_estimate();
+        if used + bytes > params.trees.max_tile_bytes {
+            rest.push(b);
+            continue;
+        }
+        used += bytes;
+        mesh.append(&one);
+        *stats
+            .trees_by_species
+            .entry(species.name.clone())
+            .or_default()
+            .entry("lod1".into())
+            .or_default() += 1;
+    }
+    Planted {
+        mesh: (!mesh.faces.is_empty()).then(|| mesh.finish()),
+        billboards: rest,
+    }
+}
