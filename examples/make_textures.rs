@@ -184,7 +184,9 @@ fn species_billboards() {
     for s in catalog.species.values() {
         let h = s.nominal_height();
         let mut rng = edo_city::rng::feature_rng(1, "tree", &s.name);
-        let grown = s.grow(h, &mut rng).expect("a shipped species grows");
+        let grown = s
+            .grow_in_city(h, &mut rng)
+            .expect("a shipped species grows");
         let look = Look::of(s, h, "summer");
         let mut mesh = Mesh::new(s.name.clone());
         let place = Placement {

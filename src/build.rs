@@ -360,6 +360,8 @@ fn write_city(
     }
     let textures = output::write_textures(&opts.out, texture_set)
         .map_err(|e| write_err(&opts.out.join("textures"), e))?;
+    let species = output::species::write_species(&opts.out, &plan, catalog, params)
+        .map_err(|e| write_err(&opts.out.join("species"), e))?;
 
     let files = layer_files(&opts.input, params);
     let tiles: Vec<&String> = plan
@@ -462,6 +464,7 @@ fn write_city(
         input: input_summary(&opts.input, opts.templates.as_deref(), &data, &plan),
         tiles: manifest_tiles,
         textures,
+        species,
     };
     timings.generate_and_write = t.elapsed();
     let t = Instant::now();
@@ -529,6 +532,7 @@ pub fn check(
         input: input_summary(input, templates, &data, &plan),
         tiles,
         textures: Vec::new(),
+        species: Vec::new(),
     };
     Ok(report::assemble_report(&manifest))
 }

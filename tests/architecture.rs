@@ -40,6 +40,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "generate",
             "materials",
             "growers",
+            "templates",
+            "rng",
         ],
     ),
     ("synth", &["rng", "model", "geom"]),

@@ -23,13 +23,11 @@ use crate::model::{
 };
 use crate::params::Params;
 use crate::rng::feature_rng;
+use crate::templates::species::SAMPLE_SEED;
 use crate::templates::{Catalog, Species};
 
 /// A grown tree fitted below this height, metres, is left out: there is no room for it.
 pub const MIN_HEIGHT: f64 = 1.5;
-
-/// The seed of the tree each species' crown shape (and billboard texture) is measured on.
-pub const SAMPLE_SEED: u64 = 1;
 
 /// Gives every tree of the plan its species, height and crown (see the module's doc).
 pub fn plant(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: &Params) {
@@ -284,7 +282,7 @@ impl Crowns {
             .or_insert_with(|| {
                 let h = s.nominal_height();
                 let mut rng = feature_rng(SAMPLE_SEED, "tree", &s.name);
-                let grown = s.grow(h, &mut rng)?;
+                let grown = s.grow_in_city(h, &mut rng)?;
                 let (r, _) = grown.skeleton.extent(s.mesh.leaf_size);
                 Ok(r / h)
             })

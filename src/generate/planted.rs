@@ -2,6 +2,11 @@
 //! each grown from its own skeleton (`feature_rng(seed, "tree", id)`) and meshed at LOD1 while
 //! the tile's `trees.max_tile_bytes` allows; a tree that does not fit is drawn as its
 //! species' billboard. All grown trees of a tile are one object, `trees_grown`.
+//!
+//! The budget counts each tree's OBJ bytes as [`Mesh::obj_bytes_estimate`] estimates them
+//! (a little above what the writer prints), so a tile never holds more than
+//! `max_tile_bytes` of grown trees. A tree whose species' trees met so far in the tile say
+//! it would not fit is not grown (the smallest bytes per square metre of height seen).
 
 use super::mesh::{Frame, Mesh};
 use super::tree::{self, Lod, Look, Placement};
@@ -31,14 +36,24 @@ pub fn build<'a>(
     let mut mesh = Mesh::new("trees_grown".into());
     let mut used = 0u64;
     let mut rest = Vec::new();
+    // Bytes per square metre of height of the trees of each species meshed so far: once the
+    // budget is nearly spent, a tree expected not to fit is not grown at all.
+    let mut density: std::collections::HashMap<&str, f64> = std::collections::HashMap::new();
     for b in order {
         let Some(form) = &b.tree else { continue };
         let Some(species) = catalog.species.get(&form.species) else {
             rest.push(b);
             continue;
         };
+        let expected = density
+            .get(species.name.as_str())
+            .map_or(0.0, |d| d * b.height * b.height);
+        if used as f64 + expected > params.trees.max_tile_bytes as f64 {
+            rest.push(b);
+            continue;
+        }
         let mut rng = crate::rng::feature_rng(params.seed, "tree", &b.id);
-        let mut grown = match species.grow(b.height, &mut rng) {
+        let mut grown = match species.grow_in_city(b.height, &mut rng) {
             Ok(g) => g,
             Err(reason) => {
                 stats.skipped.push(Skipped {
@@ -74,6 +89,11 @@ pub fn build<'a>(
             continue;
         }
         used += bytes;
+        let d = bytes as f64 / (b.height * b.height).max(1e-6);
+        density
+            .entry(species.name.as_str())
+            .and_modify(|x| *x = x.min(d))
+            .or_insert(d);
         mesh.append(&one);
         *stats
             .trees_by_species

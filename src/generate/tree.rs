@@ -375,7 +375,8 @@ fn leaves(
                 clump(sk, s, k as usize, leaf, size, put, mesh);
             }
         }
-        if !leafy || spec.leaf == LeafKind::None {
+        // Roots carry no leaves.
+        if !leafy || spec.leaf == LeafKind::None || sk.nodes[i].at[2] < 0.0 {
             continue;
         }
         let (at, d, r) = (sk.nodes[i].at, s.dir[i], s.reference[i]);

@@ -119,6 +119,29 @@ impl Skeleton {
         }
     }
 
+    /// Roots as a visitor sees them: the nodes below ground within `reach` of the trunk's
+    /// axis are raised to lie along the surface (sunk by a third of their radius), the
+    /// others dropped with everything that grows from them.
+    pub fn expose_roots(&mut self, reach: f64) {
+        let mut map: Vec<Option<u32>> = vec![None; self.nodes.len()];
+        let mut kept = Vec::with_capacity(self.nodes.len());
+        for (i, n) in self.nodes.iter().enumerate() {
+            let parent_kept = n.parent.is_none_or(|p| map[p as usize].is_some());
+            let below = n.at[2] < 0.0;
+            if !parent_kept || (below && n.at[0].hypot(n.at[1]) > reach) {
+                continue;
+            }
+            let mut node = *n;
+            node.parent = n.parent.and_then(|p| map[p as usize]);
+            if below {
+                node.at[2] = -node.radius / 3.0;
+            }
+            map[i] = Some(kept.len() as u32);
+            kept.push(node);
+        }
+        self.nodes = kept;
+    }
+
     /// Narrows the plant horizontally by `s` about its axis (x and y only).
     pub fn squeeze(&mut self, s: f64) {
         let xy = |p: &mut V3| {

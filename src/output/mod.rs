@@ -13,6 +13,7 @@ pub mod plan;
 pub mod render;
 pub mod report;
 pub mod sketch;
+pub mod species;
 pub mod text;
 
 use std::borrow::Cow;

@@ -356,6 +356,10 @@ pub struct Manifest {
     pub tiles: Vec<ManifestTile>,
     /// The texture files.
     pub textures: Vec<ManifestFile>,
+    /// `species/`: each planted species' LOD0 and `placements.csv` (empty when no tree has a
+    /// species).
+    #[serde(default)]
+    pub species: Vec<ManifestFile>,
 }
 
 /// One tile of the manifest.

@@ -88,6 +88,15 @@ pub const BUILTIN_SPECIES: &[(&str, &str)] = &[
     ("sugi.toml", include_str!("../../templates/trees/sugi.toml")),
     ("take.toml", include_str!("../../templates/trees/take.toml")),
     ("ume.toml", include_str!("../../templates/trees/ume.toml")),
+    ("kusu.toml", include_str!("../../templates/trees/kusu.toml")),
+    (
+        "matsu_kaze.toml",
+        include_str!("../../templates/trees/matsu_kaze.toml"),
+    ),
+    (
+        "shidare_zakura.toml",
+        include_str!("../../templates/trees/shidare_zakura.toml"),
+    ),
 ];
 
 /// Why the templates cannot be used: the build stops before it reads any data.

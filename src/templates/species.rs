@@ -13,9 +13,14 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::file::line_col;
+use crate::growers::colonization::{self, Attach, Envelope, Field, GroupReport};
 use crate::growers::lsystem::{LSystem, LsError, Place, TurtleParams, DEFAULT_MAX_SYMBOLS};
 use crate::growers::skeleton::Skeleton;
 use crate::materials;
+
+/// The seed of each species' sample tree: its crown shape is measured on it, its billboard
+/// texture rendered from it, and `<out>/species/` holds its LOD0.
+pub const SAMPLE_SEED: u64 = 1;
 
 /// The seasons a build may show (`trees.season`).
 pub const SEASONS: [&str; 4] = ["spring", "summer", "autumn", "winter"];
@@ -39,6 +44,19 @@ pub enum Grower {
         system: LSystem,
         /// What the turtle's symbols mean in metres and degrees.
         turtle: TurtleParams,
+    },
+    /// Space colonization with vector-field control, in groups (seed 001).
+    Colonization {
+        /// Step, influence, kill, field.
+        params: colonization::Params,
+        /// Trunk, branches, roots.
+        groups: Vec<colonization::Group>,
+        /// Radius of a branch tip, metres (at the species' nominal height).
+        tip_radius: f64,
+        /// The pipe model's exponent, 2 to 3.
+        pipe_exponent: f64,
+        /// Roots within this many metres of the trunk are shown above ground in the city.
+        roots_exposed: f64,
     },
 }
 
@@ -110,6 +128,18 @@ impl Species {
                 let sk = crate::growers::lsystem::turtle::interpret(&word, turtle);
                 (sk, serde_json::json!({ "symbols": word.modules.len() }))
             }
+            Grower::Colonization {
+                params,
+                groups,
+                tip_radius,
+                pipe_exponent,
+                ..
+            } => {
+                let (mut sk, reports) =
+                    colonization::grow(params, groups, rng).map_err(|e| fail(&e))?;
+                sk.pipe_radii(*tip_radius, *pipe_exponent);
+                (sk, colonization_report(params, &reports))
+            }
         };
         let (_, hi) = sk.bounds();
         if !(hi[2] > 0.0 && hi[2].is_finite()) {
@@ -123,6 +153,23 @@ impl Species {
             skeleton: sk,
             report,
         })
+    }
+
+    /// [`Species::grow`], then the roots as the city shows them: those within
+    /// `roots_exposed` of the trunk along the ground, the rest (hidden below it) dropped.
+    pub fn grow_in_city(&self, height: f64, rng: &mut Pcg64) -> Result<Grown, String> {
+        let mut g = self.grow(height, rng)?;
+        g.skeleton
+            .expose_roots(self.roots_exposed() * height / self.nominal_height());
+        Ok(g)
+    }
+
+    /// How far from the trunk roots show above ground (0 for none or an L-system).
+    pub fn roots_exposed(&self) -> f64 {
+        match &self.grower {
+            Grower::Colonization { roots_exposed, .. } => *roots_exposed,
+            Grower::LSystem { .. } => 0.0,
+        }
     }
 
     /// The leaf material shown in `season` (one of [`SEASONS`]).
@@ -149,6 +196,7 @@ struct RawSpecies {
     height: Spanned<[f64; 2]>,
     billboard: Spanned<String>,
     lsystem: Option<RawLSystem>,
+    colonization: Option<RawColonization>,
     mesh: RawMesh,
     #[serde(default)]
     season: BTreeMap<String, Spanned<String>>,
@@ -171,6 +219,73 @@ struct RawLSystem {
     elasticity: f64,
     #[serde(default = "default_max")]
     max_symbols: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawColonization {
+    step: f64,
+    influence: Option<f64>,
+    kill: Option<f64>,
+    #[serde(default = "default_iter")]
+    max_iter: usize,
+    #[serde(default)]
+    field: Option<RawField>,
+    #[serde(default)]
+    weight: f64,
+    #[serde(default)]
+    twist: f64,
+    tip_radius: f64,
+    #[serde(default = "default_pipe")]
+    pipe_exponent: f64,
+    #[serde(default)]
+    roots_exposed: f64,
+    group: Vec<Spanned<RawGroup>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawField {
+    kind: String,
+    #[serde(default)]
+    vector: Option<[f64; 3]>,
+    #[serde(default)]
+    strength: f64,
+    #[serde(default)]
+    rise: f64,
+    #[serde(default)]
+    at: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawGroup {
+    name: String,
+    points: usize,
+    envelope: RawEnvelope,
+    /// "base", or [low, high] shares of the first group's height.
+    #[serde(default)]
+    attach: Option<toml::Value>,
+    weight: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawEnvelope {
+    shape: String,
+    center: Option<[f64; 3]>,
+    radii: Option<[f64; 3]>,
+    base: Option<f64>,
+    top: Option<f64>,
+    radius: Option<f64>,
+    file: Option<String>,
+}
+
+fn default_iter() -> usize {
+    1000
+}
+fn default_pipe() -> f64 {
+    2.5
 }
 
 fn default_decay() -> f64 {
@@ -315,9 +430,18 @@ pub fn parse(file: &str, text: &str) -> Result<Species, String> {
             };
             ("lsystem", lsystem(l, file, text)?)
         }
+        "colonization" => {
+            let Some(c) = raw.colonization else {
+                return Err(format!(
+                    "{}: method \"colonization\" needs a [colonization] table",
+                    at(raw.method.span())
+                ));
+            };
+            ("colonization", colonization_grower(c, file, text)?)
+        }
         other => {
             return Err(format!(
-                "{}: `method` must be \"lsystem\", got \"{other}\"",
+                "{}: `method` must be \"lsystem\" or \"colonization\", got \"{other}\"",
                 at(raw.method.span())
             ))
         }
@@ -394,5 +518,244 @@ fn lsystem(l: RawLSystem, file: &str, text: &str) -> Result<Grower, String> {
             tropism: l.tropism,
             elasticity: l.elasticity,
         },
+    })
+}
+
+/// The `[colonization]` table: parameters checked, envelopes built (a hull read from its OBJ,
+/// relative to the species file).
+fn colonization_grower(c: RawColonization, file: &str, text: &str) -> Result<Grower, String> {
+    let at = |span: std::ops::Range<usize>| {
+        let (l, col) = line_col(text, span.start);
+        format!("{file}:{l}:{col}")
+    };
+    let field =
+        match &c.field {
+            None => Field::None,
+            Some(f) => match f.kind.as_str() {
+                "none" => Field::None,
+                "constant" => Field::Constant(f.vector.ok_or_else(|| {
+                    format!("{file}: a constant field needs `vector = [x, y, z]`")
+                })?),
+                "vortex" => Field::Vortex {
+                    strength: f.strength,
+                    rise: f.rise,
+                },
+                "point" => Field::Toward(
+                    f.at.ok_or_else(|| format!("{file}: a point field needs `at = [x, y, z]`"))?,
+                ),
+                other => {
+                    return Err(format!(
+                    "{file}: `colonization.field.kind` must be none, constant, vortex or point, \
+                     got \"{other}\""
+                ))
+                }
+            },
+        };
+    let params = colonization::Params {
+        step: c.step,
+        influence: c.influence.unwrap_or(10.0 * c.step),
+        kill: c.kill.unwrap_or(2.0 * c.step),
+        max_iter: c.max_iter,
+        field,
+        weight: c.weight,
+        twist: c.twist.to_radians(),
+    };
+    if let Some(p) = params.problem() {
+        return Err(format!("{file}: [colonization]: {p}"));
+    }
+    if !(c.tip_radius.is_finite() && c.tip_radius > 0.0 && c.tip_radius < 1.0) {
+        return Err(format!(
+            "{file}: `colonization.tip_radius` must be from 0 to 1 metre"
+        ));
+    }
+    if !(2.0..=3.0).contains(&c.pipe_exponent) {
+        return Err(format!(
+            "{file}: `colonization.pipe_exponent` must be from 2 to 3"
+        ));
+    }
+    if !(c.roots_exposed.is_finite() && (0.0..=50.0).contains(&c.roots_exposed)) {
+        return Err(format!(
+            "{file}: `colonization.roots_exposed` must be from 0 to 50 metres"
+        ));
+    }
+    if c.group.is_empty() {
+        return Err(format!(
+            "{file}: [colonization] needs at least one [[colonization.group]]"
+        ));
+    }
+    let mut groups = Vec::new();
+    for g in &c.group {
+        let here = at(g.span());
+        let g = g.get_ref();
+        if g.points == 0 || g.points > colonization::MAX_POINTS {
+            return Err(format!(
+                "{here}: group `{}`: `points` must be from 1 to {}",
+                g.name,
+                colonization::MAX_POINTS
+            ));
+        }
+        let attach = match &g.attach {
+            None => Attach::Base,
+            Some(toml::Value::String(s)) if s == "base" => Attach::Base,
+            Some(toml::Value::Array(a)) if a.len() == 2 => {
+                let num = |v: &toml::Value| v.as_float().or(v.as_integer().map(|i| i as f64));
+                match (num(&a[0]), num(&a[1])) {
+                    (Some(lo), Some(hi)) if (0.0..=1.0).contains(&lo) && lo <= hi && hi <= 1.0 => {
+                        Attach::Stem(lo, hi)
+                    }
+                    _ => {
+                        return Err(format!(
+                            "{here}: group `{}`: `attach` = [low, high] with 0 <= low <= high <= 1",
+                            g.name
+                        ))
+                    }
+                }
+            }
+            Some(_) => {
+                return Err(format!(
+                    "{here}: group `{}`: `attach` is \"base\" or [low, high]",
+                    g.name
+                ))
+            }
+        };
+        groups.push(colonization::Group {
+            name: g.name.clone(),
+            envelope: envelope(&g.envelope, file)
+                .map_err(|e| format!("{here}: group `{}`: {e}", g.name))?,
+            points: g.points,
+            attach,
+            weight: g.weight,
+        });
+    }
+    Ok(Grower::Colonization {
+        params,
+        groups,
+        tip_radius: c.tip_radius,
+        pipe_exponent: c.pipe_exponent,
+        roots_exposed: c.roots_exposed,
+    })
+}
+
+fn envelope(e: &RawEnvelope, file: &str) -> Result<Envelope, String> {
+    let pos = |v: f64| v.is_finite() && v > 0.0;
+    let need = |v: Option<f64>, key: &str| {
+        v.filter(|v| v.is_finite())
+            .ok_or_else(|| format!("envelope `{}` needs `{key}`", e.shape))
+    };
+    let radii = || {
+        e.radii
+            .filter(|r| r.iter().all(|&v| pos(v)))
+            .ok_or_else(|| format!("envelope `{}` needs positive `radii = [x, y, z]`", e.shape))
+    };
+    Ok(match e.shape.as_str() {
+        "ellipsoid" => Envelope::Ellipsoid {
+            center: e.center.unwrap_or([0.0; 3]),
+            radii: radii()?,
+        },
+        "below_ground" => Envelope::BelowGround { radii: radii()? },
+        "cone" | "cylinder" => {
+            let (base, top, radius) = (need(e.base, "base")?, need(e.top, "top")?, need(e.radius, "radius")?);
+            if !(top > base && radius > 0.0) {
+                return Err("needs top > base and a positive radius".into());
+            }
+            if e.shape == "cone" {
+                Envelope::Cone { base, top, radius }
+            } else {
+                Envelope::Cylinder { base, top, radius }
+            }
+        }
+        "hull" => {
+            let name = e.file.as_deref().ok_or("envelope `hull` needs `file` (an OBJ)")?;
+            let path = std::path::Path::new(file)
+                .parent()
+                .unwrap_or(std::path::Path::new(""))
+                .join(name);
+            let obj = std::fs::read_to_string(&path)
+                .map_err(|err| format!("cannot read the hull {}: {err}", path.display()))?;
+            let triangles = obj_triangles(&obj)
+                .map_err(|err| format!("hull {}: {err}", path.display()))?;
+            Envelope::Hull { triangles }
+        }
+        other => {
+            return Err(format!(
+                "envelope shape must be ellipsoid, below_ground, cone, cylinder or hull, got \"{other}\""
+            ))
+        }
+    })
+}
+
+/// The triangles of an OBJ's faces (fans), in the growers' axes: OBJ is y-up, so (x, y, z)
+/// of the file is (x, -z, y) here.
+fn obj_triangles(text: &str) -> Result<Vec<[[f64; 3]; 3]>, String> {
+    let mut v: Vec<[f64; 3]> = Vec::new();
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let mut w = line.split_whitespace();
+        match w.next() {
+            Some("v") => {
+                let c: Vec<f64> = w.take(3).filter_map(|t| t.parse().ok()).collect();
+                if c.len() != 3 || !c.iter().all(|x| x.is_finite()) {
+                    return Err(format!("line {}: a vertex needs three numbers", n + 1));
+                }
+                v.push([c[0], -c[2], c[1]]);
+            }
+            Some("f") => {
+                let idx: Vec<usize> = w
+                    .map(|t| {
+                        let i: i64 = t.split('/').next().unwrap_or("").parse().unwrap_or(0);
+                        if i < 0 {
+                            (v.len() as i64 + i) as usize
+                        } else {
+                            (i - 1).max(0) as usize
+                        }
+                    })
+                    .collect();
+                if idx.len() < 3 || idx.iter().any(|&i| i >= v.len()) {
+                    return Err(format!("line {}: a face names a missing vertex", n + 1));
+                }
+                for k in 1..idx.len() - 1 {
+                    out.push([v[idx[0]], v[idx[k]], v[idx[k + 1]]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    if out.len() < 4 {
+        return Err("fewer than four triangles: not a closed hull".into());
+    }
+    Ok(out)
+}
+
+/// The report keys of a colonized tree: each group's, and their sums (the first group that
+/// did not use up its points gives the stop reason, else `all_killed`).
+fn colonization_report(p: &colonization::Params, reports: &[GroupReport]) -> serde_json::Value {
+    let group = |r: &GroupReport| {
+        serde_json::json!({
+            "name": r.name,
+            "stop": r.stop.as_str(),
+            "iterations": r.iterations,
+            "nodes": r.nodes,
+            "edges": r.edges,
+            "points_left": r.points_left,
+            "oscillations": r.oscillations,
+            "step": p.step,
+            "influence": p.influence,
+            "kill": p.kill,
+        })
+    };
+    let stop = reports
+        .iter()
+        .map(|r| r.stop)
+        .find(|s| *s != colonization::Stop::AllKilled)
+        .unwrap_or(colonization::Stop::AllKilled);
+    serde_json::json!({
+        "stop": stop.as_str(),
+        "iterations": reports.iter().map(|r| r.iterations).sum::<usize>(),
+        "edges": reports.iter().map(|r| r.edges).sum::<usize>(),
+        "points_left": reports.iter().map(|r| r.points_left).sum::<usize>(),
+        "step": p.step,
+        "influence": p.influence,
+        "kill": p.kill,
+        "groups": reports.iter().map(group).collect::<Vec<_>>(),
     })
 }

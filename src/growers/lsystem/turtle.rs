@@ -209,8 +209,8 @@ fn bend(s: &mut State, p: &TurtleParams) {
 
 #[cfg(test)]
 mod tests {
-    use crate::growers::lsystem::grammar::parse_axiom;
     use super::*;
+    use crate::growers::lsystem::grammar::parse_axiom;
 
     fn end_of(word: &str, angle: f64) -> V3 {
         let sk = interpret(

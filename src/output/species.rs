@@ -1,0 +1,126 @@
+//! `<out>/species/`: for users who instance trees themselves (Blender's collection
+//! instances, a game engine), the LOD0 of every species the build planted, grown from its
+//! sample tree, and `placements.csv`: where each tree of the city stands, turned and scaled.
+//!
+//! The tiles' grown trees are each grown from their own skeleton; an instance of the
+//! sample is the same species at the same height and turn, not the same branches.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::report::ManifestFile;
+use super::{atomic, mtl, obj, sha256_hex};
+use crate::generate::mesh::{Frame, Mesh};
+use crate::generate::tree::{self, Lod, Look, Placement};
+use crate::model::Plan;
+use crate::params::Params;
+use crate::templates::species::SAMPLE_SEED;
+use crate::templates::Catalog;
+
+/// Writes the species directory (or removes an earlier build's when no tree has a species);
+/// returns its files for the manifest.
+pub fn write_species(
+    out: &Path,
+    plan: &Plan,
+    catalog: &Catalog,
+    params: &Params,
+) -> std::io::Result<Vec<ManifestFile>> {
+    let dir = out.join("species");
+    let trees: Vec<_> = plan
+        .billboards
+        .values()
+        .flatten()
+        .filter_map(|b| b.tree.as_ref().map(|t| (b, t)))
+        .collect();
+    if trees.is_empty() {
+        if dir.is_dir() {
+            std::fs::remove_dir_all(&dir)?;
+        }
+        return Ok(Vec::new());
+    }
+    std::fs::create_dir_all(&dir)?;
+    atomic::remove_leftover_temporaries(&dir);
+    let mut files = Vec::new();
+    let mut put = |name: String, bytes: &[u8]| -> std::io::Result<()> {
+        atomic::write_atomic(&dir.join(&name), bytes)?;
+        files.push(ManifestFile {
+            path: format!("species/{name}"),
+            bytes: bytes.len() as u64,
+            sha256: sha256_hex(bytes),
+        });
+        Ok(())
+    };
+    let used: BTreeMap<&str, ()> = trees
+        .iter()
+        .map(|(_, t)| (t.species.as_str(), ()))
+        .collect();
+    let mut heights = BTreeMap::new();
+    for name in used.keys() {
+        let Some(s) = catalog.species.get(*name) else {
+            continue;
+        };
+        let h = s.nominal_height();
+        let mut rng = crate::rng::feature_rng(SAMPLE_SEED, "tree", &s.name);
+        let Ok(grown) = s.grow_in_city(h, &mut rng) else {
+            continue;
+        };
+        let mut mesh = Mesh::new(format!("{}_lod0", s.name));
+        let place = Placement {
+            at: geo_types::Coord { x: 0.0, y: 0.0 },
+            ground: 0.0,
+            rotation: 0.0,
+        };
+        let look = Look::of(s, h, &params.trees.season);
+        let frame = Frame { origin: [0.0, 0.0] };
+        tree::mesh_tree(
+            &grown.skeleton,
+            &s.mesh,
+            look,
+            Lod::Full,
+            place,
+            frame,
+            &mut mesh,
+        );
+        let mut buf = Vec::new();
+        obj::write_tile(&mut buf, &s.name, [0.0, 0.0], [&mesh]);
+        put(format!("{}.obj", s.name), &buf)?;
+        put(format!("{}.mtl", s.name), mtl::mtl_text().as_bytes())?;
+        heights.insert(s.name.clone(), h);
+    }
+    let mut csv = String::from("id,tile,species,lot,x,y,z,rotation_deg,scale,squeeze,style\n");
+    for (b, t) in &trees {
+        let Some(h) = heights.get(&t.species) else {
+            continue;
+        };
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{:.3},{:.3},{:.3},{:.2},{:.4},{:.4},{}",
+            quote(&b.id),
+            b.tile,
+            t.species,
+            quote(t.lot.as_deref().unwrap_or("")),
+            b.at.x - plan.origin[0],
+            b.ground,
+            -(b.at.y - plan.origin[1]),
+            b.facing.to_degrees(),
+            b.height / h,
+            t.squeeze,
+            match catalog.species.get(&t.species) {
+                Some(s) if t.grown => s.method,
+                _ => "billboard",
+            }
+        );
+    }
+    put("placements.csv".into(), csv.as_bytes())?;
+    Ok(files)
+}
+
+/// A CSV field, quoted when it holds a comma, a quote or a line break.
+fn quote(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
