@@ -398,23 +398,27 @@ fn write_city(
                 };
                 let mut meshes =
                     generate::generate_tile(&tile, catalog, params, plan.origin, &files);
-                meshes.stats.tree_bytes = output::obj_bytes(
-                    meshes
-                        .meshes
-                        .iter()
-                        .filter(|m| m.name == "trees" || m.name == "trees_grown"),
-                ) as u64;
                 gen_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
                 let t = Instant::now();
                 let written = output::write_tile(&opts.out, id, plan.origin, &meshes.meshes)
                     .map_err(|e| write_err(&tiles_dir.join(format!("{id}.obj")), e));
                 write_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
                 progress.inc(1);
-                written.map(|(obj, mtl)| report::ManifestTile {
-                    id: id.clone(),
-                    obj,
-                    mtl,
-                    stats: meshes.stats,
+                written.map(|(obj, mtl, sizes)| {
+                    // The bytes the trees' objects took in the file, exactly.
+                    meshes.stats.tree_bytes = meshes
+                        .meshes
+                        .iter()
+                        .zip(&sizes)
+                        .filter(|(m, _)| m.name == "trees" || m.name == "trees_grown")
+                        .map(|(_, &n)| n as u64)
+                        .sum();
+                    report::ManifestTile {
+                        id: id.clone(),
+                        obj,
+                        mtl,
+                        stats: meshes.stats,
+                    }
                 })
             })
             .collect()

@@ -174,7 +174,8 @@ pub struct TreeArgs {
     /// Write its numbers as JSON: triangles, vertices, height, crown width, bytes per LOD.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Draw the chosen LOD seen from the south on a pale sky (PNG, 512 pixels tall).
+    /// Draw the chosen LOD seen from the south on a pale sky (PNG, 512 pixels tall); without
+    /// `--species`, a contact sheet of every species.
     #[arg(long)]
     pub png: Option<PathBuf>,
 }
@@ -195,6 +196,9 @@ fn origin() -> Placement {
 pub fn tree_command(args: TreeArgs) -> Result<()> {
     let catalog = Catalog::load(args.templates.as_deref())?;
     let Some(name) = &args.species else {
+        if let Some(path) = &args.png {
+            return species_sheet(&catalog, &args, path);
+        }
         for s in catalog.species.values() {
             say!(
                 "{:<16} {:<4} {:<13} {:>4.1}-{:<4.1} m  {}",
@@ -253,15 +257,7 @@ pub fn tree_command(args: TreeArgs) -> Result<()> {
     }
     if let Some(path) = &args.png {
         let (r, top) = tree::extent(&grown.skeleton, species.mesh.leaf_size);
-        let half = r.max(top / 2.0) * 1.05;
-        let window = [-half, half, -0.02 * top, 2.0 * half - 0.02 * top];
-        let img = edo_city::output::render::render(
-            std::slice::from_ref(chosen),
-            edo_city::output::render::View::South,
-            window,
-            (512, 512),
-            &edo_city::output::render::shipped_texture,
-        );
+        let img = side_view(chosen, r, top, 512);
         let png = edo_city::output::render::on_sky(&img);
         write_atomic(path, &png).with_context(|| format!("cannot write {}", path.display()))?;
     }
@@ -310,5 +306,49 @@ pub fn tree_command(args: TreeArgs) -> Result<()> {
         tree::triangles(&meshes[1]),
         tree::triangles(&meshes[2])
     );
+    Ok(())
+}
+
+/// The side view of `lod` of one tree, framed square around it.
+fn side_view(mesh: &Mesh, r: f64, top: f64, px: u32) -> image::RgbaImage {
+    let half = r.max(top / 2.0) * 1.05;
+    let window = [-half, half, -0.02 * top, 2.0 * half - 0.02 * top];
+    edo_city::output::render::render(
+        std::slice::from_ref(mesh),
+        edo_city::output::render::View::South,
+        window,
+        (px, px),
+        &edo_city::output::render::shipped_texture,
+    )
+}
+
+/// `edo-city tree --png sheet.png`: every species at its nominal height, five to a row.
+fn species_sheet(catalog: &Catalog, args: &TreeArgs, path: &std::path::Path) -> Result<()> {
+    let lod = Lod::from_number(args.lod).context("--lod must be 0, 1 or 2")?;
+    if !SEASONS.contains(&args.season.as_str()) {
+        bail!("--season must be one of {}", SEASONS.join(", "));
+    }
+    let mut cells = Vec::new();
+    for s in catalog.species.values() {
+        let h = s.nominal_height();
+        let mut rng = edo_city::rng::feature_rng(args.seed, "tree", &s.name);
+        let grown = s.grow_in_city(h, &mut rng).map_err(anyhow::Error::msg)?;
+        let look = Look::of(s, h, &args.season);
+        let mut mesh = Mesh::new(s.name.clone());
+        tree::mesh_tree(
+            &grown.skeleton,
+            &s.mesh,
+            look,
+            lod,
+            origin(),
+            frame(),
+            &mut mesh,
+        );
+        let (r, top) = tree::extent(&grown.skeleton, s.mesh.leaf_size);
+        cells.push((s.name.clone(), side_view(&mesh, r, top, 320)));
+    }
+    let png = edo_city::output::render::sheet(&cells, 5).context("cannot draw the sheet")?;
+    write_atomic(path, &png).with_context(|| format!("cannot write {}", path.display()))?;
+    say!("{} species drawn into {}", cells.len(), path.display());
     Ok(())
 }

@@ -31,15 +31,16 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Writes `<out>/tiles/<tile>.obj` and `.mtl`; returns their manifest entries.
+/// Writes `<out>/tiles/<tile>.obj` and `.mtl`; returns their manifest entries and the bytes
+/// of each mesh's object in the OBJ.
 pub fn write_tile(
     out: &Path,
     tile: &str,
     origin: [f64; 2],
     meshes: &[Mesh],
-) -> std::io::Result<(ManifestFile, ManifestFile)> {
+) -> std::io::Result<(ManifestFile, ManifestFile, Vec<usize>)> {
     let mut obj = Vec::with_capacity(meshes.len() * 4096);
-    obj::write_tile(&mut obj, tile, origin, meshes);
+    let sizes = obj::write_tile(&mut obj, tile, origin, meshes);
     let mtl = mtl::mtl_text().into_bytes();
     let dir = out.join("tiles");
     atomic::write_atomic(&dir.join(format!("{tile}.obj")), &obj)?;
@@ -55,6 +56,7 @@ pub fn write_tile(
             bytes: mtl.len() as u64,
             sha256: sha256_hex(&mtl),
         },
+        sizes,
     ))
 }
 
@@ -147,10 +149,10 @@ pub fn write_model(obj_path: &Path, meshes: &[Mesh], texture_set: &str) -> Resul
     Ok(textures.len())
 }
 
-/// The bytes `meshes` take in an OBJ file, without the file's header.
+/// The bytes `meshes` take in an OBJ file of their own, without the file's header.
 pub fn obj_bytes<'a>(meshes: impl IntoIterator<Item = &'a Mesh>) -> usize {
-    let (mut buf, mut header) = (Vec::new(), Vec::new());
-    obj::write_tile(&mut buf, "x", [0.0, 0.0], meshes);
-    obj::write_tile(&mut header, "x", [0.0, 0.0], std::iter::empty());
-    buf.len() - header.len()
+    let mut buf = Vec::new();
+    obj::write_tile(&mut buf, "x", [0.0, 0.0], meshes)
+        .iter()
+        .sum()
 }

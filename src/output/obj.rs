@@ -32,13 +32,13 @@ fn push_fixed(buf: &mut Vec<u8>, v: i64, scale: i64, digits: usize) {
     buf.extend_from_slice(frac);
 }
 
-/// Writes a whole tile into `buf`.
+/// Writes a whole tile into `buf`; returns the bytes each mesh's object took.
 pub fn write_tile<'a>(
     buf: &mut Vec<u8>,
     tile: &str,
     origin: [f64; 2],
     meshes: impl IntoIterator<Item = &'a Mesh>,
-) {
+) -> Vec<usize> {
     let _ = write!(
         buf,
         "# edo-city {} tile {tile}\n\
@@ -51,7 +51,9 @@ pub fn write_tile<'a>(
     );
     let mut itoa_buf = itoa::Buffer::new();
     let (mut v_base, mut vt_base) = (1u64, 1u64);
+    let mut sizes = Vec::new();
     for mesh in meshes {
+        let start = buf.len();
         buf.extend_from_slice(b"o ");
         buf.extend_from_slice(mesh.name.as_bytes());
         buf.push(b'\n');
@@ -93,7 +95,9 @@ pub fn write_tile<'a>(
         }
         v_base += mesh.positions.len() as u64;
         vt_base += mesh.uvs.len() as u64;
+        sizes.push(buf.len() - start);
     }
+    sizes
 }
 
 #[cfg(test)]

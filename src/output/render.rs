@@ -195,6 +195,35 @@ pub fn on_sky(img: &RgbaImage) -> Vec<u8> {
     bytes
 }
 
+/// A contact sheet: `cells` (label, picture; all the same size) in rows of `columns` on a pale
+/// sky, each labelled below, as PNG bytes.
+pub fn sheet(cells: &[(String, RgbaImage)], columns: usize) -> Option<Vec<u8>> {
+    let (w, h) = cells.first().map(|c| c.1.dimensions())?;
+    let label = 24u32;
+    let columns = columns.max(1);
+    let rows = cells.len().div_ceil(columns);
+    let mut pm = tiny_skia::Pixmap::new(w * columns as u32, (h + label) * rows as u32)?;
+    pm.fill(tiny_skia::Color::from_rgba8(236, 240, 244, 255));
+    let width = pm.width();
+    for (k, (name, img)) in cells.iter().enumerate() {
+        let (x0, y0) = ((k % columns) as u32 * w, (k / columns) as u32 * (h + label));
+        let data = pm.data_mut();
+        for (x, y, p) in img.enumerate_pixels() {
+            let t = y as f32 / h as f32;
+            let sky = [200.0 + 30.0 * t, 220.0 + 10.0 * t, 240.0 - 20.0 * t];
+            let a = f32::from(p.0[3]) / 255.0;
+            let i = (((y0 + y) * width + x0 + x) * 4) as usize;
+            for c in 0..3 {
+                data[i + c] = (f32::from(p.0[c]) * a + sky[c] * (1.0 - a)).round() as u8;
+            }
+            data[i + 3] = 255;
+        }
+        let tx = x0 as f32 + (w.saturating_sub(super::text::text_width(name, 2)) / 2) as f32;
+        super::text::draw_text(&mut pm, tx, (y0 + h + 4) as f32, name, 2, [40, 40, 40]);
+    }
+    pm.encode_png().ok()
+}
+
 /// The shipped texture of a material file name, decoded.
 pub fn shipped_texture(name: &str) -> Option<RgbaImage> {
     let bytes = crate::materials::TEXTURES
