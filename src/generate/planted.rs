@@ -6,7 +6,7 @@
 //! The budget counts each tree's OBJ bytes as [`Mesh::obj_bytes_estimate`] estimates them
 //! (a little above what the writer prints), so a tile never holds more than
 //! `max_tile_bytes` of grown trees. A tree whose species' trees met so far in the tile say
-//! it would not fit is not grown (the smallest bytes per square metre of height seen).
+//! it would not fit is not grown (the most bytes per square metre of height seen).
 
 use super::mesh::{Frame, Mesh};
 use super::tree::{self, Lod, Look, Placement};
@@ -92,7 +92,7 @@ pub fn build<'a>(
         let d = bytes as f64 / (b.height * b.height).max(1e-6);
         density
             .entry(species.name.as_str())
-            .and_modify(|x| *x = x.min(d))
+            .and_modify(|x| *x = x.max(d))
             .or_insert(d);
         mesh.append(&one);
         *stats

@@ -316,22 +316,6 @@ impl Grid {
         let k = self.key(p);
         self.cells.entry(k).or_default().push(i);
     }
-
-    /// Every entry of the 27 cells around `p` (a superset of those within `cell`).
-    fn around(&self, p: V3) -> impl Iterator<Item = u32> + '_ {
-        let k = self.key(p);
-        (-1..=1).flat_map(move |dx| {
-            (-1..=1).flat_map(move |dy| {
-                (-1..=1).flat_map(move |dz| {
-                    self.cells
-                        .get(&[k[0] + dx, k[1] + dy, k[2] + dz])
-                        .into_iter()
-                        .flatten()
-                        .copied()
-                })
-            })
-        })
-    }
 }
 
 /// Each attraction point's nearest growing node within `influence`, kept up to date as
@@ -360,14 +344,26 @@ impl<'a> Nearest<'a> {
     /// Node `n` at `at` now grows: the points within `influence` that it is nearer to take
     /// it (ties keep the lower index, which is the older node).
     fn add(&mut self, n: u32, at: V3) {
-        for a in self.grid.around(at) {
-            let a = a as usize;
-            if !self.alive[a] {
-                continue;
-            }
-            let d = v3::dist(self.points[a], at);
-            if d < self.grid.cell && self.best[a].is_none_or(|(_, bd)| d < bd) {
-                self.best[a] = Some((n, d));
+        let k = self.grid.key(at);
+        let cell = self.grid.cell;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(list) = self.grid.cells.get_mut(&[k[0] + dx, k[1] + dy, k[2] + dz])
+                    else {
+                        continue;
+                    };
+                    // Dead points leave the grid as they are met, so the crown's filled
+                    // parts cost nothing.
+                    list.retain(|&a| self.alive[a as usize]);
+                    for &a in list.iter() {
+                        let a = a as usize;
+                        let d = v3::dist(self.points[a], at);
+                        if d < cell && self.best[a].is_none_or(|(_, bd)| d < bd) {
+                            self.best[a] = Some((n, d));
+                        }
+                    }
+                }
             }
         }
     }
