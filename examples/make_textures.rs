@@ -531,6 +531,30 @@ fn main() {
     );
     bark();
     bamboo_culm();
+    // The rock garden's raked gravel (rake lines along the texture's width, 2 m a repeat,
+    // eight furrows), its moss and its stones.
+    let mut c = Canvas::new(128, 128);
+    c.band(0.0, 1.0, |x, y| {
+        let furrow = ((y as f32 / 128.0 * std::f32::consts::TAU * 8.0).sin()) * 0.09;
+        shade([214, 208, 196], furrow + noise(x, y, 98) * 0.07)
+    });
+    c.save("gravel_raked.png");
+    let mut c = Canvas::new(64, 64);
+    c.band(0.0, 1.0, |x, y| {
+        shade(
+            [72, 104, 50],
+            noise(x / 2, y / 2, 99) * 0.25 + noise(x, y, 100) * 0.1,
+        )
+    });
+    c.save("moss.png");
+    let mut c = Canvas::new(64, 64);
+    c.band(0.0, 1.0, |x, y| {
+        shade(
+            [118, 114, 108],
+            noise(x / 4, y / 3, 101) * 0.2 + noise(x, y, 102) * 0.08,
+        )
+    });
+    c.save("stone.png");
     species_billboards();
 
     // Eight people in kimono of the period's common dyes (indigo, brown, grey, persimmon).

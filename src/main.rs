@@ -21,6 +21,7 @@ mod cli;
 
 use cli::args::*;
 use cli::commands::*;
+use cli::garden::*;
 use cli::plants::*;
 use cli::Problems;
 
@@ -70,6 +71,9 @@ enum Command {
     /// Grow one tree of a species and write a level of detail (OBJ) and its numbers (JSON);
     /// without `--species`, list the species.
     Tree(TreeArgs),
+    /// Design a dry rock garden (karesansui) by the GA of seed 000 with the Ryoanji rules;
+    /// `--interactive` shows each generation's best and breeds from your picks.
+    Garden(GardenArgs),
 }
 
 fn main() -> ExitCode {
@@ -108,6 +112,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Boids(args) => boids_command(args),
         Command::Lsystem(args) => lsystem_command(args),
         Command::Tree(args) => tree_command(args),
+        Command::Garden(args) => garden_command(args),
         Command::Init(args) => init_command(args),
         Command::Params => params_command(),
         Command::Template(args) => template_command(args),

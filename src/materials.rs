@@ -270,6 +270,30 @@ pub const MATERIALS: &[Material] = &[
         alpha: false,
         texture: Some("bamboo_culm.png"),
     },
+    Material {
+        name: "gravel_raked",
+        kd: [0.82, 0.80, 0.76],
+        alpha: false,
+        texture: Some("gravel_raked.png"),
+    },
+    Material {
+        name: "moss",
+        kd: [0.30, 0.42, 0.20],
+        alpha: false,
+        texture: Some("moss.png"),
+    },
+    Material {
+        name: "stone",
+        kd: [0.45, 0.44, 0.42],
+        alpha: false,
+        texture: Some("stone.png"),
+    },
+    Material {
+        name: "rake_line",
+        kd: [0.62, 0.60, 0.56],
+        alpha: false,
+        texture: None,
+    },
 ];
 
 /// Texture files, compiled in: (file name, PNG bytes).
@@ -349,6 +373,12 @@ pub const TEXTURES: &[(&str, &[u8])] = &[
         "leaf_willow.png",
         include_bytes!("../textures/leaf_willow.png"),
     ),
+    (
+        "gravel_raked.png",
+        include_bytes!("../textures/gravel_raked.png"),
+    ),
+    ("moss.png", include_bytes!("../textures/moss.png")),
+    ("stone.png", include_bytes!("../textures/stone.png")),
     (
         "bamboo_culm.png",
         include_bytes!("../textures/bamboo_culm.png"),

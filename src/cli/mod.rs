@@ -2,6 +2,7 @@
 
 pub mod args;
 pub mod commands;
+pub mod garden;
 pub mod plants;
 pub mod progress;
 pub mod summary;

@@ -6,6 +6,7 @@
 pub mod billboards;
 pub mod clip;
 pub mod fences;
+pub mod garden;
 pub mod instance;
 pub mod kura;
 pub mod machiya;
