@@ -39,6 +39,18 @@ fn main() {
         });
         println!("colonization {points:>6} points: {ms:8.1} ms ({nodes} nodes)");
     }
+    for (w, d) in [(25.0, 25.0), (25.0, 10.0)] {
+        let s = edo_city::growers::garden::Settings::sized(w, d);
+        let p = edo_city::growers::garden::ga::GaParams::default();
+        let ms = best_ms(|| {
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+            edo_city::growers::garden::ga::run(&s, &p, 20, &mut rng);
+        });
+        println!(
+            "garden GA {w} x {d}: {:.0} generations a second at population 100",
+            20.0 / (ms / 1000.0)
+        );
+    }
     let catalog = edo_city::templates::Catalog::load(None).unwrap();
     for s in catalog.species.values() {
         let h = s.nominal_height();

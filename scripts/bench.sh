@@ -66,3 +66,27 @@ for i in $(seq 1 "$RUNS"); do
   $bin build "$work/town-30052" --out "$work/out-boids" --params "$work/boids.toml" --quiet --force --timings 2>&1 \
     | sed -n "s/^timings: /run $i: /p"
 done
+
+echo "== the growers (examples/bench_growers.rs: colonization at 2,000 and 20,000 points, the garden GA, each species' skeleton and LODs)"
+cargo run --release --quiet --example bench_growers
+
+echo "== grown trees in the city (30,052 lots; trees.style; compare with the default runs above, which have billboards)"
+for style in lsystem colonization; do
+  printf '[trees]\nstyle = "%s"\n' "$style" > "$work/$style.toml"
+  rm -rf "$work/out-$style"
+  start=$(date +%s.%N)
+  $bin build "$work/town-30052" --out "$work/out-$style" --params "$work/$style.toml" --quiet
+  end=$(date +%s.%N)
+  printf '%-12s %.2f s, %s MB of tiles, largest tile %s bytes\n' "$style" "$(echo "$end - $start" | bc -l)" \
+    "$(du -sm --apparent-size "$work/out-$style/tiles" | cut -f1)" \
+    "$(python3 -c "import json; r=json.load(open('$work/out-$style/report.json')); print(max(t['obj_bytes'] for t in r['tiles']))")"
+done
+
+echo "== rock gardens in the city (30,052 lots, garden.enabled = false against the default runs above)"
+printf '[garden]\nenabled = false\n' > "$work/nogarden.toml"
+for i in $(seq 1 "$RUNS"); do
+  start=$(date +%s.%N)
+  $bin build "$work/town-30052" --out "$work/out-nogarden" --params "$work/nogarden.toml" --quiet --force
+  end=$(date +%s.%N)
+  printf 'no gardens run %d: %.2f s\n' "$i" "$(echo "$end - $start" | bc -l)"
+done

@@ -682,6 +682,7 @@ fn input_summary(
     s.warnings.extend(plan.warnings.iter().cloned());
     s.ledgers = output::accounting::ledgers(data);
     s.crowds = plan.crowds.clone();
+    s.gardens = plan.garden_reports.clone();
     // A skip that names only its feature gets its record, so the ledger closes after the
     // manifest's round trip too (`--tiles`, `merge`).
     for skip in s.skipped.iter_mut().filter(|k| k.record.is_none()) {

@@ -12,9 +12,11 @@ use thiserror::Error;
 
 mod billboards;
 mod crowd;
+mod garden;
 mod partial;
 pub use billboards::{PeopleParams, PointsLayer, TreesParams};
 pub use crowd::CrowdParams;
+pub use garden::GardenParams;
 
 /// The default parameter file, shipped inside the binary.
 pub const DEFAULT_TOML: &str = include_str!("../params/default.toml");
@@ -87,6 +89,8 @@ pub struct Params {
     pub trees: TreesParams,
     /// Street crowds (`people.motion = "boids"`, seed 004).
     pub crowd: CrowdParams,
+    /// The rock gardens of temple lots (seed 000).
+    pub garden: GardenParams,
     /// Relative weights of the machiya types drawn for lots of unknown type.
     pub type_mix: BTreeMap<String, f64>,
     /// Directory of textures that replace the shipped ones by file name (a texture set, as
@@ -705,6 +709,7 @@ impl Params {
         self.people.validate().map_err(bad)?;
         self.trees.validate().map_err(bad)?;
         self.crowd.validate().map_err(bad)?;
+        self.garden.validate().map_err(bad)?;
         Ok(())
     }
 }

@@ -32,7 +32,7 @@ fn kyoto_small_builds_and_every_tile_rereads_cleanly() {
     assert_eq!(report["counts"]["tiles"], tiles.len());
     assert!(tiles.len() >= 2, "the fixture spans several tiles");
     let mut names = BTreeSet::new();
-    let (mut kura, mut fences) = (0, 0);
+    let (mut kura, mut fences, mut garden) = (0, 0, 0);
     for tile in tiles {
         let obj = out.path().join(tile["obj"]["path"].as_str().unwrap());
         for o in load_tile(&obj, origin) {
@@ -43,13 +43,21 @@ fn kyoto_small_builds_and_every_tile_rereads_cleanly() {
                 continue; // billboards: tests/billboards.rs
             }
             let (kind, id) = o.name.split_once('_').expect("objects are <kind>_<id>");
+            // A garden's stone is stone_<lot>_<group>_<role>_<k>.
+            let id = if kind == "stone" {
+                id.split('_').next().unwrap()
+            } else {
+                id
+            };
             let is_kura = kind == "kura";
             kura += is_kura as usize;
             fences += (kind == "fence") as usize;
+            garden += (kind == "garden" || kind == "stone") as usize;
             let (lot_use, _, poly) = lots.get(id).unwrap_or_else(|| panic!("no lot {id}"));
             match kind {
                 "machiya" | "kura" => assert_eq!(lot_use, "machiya"),
                 "fence" => assert!(["buke", "jisha"].contains(&lot_use.as_str()), "{lot_use}"),
+                "garden" | "stone" => assert_eq!(lot_use, "jisha"),
                 other => panic!("unexpected object {other}_{id}"),
             }
             for v in &o.vertices {
@@ -79,7 +87,11 @@ fn kyoto_small_builds_and_every_tile_rereads_cleanly() {
     }
     assert_eq!(fences, 2, "the samurai and the temple lot are walled");
     assert_eq!(
-        names.len() - kura - fences,
+        garden, 16,
+        "the temple lot's rock garden: its bed and 15 stones"
+    );
+    assert_eq!(
+        names.len() - kura - fences - garden,
         machiya_lots,
         "one machiya_* object per machiya lot"
     );

@@ -173,3 +173,73 @@ fn an_interactive_run_breeds_from_the_picked_candidates() {
         "{asked}"
     );
 }
+
+#[test]
+fn temples_get_gardens_clear_of_buildings_with_trees_and_people_kept_out() {
+    use edo_city::analyse::obstacles::Obstacles;
+    use geo::Contains;
+    let dir = tempfile::tempdir().unwrap();
+    common::synth(dir.path(), 3000, 4);
+    let params = edo_city::params::Params::default();
+    let data = edo_city::input::read_dataset(dir.path(), &params).expect("reads");
+    let catalog = edo_city::templates::Catalog::load(None).unwrap();
+    let plan = edo_city::analyse::analyse(&data, &params, &catalog, "lots.shp", &|_| {});
+    let temples = data
+        .lots
+        .iter()
+        .filter(|l| l.lot_use.name() == "jisha")
+        .count();
+    assert!(temples > 0);
+    assert_eq!(
+        plan.garden_reports.len(),
+        temples,
+        "one entry per temple lot"
+    );
+    let obstacles = Obstacles::new(
+        plan.houses.values().flatten(),
+        plan.fences.values().flatten(),
+        &catalog,
+        &params,
+    );
+    let gardens: Vec<_> = plan.gardens.values().flatten().collect();
+    assert!(!gardens.is_empty());
+    for g in &gardens {
+        let lot = data.lots.iter().find(|l| l.id == g.lot).unwrap();
+        let ring = g.outline();
+        for (k, q) in ring.iter().enumerate() {
+            let r = ring[(k + 1) % 4];
+            for t in [0.0, 0.25, 0.5, 0.75] {
+                let p = geo_types::Coord {
+                    x: q.x + (r.x - q.x) * t,
+                    y: q.y + (r.y - q.y) * t,
+                };
+                assert!(
+                    lot.outline.contains(&geo::Point(p)),
+                    "{}: the garden leaves its lot",
+                    g.lot
+                );
+                assert!(
+                    !obstacles.hit(p, params.garden.clearance - 1e-6),
+                    "{}: the garden meets a building or wall",
+                    g.lot
+                );
+            }
+        }
+        assert!(g.size[0].min(g.size[1]) >= params.garden.min_size);
+        assert_eq!(g.stones.len(), 15);
+        let mut poly: Vec<geo_types::Coord<f64>> = ring.clone();
+        poly.push(ring[0]);
+        let outline = geo_types::Polygon::new(poly.into(), vec![]);
+        for b in plan.billboards.values().flatten() {
+            assert!(
+                !outline.contains(&geo::Point(b.at)),
+                "{} stands in the garden of {}",
+                b.id,
+                g.lot
+            );
+        }
+    }
+    for r in &plan.garden_reports {
+        assert!(r.placed || !r.reason.is_empty(), "{r:?}");
+    }
+}

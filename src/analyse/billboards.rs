@@ -165,7 +165,8 @@ pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, param
         plan.fences.values().flatten(),
         catalog,
         params,
-    );
+    )
+    .with_gardens(plan.gardens.values().flatten());
     let mut all = Vec::new();
     for kind in [BillboardKind::Person, BillboardKind::Tree] {
         let k = Kind::of(kind, params);

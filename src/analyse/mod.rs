@@ -5,6 +5,7 @@ pub mod billboards;
 pub mod crowds;
 pub mod fences;
 pub mod frontage;
+pub mod gardens;
 pub mod house;
 pub mod kura;
 pub mod obstacles;
@@ -130,6 +131,7 @@ pub fn analyse(
         }
     }
     let t = std::time::Instant::now();
+    gardens::plan_gardens(data, &mut plan, catalog, params);
     billboards::plan_billboards(data, &mut plan, catalog, params);
     trees::plant(data, &mut plan, catalog, params);
     plan.billboards_time = t.elapsed();

@@ -79,6 +79,31 @@ impl Obstacles {
         }
     }
 
+    /// The same with the plan's rock gardens as obstacles too: trees and people keep out.
+    pub fn with_gardens<'a>(
+        mut self,
+        gardens: impl Iterator<Item = &'a crate::model::PlannedGarden>,
+    ) -> Obstacles {
+        let mut added = false;
+        for g in gardens {
+            let mut ring = g.outline();
+            ring.push(ring[0]);
+            self.items
+                .push(Obstacle::Rect(Polygon::new(ring.into(), vec![])));
+            added = true;
+        }
+        if added {
+            let boxes = self
+                .items
+                .iter()
+                .enumerate()
+                .filter_map(|(i, o)| Some(GeomWithData::new(envelope(o)?, i)))
+                .collect();
+            self.tree = RTree::bulk_load(boxes);
+        }
+        self
+    }
+
     /// Whether `p` lies in an obstacle or within `clearance` of one.
     pub fn hit(&self, p: Coord<f64>, clearance: f64) -> bool {
         let c = clearance.max(0.0) + WALL_HALF;

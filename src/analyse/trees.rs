@@ -40,7 +40,8 @@ pub fn plant(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: &Params
         plan.fences.values().flatten(),
         catalog,
         params,
-    );
+    )
+    .with_gardens(plan.gardens.values().flatten());
     let mut crowns = Crowns::default();
     let given: HashMap<&str, bool> = data
         .trees

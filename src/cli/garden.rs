@@ -33,6 +33,9 @@ pub struct GardenArgs {
     /// Garden depth away from the viewing side, metres (the seed's: 25; Ryoanji's: 10).
     #[arg(long, default_value_t = 25.0)]
     pub depth: f64,
+    /// Start from gathered groups rather than the seed's uniform scatter (converges sooner).
+    #[arg(long)]
+    pub gathered: bool,
     /// Show each generation's best candidates and breed from the numbers you pick.
     #[arg(long)]
     pub interactive: bool,
@@ -71,6 +74,7 @@ pub fn garden_command(args: GardenArgs) -> Result<()> {
     }
     let p = GaParams {
         population: args.population,
+        gathered: args.gathered,
         ..GaParams::default()
     };
     let mut rng = edo_city::rng::feature_rng(args.seed, "garden", "");

@@ -56,6 +56,8 @@ pub struct TilePlan<'a> {
     pub fences: &'a [PlannedFence],
     /// The tile's people and trees.
     pub billboards: &'a [PlannedBillboard],
+    /// The tile's rock gardens.
+    pub gardens: &'a [crate::model::PlannedGarden],
     /// The DEM, the tile's id and its bounds, when the terrain is to be written.
     pub ground: Option<(&'a crate::model::dem::Dem, &'a str, [f64; 4])>,
 }
@@ -67,6 +69,7 @@ impl<'a> TilePlan<'a> {
             lots: plan.houses.get(id).map_or(&[][..], Vec::as_slice),
             fences: plan.fences.get(id).map_or(&[][..], Vec::as_slice),
             billboards: plan.billboards.get(id).map_or(&[][..], Vec::as_slice),
+            gardens: plan.gardens.get(id).map_or(&[][..], Vec::as_slice),
             ground: None,
         }
     }
@@ -175,6 +178,10 @@ pub fn generate_tile(
         &mut out.stats,
     );
     out.meshes.extend(people_and_trees);
+    for g in tile.gardens {
+        out.meshes.extend(garden::planned(g, params.seed, frame));
+        out.stats.gardens += 1;
+    }
     if let Some((dem, id, bounds)) = tile.ground {
         out.meshes.extend(terrain::terrain_mesh(
             format!("terrain_{id}"),

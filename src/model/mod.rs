@@ -572,6 +572,69 @@ pub struct Plan {
     pub billboards: BTreeMap<TileId, Vec<PlannedBillboard>>,
     /// The street crowds' order parameters, per street stretch (`people.motion = "boids"`).
     pub crowds: Vec<CrowdStat>,
+    /// The rock gardens, per tile (the tile of their lot).
+    pub gardens: BTreeMap<TileId, Vec<PlannedGarden>>,
+    /// What became of every lot that could have had a garden.
+    pub garden_reports: Vec<GardenStat>,
+}
+
+/// A dry rock garden (karesansui 枯山水) planned in a lot (seed 000).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannedGarden {
+    /// The lot's id.
+    pub lot: String,
+    /// Map point of garden (0, 0): the left end of its viewing side.
+    pub corner: Coord<f64>,
+    /// Direction of the viewing side, radians counter-clockwise from east.
+    pub angle: f64,
+    /// Width along the viewing side and depth away from it, metres.
+    pub size: [f64; 2],
+    /// Ground elevation.
+    pub ground: f64,
+    /// The stones: (x, y, size, group from 0) in garden coordinates, each group largest first.
+    pub stones: Vec<[f64; 4]>,
+    /// The tile it is written to.
+    pub tile: TileId,
+}
+
+impl PlannedGarden {
+    /// Its outline on the map, counter-clockwise.
+    pub fn outline(&self) -> Vec<Coord<f64>> {
+        let (s, c) = self.angle.sin_cos();
+        [
+            (0.0, 0.0),
+            (self.size[0], 0.0),
+            (self.size[0], self.size[1]),
+            (0.0, self.size[1]),
+        ]
+        .iter()
+        .map(|&(x, y)| Coord {
+            x: self.corner.x + x * c - y * s,
+            y: self.corner.y + x * s + y * c,
+        })
+        .collect()
+    }
+}
+
+/// One lot's garden in the report: placed (with its size and fitness) or skipped (why).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GardenStat {
+    /// The lot's id.
+    pub lot: String,
+    /// Whether a garden was placed.
+    pub placed: bool,
+    /// Why not, when it was not.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub reason: String,
+    /// Width and depth, metres.
+    #[serde(default)]
+    pub size: [f64; 2],
+    /// The best layout's fitness (seed 000's eq. 1).
+    #[serde(default)]
+    pub fitness: f64,
+    /// Its stones.
+    #[serde(default)]
+    pub stones: usize,
 }
 
 /// What generation found in one tile.
@@ -616,6 +679,9 @@ pub struct TileStats {
     /// or `billboard` (the species' picture).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub trees_by_species: BTreeMap<String, BTreeMap<String, usize>>,
+    /// Rock gardens built in the tile.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub gardens: usize,
     /// Bytes of the tile's OBJ taken by its trees (objects `trees` and `trees_grown`).
     #[serde(default)]
     pub tree_bytes: u64,
@@ -627,4 +693,9 @@ pub struct TileStats {
     pub kura_counts: BTreeMap<String, KuraCounts>,
     /// Features generation left out (a template check failed), with their reasons.
     pub skipped: Vec<Skipped>,
+}
+
+/// For serde: leave a zero count out.
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }

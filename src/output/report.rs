@@ -182,6 +182,9 @@ pub struct Report {
     /// The street crowds, per street stretch and per district (`people.motion = "boids"`).
     #[serde(skip_serializing_if = "Crowds::is_empty")]
     pub crowds: Crowds,
+    /// The rock gardens of temple lots, one entry per lot (placed or skipped, with why).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub gardens: Vec<crate::model::GardenStat>,
     /// Trees of a species: by species and how each was drawn, and bytes of tree geometry per
     /// tile (absent when no tree has a species).
     #[serde(skip_serializing_if = "TreesReport::is_empty")]
@@ -325,6 +328,9 @@ pub struct InputSummary {
     /// The street crowds' order parameters (`people.motion = "boids"`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub crowds: Vec<crate::model::CrowdStat>,
+    /// Every lot that could have had a rock garden: placed or skipped with why.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub gardens: Vec<crate::model::GardenStat>,
 }
 
 /// manifest.json, written last: what the build is (tool, parameters, input, frame) and
@@ -472,6 +478,7 @@ pub fn assemble_report(m: &Manifest) -> Report {
     c.skipped = r.skipped.len();
     r.accounting = super::accounting::close(&i.ledgers, &r.skipped, &mut r.warnings);
     r.crowds = Crowds::of(&i.crowds);
+    r.gardens = i.gardens.clone();
     for s in &r.skipped {
         *r.skipped_by_reason
             .entry(reason_class(&s.reason))

@@ -25,6 +25,7 @@ pub struct Params {
     people: Option<super::billboards::partial::People>,
     trees: Option<super::billboards::partial::Trees>,
     crowd: Option<super::crowd::partial::Crowd>,
+    garden: Option<super::garden::partial::Garden>,
     type_mix: Option<BTreeMap<String, f64>>,
     textures: Option<String>,
     terrain: Option<bool>,

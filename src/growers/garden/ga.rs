@@ -21,6 +21,9 @@ pub struct GaParams {
     pub tournament: usize,
     /// The best layouts carried over unchanged.
     pub elite: usize,
+    /// Start from gathered groups ([`super::clustered_layout`]) instead of the seed's
+    /// uniform scatter: for short runs.
+    pub gathered: bool,
 }
 
 impl Default for GaParams {
@@ -31,6 +34,7 @@ impl Default for GaParams {
             mutation: 0.01,
             tournament: 3,
             elite: 2,
+            gathered: false,
         }
     }
 }
@@ -69,7 +73,14 @@ impl Population {
     /// A random first generation.
     pub fn random(s: &Settings, p: &GaParams, rng: &mut Pcg64) -> Population {
         let members = (0..p.population.max(1))
-            .map(|_| Candidate::of(random_layout(s, rng), s))
+            .map(|_| {
+                let l = if p.gathered {
+                    super::clustered_layout(s, rng)
+                } else {
+                    random_layout(s, rng)
+                };
+                Candidate::of(l, s)
+            })
             .collect();
         Population::sorted(members)
     }

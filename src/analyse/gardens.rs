@@ -1,0 +1,255 @@
+//! Rock gardens in temple lots (seed 000 in the city): each lot of `garden.uses` gets the
+//! largest open rectangle (Ryoanji's 5:2, along the lot's longest edge) that stays inside the
+//! lot and `garden.clearance` clear of every planned house, kura, wall and gate; its viewing
+//! side faces the lot's gate (else the lot's longest edge, usually its street); the GA of
+//! `growers::garden` designs its stones from `feature_rng(seed, "gardens", lot id)`. A lot
+//! without such a rectangle of at least `garden.min_size` is reported as skipped with why.
+//! Runs before the billboards, which keep out of the gardens.
+
+use geo::{Contains, Point};
+use geo_types::{Coord, Polygon};
+use rayon::prelude::*;
+
+use super::obstacles::{boundary_distance, Obstacles};
+use crate::growers::garden::ga::{self, GaParams};
+use crate::growers::garden::Settings;
+use crate::model::{tile::tile_id, Dataset, FenceKind, GardenStat, Lot, Plan, PlannedGarden};
+use crate::params::Params;
+use crate::templates::Catalog;
+
+/// Plans every garden into `plan.gardens` and reports each lot in `plan.garden_reports`.
+pub fn plan_gardens(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: &Params) {
+    let g = &params.garden;
+    if !g.enabled {
+        return;
+    }
+    let obstacles = Obstacles::new(
+        plan.houses.values().flatten(),
+        plan.fences.values().flatten(),
+        catalog,
+        params,
+    );
+    let lots: Vec<&Lot> = data
+        .lots
+        .iter()
+        .filter(|l| g.uses.iter().any(|u| u == l.lot_use.name()))
+        .collect();
+    let gates: Vec<(String, Coord<f64>)> = plan
+        .fences
+        .values()
+        .flatten()
+        .filter(|f| f.kind == FenceKind::Gate)
+        .map(|f| {
+            (
+                f.id.clone(),
+                Coord {
+                    x: (f.a.x + f.b.x) / 2.0,
+                    y: (f.a.y + f.b.y) / 2.0,
+                },
+            )
+        })
+        .collect();
+    let results: Vec<(GardenStat, Option<PlannedGarden>)> = lots
+        .par_iter()
+        .map(|lot| {
+            let gate = gates.iter().find(|(id, _)| *id == lot.id).map(|g| g.1);
+            design(lot, gate, &obstacles, params)
+        })
+        .collect();
+    for (stat, garden) in results {
+        plan.garden_reports.push(stat);
+        if let Some(gd) = garden {
+            plan.tiles.insert(gd.tile.clone());
+            plan.gardens.entry(gd.tile.clone()).or_default().push(gd);
+        }
+    }
+}
+
+/// One lot's garden: its place, then its design.
+fn design(
+    lot: &Lot,
+    gate: Option<Coord<f64>>,
+    obstacles: &Obstacles,
+    p: &Params,
+) -> (GardenStat, Option<PlannedGarden>) {
+    let g = &p.garden;
+    let skip = |reason: String| {
+        (
+            GardenStat {
+                lot: lot.id.clone(),
+                placed: false,
+                reason,
+                size: [0.0; 2],
+                fitness: 0.0,
+                stones: 0,
+            },
+            None,
+        )
+    };
+    let Some((corner, angle, size)) = place(&lot.outline, gate, obstacles, p) else {
+        return skip(format!(
+            "no open rectangle of at least {} x {} m clear of buildings and walls by {} m",
+            g.min_size * 2.5,
+            g.min_size,
+            g.clearance
+        ));
+    };
+    let s = Settings::sized(size[0], size[1]);
+    let gp = GaParams {
+        population: g.population,
+        gathered: true,
+        ..GaParams::default()
+    };
+    let mut rng = crate::rng::feature_rng(p.seed, "gardens", &lot.id);
+    let (pop, _) = ga::run(&s, &gp, g.generations, &mut rng);
+    let best = pop.best();
+    let stones: Vec<[f64; 4]> = best
+        .layout
+        .stones
+        .iter()
+        .map(|st| [st.x, st.y, st.size, st.group as f64])
+        .collect();
+    let (sn, cs) = angle.sin_cos();
+    let centre = Coord {
+        x: corner.x + size[0] / 2.0 * cs - size[1] / 2.0 * sn,
+        y: corner.y + size[0] / 2.0 * sn + size[1] / 2.0 * cs,
+    };
+    let garden = PlannedGarden {
+        lot: lot.id.clone(),
+        corner,
+        angle,
+        size,
+        ground: lot.ground,
+        tile: tile_id(centre, p.tile_size, p.tile_origin),
+        stones,
+    };
+    (
+        GardenStat {
+            lot: lot.id.clone(),
+            placed: true,
+            reason: String::new(),
+            size,
+            fitness: best.fitness,
+            stones: best.layout.stones.len(),
+        },
+        Some(garden),
+    )
+}
+
+/// The largest open rectangle of the lot: (corner of its viewing side, that side's angle,
+/// [width, depth]).
+fn place(
+    outline: &Polygon<f64>,
+    gate: Option<Coord<f64>>,
+    obstacles: &Obstacles,
+    p: &Params,
+) -> Option<(Coord<f64>, f64, [f64; 2])> {
+    let g = &p.garden;
+    let ring = &outline.exterior().0;
+    // The lot's longest edge sets the axes.
+    let theta = ring
+        .windows(2)
+        .max_by(|a, b| {
+            let l = |w: &[Coord<f64>]| (w[1].x - w[0].x).hypot(w[1].y - w[0].y);
+            l(a).total_cmp(&l(b))
+        })
+        .map(|w| (w[1].y - w[0].y).atan2(w[1].x - w[0].x))?;
+    let (sn, cs) = theta.sin_cos();
+    let to_local = |q: Coord<f64>| (q.x * cs + q.y * sn, -q.x * sn + q.y * cs);
+    let to_map = |u: f64, v: f64| Coord {
+        x: u * cs - v * sn,
+        y: u * sn + v * cs,
+    };
+    let (mut u0, mut u1, mut v0, mut v1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &q in ring {
+        let (u, v) = to_local(q);
+        u0 = u0.min(u);
+        u1 = u1.max(u);
+        v0 = v0.min(v);
+        v1 = v1.max(v);
+    }
+    if !(u1 - u0).is_finite() || u1 - u0 > 5000.0 || v1 - v0 > 5000.0 {
+        return None;
+    }
+    let free = |q: Coord<f64>| {
+        outline.contains(&Point(q))
+            && boundary_distance(q, outline) >= g.clearance
+            && !obstacles.hit(q, g.clearance)
+    };
+    let mut w = g.max_width.min(u1 - u0);
+    while w * 0.4 >= g.min_size {
+        let d = w * 0.4;
+        let step = (w / 4.0).max(0.5);
+        let (nx, ny) = ((w / 2.0).ceil() as usize + 1, (d / 2.0).ceil() as usize + 1);
+        let mut v = v0;
+        while v + d <= v1 {
+            let mut u = u0;
+            while u + w <= u1 {
+                let ok = (0..ny).all(|j| {
+                    (0..nx).all(|i| {
+                        let (a, b) = (
+                            u + w * i as f64 / (nx - 1) as f64,
+                            v + d * j as f64 / (ny - 1) as f64,
+                        );
+                        free(to_map(a, b))
+                    })
+                });
+                if ok {
+                    return Some(orient((u, v, w, d), theta, gate, &to_map));
+                }
+                u += step;
+            }
+            v += step;
+        }
+        w *= 0.85;
+    }
+    None
+}
+
+/// The viewing side of a rectangle (u, v, w, d) in the lot's frame: the side nearest the
+/// gate, else the one along the lot's longest edge (v = min).
+fn orient(
+    (u, v, w, d): (f64, f64, f64, f64),
+    theta: f64,
+    gate: Option<Coord<f64>>,
+    to_map: &dyn Fn(f64, f64) -> Coord<f64>,
+) -> (Coord<f64>, f64, [f64; 2]) {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    // (corner, angle, size, the side's midpoint).
+    let sides = [
+        (to_map(u, v), theta, [w, d], to_map(u + w / 2.0, v)),
+        (
+            to_map(u + w, v + d),
+            theta + PI,
+            [w, d],
+            to_map(u + w / 2.0, v + d),
+        ),
+        (
+            to_map(u, v + d),
+            theta - FRAC_PI_2,
+            [d, w],
+            to_map(u, v + d / 2.0),
+        ),
+        (
+            to_map(u + w, v),
+            theta + FRAC_PI_2,
+            [d, w],
+            to_map(u + w, v + d / 2.0),
+        ),
+    ];
+    let k = match gate {
+        None => 0,
+        Some(gp) => (0..4)
+            .min_by(|&a, &b| {
+                let dist = |k: usize| (sides[k].3.x - gp.x).hypot(sides[k].3.y - gp.y);
+                dist(a).total_cmp(&dist(b))
+            })
+            .unwrap_or(0),
+    };
+    (sides[k].0, sides[k].1, sides[k].2)
+}
