@@ -173,8 +173,7 @@ fn bamboo_culm() {
 /// in summer, seen from the south, framed as LOD2's crossed quads are (the farthest branch
 /// from the trunk to each side, ground to top). Binary alpha: no fringe of background colour.
 fn species_billboards() {
-    use edo_city::generate::mesh::{Frame, Mesh};
-    use edo_city::generate::tree::{self, Lod, Look, Placement};
+    use edo_city::generate::tree;
     let catalog = edo_city::templates::Catalog::load(None).expect("the shipped species load");
     let from_disk = |name: &str| {
         image::open(format!("textures/{name}"))
@@ -182,28 +181,7 @@ fn species_billboards() {
             .map(|i| i.to_rgba8())
     };
     for s in catalog.species.values() {
-        let h = s.nominal_height();
-        let mut rng = edo_city::rng::feature_rng(1, "tree", &s.name);
-        let grown = s
-            .grow_in_city(h, &mut rng)
-            .expect("a shipped species grows");
-        let look = Look::of(s, h, "summer");
-        let mut mesh = Mesh::new(s.name.clone());
-        let place = Placement {
-            at: geo_types::Coord { x: 0.0, y: 0.0 },
-            ground: 0.0,
-            rotation: 0.0,
-        };
-        tree::mesh_tree(
-            &grown.skeleton,
-            &s.mesh,
-            look,
-            Lod::Full,
-            place,
-            Frame { origin: [0.0, 0.0] },
-            &mut mesh,
-        );
-        let (r, top) = tree::extent(&grown.skeleton, look.leaf.map_or(0.0, |_| look.leaf_size));
+        let (mesh, (r, top)) = tree::sample_lod0(s, "summer").expect("a shipped species grows");
         let r = r.max(top * 0.1);
         let height = 256u32;
         let width = ((f64::from(height) * 2.0 * r / top).round() as u32).clamp(96, 512);

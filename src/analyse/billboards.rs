@@ -160,13 +160,7 @@ pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, param
         return;
     }
     let near = Surroundings::new(data);
-    let obstacles = Obstacles::new(
-        plan.houses.values().flatten(),
-        plan.fences.values().flatten(),
-        catalog,
-        params,
-    )
-    .with_gardens(plan.gardens.values().flatten());
+    let obstacles = Obstacles::of_plan(plan, catalog, params);
     let mut all = Vec::new();
     for kind in [BillboardKind::Person, BillboardKind::Tree] {
         let k = Kind::of(kind, params);

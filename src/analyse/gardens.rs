@@ -23,12 +23,8 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: 
     if !g.enabled {
         return;
     }
-    let obstacles = Obstacles::new(
-        plan.houses.values().flatten(),
-        plan.fences.values().flatten(),
-        catalog,
-        params,
-    );
+    // No garden is planned yet: the plan's houses, kura, fences and gates.
+    let obstacles = Obstacles::of_plan(plan, catalog, params);
     let lots: Vec<&Lot> = data
         .lots
         .iter()

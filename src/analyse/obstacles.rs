@@ -79,6 +79,17 @@ impl Obstacles {
         }
     }
 
+    /// Everything `plan` builds so far: houses, kura, fences and gates, and rock gardens.
+    pub fn of_plan(plan: &crate::model::Plan, catalog: &Catalog, params: &Params) -> Obstacles {
+        Obstacles::new(
+            plan.houses.values().flatten(),
+            plan.fences.values().flatten(),
+            catalog,
+            params,
+        )
+        .with_gardens(plan.gardens.values().flatten())
+    }
+
     /// The same with the plan's rock gardens as obstacles too: trees and people keep out.
     pub fn with_gardens<'a>(
         mut self,

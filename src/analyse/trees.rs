@@ -35,13 +35,7 @@ pub fn plant(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: &Params
         return;
     }
     let lots = LotIndex::new(data);
-    let obstacles = Obstacles::new(
-        plan.houses.values().flatten(),
-        plan.fences.values().flatten(),
-        catalog,
-        params,
-    )
-    .with_gardens(plan.gardens.values().flatten());
+    let obstacles = Obstacles::of_plan(plan, catalog, params);
     let mut crowns = Crowns::default();
     let given: HashMap<&str, bool> = data
         .trees

@@ -17,7 +17,7 @@ use super::mesh::{Frame, Mesh};
 use crate::growers::lsystem::presets::GOLDEN_ANGLE;
 use crate::growers::skeleton::Skeleton;
 use crate::growers::v3::{self, V3};
-use crate::templates::species::{LeafKind, MeshSpec, Species};
+use crate::templates::species::{LeafKind, MeshSpec, Species, SAMPLE_SEED};
 
 /// A level of detail.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -479,4 +479,32 @@ pub fn billboard_of(
 /// Triangles of a mesh's faces (a face of n corners is n - 2).
 pub fn triangles(mesh: &Mesh) -> usize {
     mesh.faces.iter().map(|f| f.corners.len() - 2).sum()
+}
+
+/// The sample tree of a species (seed [`SAMPLE_SEED`], the middle of its height range, roots
+/// as the city shows them) meshed at LOD0 in `season`, standing at the origin: the billboard
+/// textures are rendered from it and `<out>/species/` holds it. Also its extent.
+pub fn sample_lod0(species: &Species, season: &str) -> Result<(Mesh, (f64, f64)), String> {
+    let h = species.nominal_height();
+    let mut rng = crate::rng::feature_rng(SAMPLE_SEED, "tree", &species.name);
+    let grown = species.grow_in_city(h, &mut rng)?;
+    let look = Look::of(species, h, season);
+    let mut mesh = Mesh::new(format!("{}_lod0", species.name));
+    let place = Placement {
+        at: Coord { x: 0.0, y: 0.0 },
+        ground: 0.0,
+        rotation: 0.0,
+    };
+    let frame = Frame { origin: [0.0, 0.0] };
+    mesh_tree(
+        &grown.skeleton,
+        &species.mesh,
+        look,
+        Lod::Full,
+        place,
+        frame,
+        &mut mesh,
+    );
+    let margin = look.leaf.map_or(0.0, |_| look.leaf_size);
+    Ok((mesh.finish(), extent(&grown.skeleton, margin)))
 }

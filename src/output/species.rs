@@ -11,11 +11,9 @@ use std::path::Path;
 
 use super::report::ManifestFile;
 use super::{atomic, mtl, obj, sha256_hex};
-use crate::generate::mesh::{Frame, Mesh};
-use crate::generate::tree::{self, Lod, Look, Placement};
+use crate::generate::tree;
 use crate::model::Plan;
 use crate::params::Params;
-use crate::templates::species::SAMPLE_SEED;
 use crate::templates::Catalog;
 
 /// Writes the species directory (or removes an earlier build's when no tree has a species);
@@ -60,33 +58,14 @@ pub fn write_species(
         let Some(s) = catalog.species.get(*name) else {
             continue;
         };
-        let h = s.nominal_height();
-        let mut rng = crate::rng::feature_rng(SAMPLE_SEED, "tree", &s.name);
-        let Ok(grown) = s.grow_in_city(h, &mut rng) else {
+        let Ok((mesh, _)) = tree::sample_lod0(s, &params.trees.season) else {
             continue;
         };
-        let mut mesh = Mesh::new(format!("{}_lod0", s.name));
-        let place = Placement {
-            at: geo_types::Coord { x: 0.0, y: 0.0 },
-            ground: 0.0,
-            rotation: 0.0,
-        };
-        let look = Look::of(s, h, &params.trees.season);
-        let frame = Frame { origin: [0.0, 0.0] };
-        tree::mesh_tree(
-            &grown.skeleton,
-            &s.mesh,
-            look,
-            Lod::Full,
-            place,
-            frame,
-            &mut mesh,
-        );
         let mut buf = Vec::new();
         obj::write_tile(&mut buf, &s.name, [0.0, 0.0], [&mesh]);
         put(format!("{}.obj", s.name), &buf)?;
         put(format!("{}.mtl", s.name), mtl::mtl_text().as_bytes())?;
-        heights.insert(s.name.clone(), h);
+        heights.insert(s.name.clone(), s.nominal_height());
     }
     let mut csv = String::from("id,tile,species,lot,x,y,z,rotation_deg,scale,squeeze,style\n");
     for (b, t) in &trees {
