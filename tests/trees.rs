@@ -401,7 +401,7 @@ fn grown_trees_keep_the_tile_budget_and_the_same_bytes_for_any_threads_and_tiles
         .map(|v| v.as_u64().unwrap())
         .sum();
     assert_eq!(rows as u64, by_species);
-    assert!(csv.starts_with("id,tile,species,lot,x,y,z,rotation_deg,scale,squeeze,style\n"));
+    assert!(csv.starts_with("id,tile,species,lot,x,y,z,rotation,scale,squeeze,style\n"));
     for species in trees["by_species"].as_object().unwrap().keys() {
         let obj = one.join(format!("species/{species}.obj"));
         let (models, _) = tobj::load_obj(

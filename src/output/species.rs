@@ -67,7 +67,7 @@ pub fn write_species(
         put(format!("{}.mtl", s.name), mtl::mtl_text().as_bytes())?;
         heights.insert(s.name.clone(), s.nominal_height());
     }
-    let mut csv = String::from("id,tile,species,lot,x,y,z,rotation_deg,scale,squeeze,style\n");
+    let mut csv = String::from("id,tile,species,lot,x,y,z,rotation,scale,squeeze,style\n");
     for (b, t) in &trees {
         let Some(h) = heights.get(&t.species) else {
             continue;

@@ -55,7 +55,8 @@ pub enum Grower {
         tip_radius: f64,
         /// The pipe model's exponent, 2 to 3.
         pipe_exponent: f64,
-        /// Roots within this many metres of the trunk are shown above ground in the city.
+        /// Roots within this many metres of the trunk are shown above ground in the city
+        /// (`[roots] exposed`).
         roots_exposed: f64,
     },
 }
@@ -200,6 +201,15 @@ struct RawSpecies {
     mesh: RawMesh,
     #[serde(default)]
     season: BTreeMap<String, Spanned<String>>,
+    /// `[roots] exposed = metres`: how far from the trunk roots show above ground.
+    #[serde(default)]
+    roots: Option<RawRoots>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRoots {
+    exposed: f64,
 }
 
 #[derive(Deserialize)]
@@ -238,8 +248,6 @@ struct RawColonization {
     tip_radius: f64,
     #[serde(default = "default_pipe")]
     pipe_exponent: f64,
-    #[serde(default)]
-    roots_exposed: f64,
     group: Vec<Spanned<RawGroup>>,
 }
 
@@ -437,7 +445,8 @@ pub fn parse(file: &str, text: &str) -> Result<Species, String> {
                     at(raw.method.span())
                 ));
             };
-            ("colonization", colonization_grower(c, file, text)?)
+            let exposed = raw.roots.as_ref().map_or(0.0, |r| r.exposed);
+            ("colonization", colonization_grower(c, exposed, file, text)?)
         }
         other => {
             return Err(format!(
@@ -523,7 +532,12 @@ fn lsystem(l: RawLSystem, file: &str, text: &str) -> Result<Grower, String> {
 
 /// The `[colonization]` table: parameters checked, envelopes built (a hull read from its OBJ,
 /// relative to the species file).
-fn colonization_grower(c: RawColonization, file: &str, text: &str) -> Result<Grower, String> {
+fn colonization_grower(
+    c: RawColonization,
+    roots_exposed: f64,
+    file: &str,
+    text: &str,
+) -> Result<Grower, String> {
     let at = |span: std::ops::Range<usize>| {
         let (l, col) = line_col(text, span.start);
         format!("{file}:{l}:{col}")
@@ -573,9 +587,9 @@ fn colonization_grower(c: RawColonization, file: &str, text: &str) -> Result<Gro
             "{file}: `colonization.pipe_exponent` must be from 2 to 3"
         ));
     }
-    if !(c.roots_exposed.is_finite() && (0.0..=50.0).contains(&c.roots_exposed)) {
+    if !(roots_exposed.is_finite() && (0.0..=50.0).contains(&roots_exposed)) {
         return Err(format!(
-            "{file}: `colonization.roots_exposed` must be from 0 to 50 metres"
+            "{file}: `roots.exposed` must be from 0 to 50 metres"
         ));
     }
     if c.group.is_empty() {
@@ -632,7 +646,7 @@ fn colonization_grower(c: RawColonization, file: &str, text: &str) -> Result<Gro
         groups,
         tip_radius: c.tip_radius,
         pipe_exponent: c.pipe_exponent,
-        roots_exposed: c.roots_exposed,
+        roots_exposed,
     })
 }
 
