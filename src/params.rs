@@ -769,10 +769,19 @@ fn resolved_table(
     Ok(merged)
 }
 
-/// Overlays `user` on `base`, table by table; `type_mix` is replaced whole.
+/// Overlays `user` on `base`, table by table; `type_mix` is replaced whole, and each row of
+/// a species table (`trees.species.<use>`, `district.<id>.tree_species.<use>`): a user who
+/// lists a use's species means exactly those.
 fn merge(base: &mut toml::Table, user: toml::Table) {
     for (key, value) in user {
         match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(u))
+                if matches!(key.as_str(), "species" | "tree_species") =>
+            {
+                for (row, weights) in u {
+                    b.insert(row, weights);
+                }
+            }
             (Some(toml::Value::Table(b)), toml::Value::Table(u))
                 if !matches!(key.as_str(), "type_mix" | "values" | "constants") =>
             {
@@ -879,6 +888,14 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("c.toml") && err.contains("seeed"), "{err}");
+    }
+
+    #[test]
+    fn a_species_row_is_replaced_whole_and_the_other_rows_stay() {
+        let p =
+            Params::from_toml_str("[trees.species]\nmachiya = { kusu = 1.0 }\n", "t.toml").unwrap();
+        assert_eq!(p.trees.species["machiya"].len(), 1);
+        assert!(p.trees.species["jisha"].contains_key("sugi"));
     }
 
     #[test]
