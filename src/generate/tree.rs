@@ -371,7 +371,11 @@ fn leaves(
         }
         let pruned_kids = s.kids[i].iter().any(|&k| !s.keep[k as usize]);
         if lod == Lod::Reduced && pruned_kids {
-            for &k in s.kids[i].iter().filter(|&&k| !s.keep[k as usize]) {
+            // Roots carry no leaves: their pruned twigs become nothing.
+            for &k in s.kids[i]
+                .iter()
+                .filter(|&&k| !s.keep[k as usize] && sk.nodes[k as usize].at[2] >= 0.0)
+            {
                 clump(sk, s, k as usize, leaf, size, put, mesh);
             }
         }
