@@ -227,6 +227,8 @@ pub struct Layers {
     pub people: PointsLayer,
     /// Trees given as points (none: they are drawn).
     pub trees: PointsLayer,
+    /// Polygons where rock gardens are laid out (whatever the lot's use).
+    pub gardens: GardensLayer,
     /// The terrain grid.
     pub dem: DemLayer,
 }
@@ -250,6 +252,21 @@ pub struct FencesLayer {
     #[serde(default)]
     pub encoding: String,
     /// Field holding the line's id (else its record number from 1).
+    pub id_field: String,
+}
+
+/// Garden polygons: each gets a rock garden (karesansui) in the largest rectangle that fits
+/// it clear of the planned buildings, besides the lots of `garden.uses`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GardensLayer {
+    /// Shapefile path, relative to the input directory; "" = no such layer (a missing
+    /// default file is no layer).
+    pub file: String,
+    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
+    #[serde(default)]
+    pub encoding: String,
+    /// Field holding the polygon's id (else its record number from 1).
     pub id_field: String,
 }
 

@@ -243,3 +243,146 @@ fn temples_get_gardens_clear_of_buildings_with_trees_and_people_kept_out() {
         assert!(r.placed || !r.reason.is_empty(), "{r:?}");
     }
 }
+
+/// Writes a polygon layer with an `id` field (no `.prj`: the town's CRS is assumed).
+fn write_areas(path: &std::path::Path, areas: &[(&str, Vec<geo_types::Coord<f64>>)]) {
+    let name = |n: &str| dbase::FieldName::try_from(n).unwrap();
+    let table = dbase::TableWriterBuilder::new().add_character_field(name("id"), 10);
+    let mut w = shapefile::Writer::from_path(path, table).unwrap();
+    for (id, ring) in areas {
+        let mut rec = dbase::Record::default();
+        rec.insert(
+            "id".into(),
+            dbase::FieldValue::Character(Some(id.to_string())),
+        );
+        // Clockwise outer ring, closed, as the shapefile standard has it.
+        let mut pts: Vec<shapefile::Point> = ring
+            .iter()
+            .rev()
+            .map(|c| shapefile::Point::new(c.x, c.y))
+            .collect();
+        pts.push(pts[0]);
+        let poly = shapefile::Polygon::new(shapefile::PolygonRing::Outer(pts));
+        w.write_shape_and_record(&poly, &rec).unwrap();
+    }
+}
+
+#[test]
+fn the_polygons_of_a_gardens_layer_get_gardens_whatever_their_lots_use() {
+    use geo::{Centroid, Contains};
+    let dir = tempfile::tempdir().unwrap();
+    let town = dir.path().join("town");
+    common::synth(&town, 3000, 4);
+    let params = edo_city::params::Params::default();
+    let before = edo_city::input::read_dataset(&town, &params).expect("reads");
+    // A temple drawn with a garden polygon of its own (it then gets no second garden), open
+    // ground west of the town in no lot, and a 2 m square in no lot.
+    let temple = before
+        .lots
+        .iter()
+        .find(|l| l.lot_use.name() == "jisha")
+        .unwrap();
+    let c = temple.outline.centroid().unwrap().0;
+    let shrunk: Vec<_> = temple.outline.exterior().0[1..]
+        .iter()
+        .map(|q| geo_types::Coord {
+            x: c.x + (q.x - c.x) * 0.8,
+            y: c.y + (q.y - c.y) * 0.8,
+        })
+        .collect();
+    let corners = before
+        .lots
+        .iter()
+        .flat_map(|l| l.outline.exterior().0.iter());
+    let x0 = corners.map(|q| q.x).fold(f64::INFINITY, f64::min) - 200.0;
+    let rect = |x: f64, y: f64, w: f64, d: f64| {
+        vec![
+            geo_types::Coord { x, y },
+            geo_types::Coord { x: x + w, y },
+            geo_types::Coord { x: x + w, y: y + d },
+            geo_types::Coord { x, y: y + d },
+        ]
+    };
+    write_areas(
+        &town.join("gardens.shp"),
+        &[
+            ("g1", shrunk),
+            ("g2", rect(x0, c.y, 2.0, 2.0)),
+            ("g3", rect(x0, c.y + 50.0, 30.0, 20.0)),
+        ],
+    );
+
+    let data = edo_city::input::read_dataset(&town, &params).expect("reads");
+    assert_eq!(data.gardens.len(), 3);
+    let catalog = edo_city::templates::Catalog::load(None).unwrap();
+    let plan = edo_city::analyse::analyse(&data, &params, &catalog, "lots.shp", &|_| {});
+    let placed: Vec<_> = plan.gardens.values().flatten().collect();
+    let g1 = placed
+        .iter()
+        .find(|g| g.lot == "area-g1")
+        .expect("the drawn polygon got a garden");
+    let drawn = &data.gardens[0].outline;
+    for q in g1.outline() {
+        assert!(
+            drawn.contains(&geo::Point(q)),
+            "the garden leaves its polygon"
+        );
+    }
+    assert_eq!(g1.stones.len(), 15);
+    assert_eq!(
+        plan.garden_reports
+            .iter()
+            .filter(|r| r.lot == temple.id)
+            .count(),
+        1,
+        "the temple holding a drawn garden gets no second one"
+    );
+    let g3 = placed.iter().find(|g| g.lot == "area-g3").unwrap();
+    assert!(
+        g3.size[0] > 25.0 * 0.85 - 1e-9,
+        "open ground: the widest garden {:?}",
+        g3.size
+    );
+
+    let out = dir.path().join("out");
+    let report = common::build_ok(&town, &out, &[]);
+    let gardens = report["gardens"].as_array().unwrap();
+    let by_area = |a: &str| gardens.iter().find(|g| g["area"] == a).unwrap();
+    assert_eq!(by_area("g1")["placed"], true);
+    assert_eq!(
+        by_area("g1")["lot"],
+        temple.id.as_str(),
+        "the lot holding it"
+    );
+    assert_eq!(by_area("g3")["placed"], true);
+    assert_eq!(by_area("g2")["placed"], false);
+    assert_eq!(by_area("g2")["lot"], "", "in no lot");
+    assert!(by_area("g2")["reason"]
+        .as_str()
+        .unwrap()
+        .contains("no open rectangle"));
+    let skipped = report["skipped"].as_array().unwrap();
+    assert!(
+        skipped
+            .iter()
+            .any(|s| s["layer"] == "gardens" && s["id"] == "g2" && s["record"] == 1),
+        "the polygon without a garden is listed as skipped"
+    );
+    let ledger = report["accounting"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["role"] == "gardens")
+        .expect("the gardens layer is accounted for");
+    assert_eq!(ledger["read"], 3);
+    assert_eq!(ledger["unaccounted"], 0, "{ledger}");
+    let objects = common::build_objects(&out);
+    assert!(objects.iter().any(|o| o.name == "garden_area-g1"));
+    assert!(
+        objects
+            .iter()
+            .filter(|o| o.name.starts_with("stone_area-g1_"))
+            .count()
+            == 15
+    );
+}

@@ -4,20 +4,47 @@
 //! side faces the lot's gate (else the lot's longest edge, usually its street); the GA of
 //! `growers::garden` designs its stones from `feature_rng(seed, "gardens", lot id)`. A lot
 //! without such a rectangle of at least `garden.min_size` is reported as skipped with why.
+//! The polygons of the gardens layer (`layers.gardens`) get a garden each, whatever their
+//! lot's use, in the same way inside their own outline (keyed `area-<id>`, viewpoint the gate
+//! of the lot holding the polygon's centre); a lot holding one gets no second garden.
 //! Runs before the billboards, which keep out of the gardens.
 
-use geo::{Contains, Point};
+use std::collections::{HashMap, HashSet};
+
+use geo::{Centroid, Contains, Point};
 use geo_types::{Coord, Polygon};
 use rayon::prelude::*;
 
 use super::obstacles::{boundary_distance, Obstacles};
 use crate::growers::garden::ga::{self, GaParams};
 use crate::growers::garden::Settings;
-use crate::model::{tile::tile_id, Dataset, FenceKind, GardenStat, Lot, Plan, PlannedGarden};
+use crate::model::{
+    tile::tile_id, Dataset, FenceKind, GardenArea, GardenStat, Lot, Plan, PlannedGarden, Skipped,
+};
 use crate::params::Params;
 use crate::templates::Catalog;
 
-/// Plans every garden into `plan.gardens` and reports each lot in `plan.garden_reports`.
+/// Where one garden is to go: a lot of `garden.uses`, or a polygon of the gardens layer.
+struct Site<'a> {
+    /// The garden's name in object names and its RNG key (see [`PlannedGarden::lot`]).
+    key: String,
+    /// The lot, for the report (empty for a gardens-layer polygon in no lot).
+    lot: String,
+    /// The gardens-layer polygon's id and record, when it is one.
+    area: Option<(String, usize)>,
+    /// The ground it must fit in.
+    outline: &'a Polygon<f64>,
+    /// How far the garden keeps from `outline`'s edge: `garden.clearance` inside a lot, a
+    /// hand's breadth inside a polygon the user drew as the garden itself.
+    edge: f64,
+    /// The lot's gate, the viewpoint.
+    gate: Option<Coord<f64>>,
+    /// Ground elevation.
+    ground: f64,
+}
+
+/// Plans every garden into `plan.gardens` and reports each lot in `plan.garden_reports`;
+/// a gardens-layer polygon that gets none is also in `plan.skipped`, with the reason.
 pub fn plan_gardens(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: &Params) {
     let g = &params.garden;
     if !g.enabled {
@@ -25,34 +52,70 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: 
     }
     // No garden is planned yet: the plan's houses, kura, fences and gates.
     let obstacles = Obstacles::of_plan(plan, catalog, params);
-    let lots: Vec<&Lot> = data
-        .lots
+    // A lot's first gate is its viewpoint.
+    let mut gates: HashMap<&str, Coord<f64>> = HashMap::new();
+    for f in plan.fences.values().flatten() {
+        if f.kind == FenceKind::Gate {
+            gates.entry(f.id.as_str()).or_insert(Coord {
+                x: (f.a.x + f.b.x) / 2.0,
+                y: (f.a.y + f.b.y) / 2.0,
+            });
+        }
+    }
+    let layer_file = data
+        .layers
         .iter()
-        .filter(|l| g.uses.iter().any(|u| u == l.lot_use.name()))
-        .collect();
-    let gates: Vec<(String, Coord<f64>)> = plan
-        .fences
-        .values()
-        .flatten()
-        .filter(|f| f.kind == FenceKind::Gate)
-        .map(|f| {
-            (
-                f.id.clone(),
-                Coord {
-                    x: (f.a.x + f.b.x) / 2.0,
-                    y: (f.a.y + f.b.y) / 2.0,
-                },
-            )
-        })
-        .collect();
-    let results: Vec<(GardenStat, Option<PlannedGarden>)> = lots
+        .find(|l| l.role == "gardens")
+        .map(|l| l.file.clone())
+        .unwrap_or_default();
+    let holder = |area: &GardenArea| -> Option<&Lot> {
+        let c = area.outline.centroid()?;
+        data.lots.iter().find(|l| l.outline.contains(&c))
+    };
+    let mut sites: Vec<Site> = Vec::new();
+    let mut drawn: HashSet<&str> = HashSet::new();
+    for area in &data.gardens {
+        let lot = holder(area);
+        if let Some(l) = lot {
+            drawn.insert(l.id.as_str());
+        }
+        sites.push(Site {
+            key: format!("area-{}", area.id),
+            lot: lot.map(|l| l.id.clone()).unwrap_or_default(),
+            area: Some((area.id.clone(), area.record)),
+            outline: &area.outline,
+            edge: 0.1,
+            gate: lot.and_then(|l| gates.get(l.id.as_str()).copied()),
+            ground: lot.map_or(0.0, |l| l.ground),
+        });
+    }
+    for lot in &data.lots {
+        if g.uses.iter().any(|u| u == lot.lot_use.name()) && !drawn.contains(lot.id.as_str()) {
+            sites.push(Site {
+                key: lot.id.clone(),
+                lot: lot.id.clone(),
+                area: None,
+                outline: &lot.outline,
+                edge: g.clearance,
+                gate: gates.get(lot.id.as_str()).copied(),
+                ground: lot.ground,
+            });
+        }
+    }
+    let results: Vec<(GardenStat, Option<PlannedGarden>)> = sites
         .par_iter()
-        .map(|lot| {
-            let gate = gates.iter().find(|(id, _)| *id == lot.id).map(|g| g.1);
-            design(lot, gate, &obstacles, params)
-        })
+        .map(|site| design(site, &obstacles, params))
         .collect();
-    for (stat, garden) in results {
+    for ((stat, garden), site) in results.into_iter().zip(&sites) {
+        if let (false, Some((id, record))) = (stat.placed, &site.area) {
+            plan.skipped.push(Skipped {
+                layer: "gardens".into(),
+                file: layer_file.clone(),
+                id: id.clone(),
+                record: Some(*record),
+                reason: stat.reason.clone(),
+            });
+        }
         plan.garden_reports.push(stat);
         if let Some(gd) = garden {
             plan.tiles.insert(gd.tile.clone());
@@ -61,34 +124,26 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: 
     }
 }
 
-/// One lot's garden: its place, then its design.
-fn design(
-    lot: &Lot,
-    gate: Option<Coord<f64>>,
-    obstacles: &Obstacles,
-    p: &Params,
-) -> (GardenStat, Option<PlannedGarden>) {
+/// One site's garden: its place, then its design.
+fn design(site: &Site, obstacles: &Obstacles, p: &Params) -> (GardenStat, Option<PlannedGarden>) {
     let g = &p.garden;
-    let skip = |reason: String| {
-        (
-            GardenStat {
-                lot: lot.id.clone(),
-                placed: false,
-                reason,
-                size: [0.0; 2],
-                fitness: 0.0,
-                stones: 0,
-            },
-            None,
-        )
+    let stat = |placed, reason: String, size, fitness, stones| GardenStat {
+        lot: site.lot.clone(),
+        area: site.area.as_ref().map(|a| a.0.clone()),
+        placed,
+        reason,
+        size,
+        fitness,
+        stones,
     };
-    let Some((corner, angle, size)) = place(&lot.outline, gate, obstacles, p) else {
-        return skip(format!(
+    let Some((corner, angle, size)) = place(site, obstacles, p) else {
+        let reason = format!(
             "no open rectangle of at least {} x {} m clear of buildings and walls by {} m",
             g.min_size * 2.5,
             g.min_size,
             g.clearance
-        ));
+        );
+        return (stat(false, reason, [0.0; 2], 0.0, 0), None);
     };
     let s = Settings::sized(size[0], size[1]);
     let gp = GaParams {
@@ -96,7 +151,7 @@ fn design(
         gathered: true,
         ..GaParams::default()
     };
-    let mut rng = crate::rng::feature_rng(p.seed, "gardens", &lot.id);
+    let mut rng = crate::rng::feature_rng(p.seed, "gardens", &site.key);
     let (pop, _) = ga::run(&s, &gp, g.generations, &mut rng);
     let best = pop.best();
     let stones: Vec<[f64; 4]> = best
@@ -111,36 +166,25 @@ fn design(
         y: corner.y + size[0] / 2.0 * sn + size[1] / 2.0 * cs,
     };
     let garden = PlannedGarden {
-        lot: lot.id.clone(),
+        lot: site.key.clone(),
         corner,
         angle,
         size,
-        ground: lot.ground,
+        ground: site.ground,
         tile: tile_id(centre, p.tile_size, p.tile_origin),
         stones,
     };
+    let n = best.layout.stones.len();
     (
-        GardenStat {
-            lot: lot.id.clone(),
-            placed: true,
-            reason: String::new(),
-            size,
-            fitness: best.fitness,
-            stones: best.layout.stones.len(),
-        },
+        stat(true, String::new(), size, best.fitness, n),
         Some(garden),
     )
 }
 
-/// The largest open rectangle of the lot: (corner of its viewing side, that side's angle,
+/// The largest open rectangle of the site: (corner of its viewing side, that side's angle,
 /// [width, depth]).
-fn place(
-    outline: &Polygon<f64>,
-    gate: Option<Coord<f64>>,
-    obstacles: &Obstacles,
-    p: &Params,
-) -> Option<(Coord<f64>, f64, [f64; 2])> {
-    let g = &p.garden;
+fn place(site: &Site, obstacles: &Obstacles, p: &Params) -> Option<(Coord<f64>, f64, [f64; 2])> {
+    let (g, outline, gate) = (&p.garden, site.outline, site.gate);
     let ring = &outline.exterior().0;
     // The lot's longest edge sets the axes.
     let theta = ring
@@ -174,7 +218,7 @@ fn place(
     }
     let free = |q: Coord<f64>| {
         outline.contains(&Point(q))
-            && boundary_distance(q, outline) >= g.clearance
+            && boundary_distance(q, outline) >= site.edge
             && !obstacles.hit(q, g.clearance)
     };
     let mut w = g.max_width.min(u1 - u0);

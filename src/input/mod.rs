@@ -16,6 +16,7 @@ pub mod simplify;
 pub mod table;
 pub mod widths;
 
+mod areas;
 mod lines;
 mod polygons;
 mod target;
@@ -194,6 +195,7 @@ struct Layers {
     fences: Option<Opened>,
     people: Option<Opened>,
     trees: Option<Opened>,
+    gardens: Option<Opened>,
 }
 
 impl Layers {
@@ -225,6 +227,12 @@ impl Layers {
             fences: role("fences", &l.fences.file, &l.fences.encoding, &d.fences.file)?,
             people: role("people", &l.people.file, &l.people.encoding, &d.people.file)?,
             trees: role("trees", &l.trees.file, &l.trees.encoding, &d.trees.file)?,
+            gardens: role(
+                "gardens",
+                &l.gardens.file,
+                &l.gardens.encoding,
+                &d.gardens.file,
+            )?,
         })
     }
 
@@ -240,6 +248,7 @@ impl Layers {
             &self.fences,
             &self.people,
             &self.trees,
+            &self.gardens,
         ]
         .into_iter()
         .flatten()
@@ -257,6 +266,7 @@ impl Layers {
             &mut self.fences,
             &mut self.people,
             &mut self.trees,
+            &mut self.gardens,
         ]
         .into_iter()
         .flatten()
@@ -394,6 +404,9 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
                 &mut data.warnings,
             )?);
         }
+    }
+    if let Some(o) = &layers.gardens {
+        areas::read_garden_areas(params, o, &target, &mut data)?;
     }
     data.dem = read_dem(dir, params, &target, &dl.dem.file, &mut data.warnings)?;
     for o in layers.all() {

@@ -114,6 +114,18 @@ pub struct FenceLine {
     pub attrs: BTreeMap<String, String>,
 }
 
+/// A polygon of the optional gardens layer (`layers.gardens`): where a user has drawn a rock
+/// garden's ground, whatever the lot's use.
+#[derive(Debug, Clone)]
+pub struct GardenArea {
+    /// Its id (the layer's id field, else its record number from 1; parts `<id>-<n>`).
+    pub id: String,
+    /// Its record in the file.
+    pub record: usize,
+    /// The polygon, in the output CRS.
+    pub outline: Polygon<f64>,
+}
+
 /// A person or a tree given as a point (`people.shp`, `trees.shp`).
 #[derive(Debug, Clone)]
 pub struct PointFeature {
@@ -219,6 +231,8 @@ pub struct Dataset {
     pub dem: Option<dem::Dem>,
     /// City blocks (machi 町 / gaiku 街区): their boundaries are street edges.
     pub blocks: Vec<Polygon<f64>>,
+    /// The polygons of the gardens layer, each to get a rock garden.
+    pub gardens: Vec<GardenArea>,
     /// Street centrelines with their widths.
     pub streets: Vec<Street>,
     /// Building footprints, each built to its own height.
@@ -581,7 +595,8 @@ pub struct Plan {
 /// A dry rock garden (karesansui 枯山水) planned in a lot (seed 000).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlannedGarden {
-    /// The lot's id.
+    /// Its name in object names and its RNG key: the lot's id, or `area-<id>` for a polygon
+    /// of the gardens layer.
     pub lot: String,
     /// Map point of garden (0, 0): the left end of its viewing side.
     pub corner: Coord<f64>,
@@ -619,8 +634,12 @@ impl PlannedGarden {
 /// One lot's garden in the report: placed (with its size and fitness) or skipped (why).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GardenStat {
-    /// The lot's id.
+    /// The lot's id (for a garden of the gardens layer: the lot holding its centre, or
+    /// empty when none does).
     pub lot: String,
+    /// The id of its polygon in the gardens layer, when it has one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub area: Option<String>,
     /// Whether a garden was placed.
     pub placed: bool,
     /// Why not, when it was not.

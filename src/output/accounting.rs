@@ -73,6 +73,11 @@ pub fn ledgers(data: &Dataset) -> Vec<Ledger> {
                     .iter()
                     .map(|f| (f.record, f.id.as_str()))
                     .collect(),
+                "gardens" => data
+                    .gardens
+                    .iter()
+                    .map(|g| (g.record, g.id.as_str()))
+                    .collect(),
                 "people" | "trees" => {
                     let points = match layer.role.as_str() {
                         "people" => &data.people,

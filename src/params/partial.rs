@@ -58,6 +58,7 @@ struct Layers {
     fences: Option<FencesLayer>,
     people: Option<super::billboards::partial::PointsLayer>,
     trees: Option<super::billboards::partial::PointsLayer>,
+    gardens: Option<FencesLayer>,
     dem: Option<DemLayer>,
 }
 #[derive(Deserialize)]
