@@ -2,16 +2,24 @@
 
 CARGO ?= cargo
 
-.PHONY: run test test-future lint bench real textures fixtures clean pictures bad-input
+.PHONY: run test test-future lint bench real textures fixtures clean pictures bad-input viewer-deps
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
 	$(CARGO) run --release -- build fixtures/kyoto-small --out out
 
-## Unit, property, end-to-end and doc tests.
-test:
+## Unit, property, end-to-end and doc tests; the glTF validator and the browser test need
+## the viewer's npm packages (installed first when missing).
+test: viewer-deps
 	$(CARGO) test --all-targets
 	$(CARGO) test --doc
+
+## The viewer's npm packages (three.js, 3d-tiles-renderer, gltf-validator, playwright-core),
+## exactly as viewer/package-lock.json pins them.
+viewer-deps: viewer/node_modules/.package-lock.json
+
+viewer/node_modules/.package-lock.json: viewer/package.json viewer/package-lock.json
+	cd viewer && npm ci --no-audit --no-fund
 
 ## The suite again under faketime a year ahead and on a leap day (needs faketime:
 ## scripts/ci-deps.sh installs it); CI runs it after `make test`.

@@ -19,6 +19,7 @@ use thiserror::Error;
 
 use crate::analyse;
 use crate::generate;
+use crate::generate::mesh::Mesh;
 use crate::input::{self, InputError};
 use crate::model::{Dataset, LotUse, Plan};
 use crate::output::{self, report};
@@ -364,6 +365,8 @@ fn write_city(
         .map_err(|e| write_err(&opts.out.join("species"), e))?;
 
     let files = layer_files(&opts.input, params);
+    let sinks = output::sink::sinks(&params.output.formats);
+    let directory = output::features::Directory::of(&data, &plan, params);
     let tiles: Vec<&String> = plan
         .tiles
         .iter()
@@ -400,26 +403,67 @@ fn write_city(
                     generate::generate_tile(&tile, catalog, params, plan.origin, &files);
                 gen_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
                 let t = Instant::now();
-                let written = output::write_tile(&opts.out, id, plan.origin, &meshes.meshes)
-                    .map_err(|e| write_err(&tiles_dir.join(format!("{id}.obj")), e));
+                let features = directory.features(&meshes.meshes);
+                let extent = output::sink::extent(&meshes.meshes);
+                let centre = output::sink::tile_centre(
+                    id,
+                    plan.origin,
+                    params.tile_size,
+                    params.tile_origin,
+                    extent,
+                );
+                let content = output::sink::TileContent {
+                    id,
+                    origin: plan.origin,
+                    centre,
+                    meshes: &meshes.meshes,
+                    features: &features,
+                };
+                let mut entry = report::ManifestTile {
+                    id: id.clone(),
+                    obj: None,
+                    mtl: None,
+                    glb: None,
+                    bounds: extent.map(|(lo, hi)| {
+                        // Output frame (x east, y up, z south) to east, north, up.
+                        let m = |v: i64| v as f64 / 1000.0;
+                        [m(lo[0]), -m(hi[2]), m(lo[1]), m(hi[0]), -m(lo[2]), m(hi[1])]
+                    }),
+                    centre: [centre[0] as f64 / 1000.0, -(centre[2] as f64) / 1000.0],
+                    stats: Default::default(),
+                };
+                let mut mesh_bytes = None;
+                for sink in &sinks {
+                    let written = sink.write_tile(&opts.out, &content).map_err(|e| {
+                        write_err(&tiles_dir.join(format!("{id}.{}", sink.format())), e)
+                    });
+                    match written {
+                        Ok(w) => {
+                            entry.add_files(w.files);
+                            mesh_bytes = mesh_bytes.or(w.mesh_bytes);
+                        }
+                        Err(e) => {
+                            progress.inc(1);
+                            return Err(e);
+                        }
+                    }
+                }
                 write_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
                 progress.inc(1);
-                written.map(|(obj, mtl, sizes)| {
-                    // The bytes the trees' objects took in the file, exactly.
-                    meshes.stats.tree_bytes = meshes
+                // The bytes the trees' objects take in the OBJ, exactly.
+                let is_tree = |m: &Mesh| m.name == "trees" || m.name == "trees_grown";
+                meshes.stats.tree_bytes = match mesh_bytes {
+                    Some(sizes) => meshes
                         .meshes
                         .iter()
                         .zip(&sizes)
-                        .filter(|(m, _)| m.name == "trees" || m.name == "trees_grown")
+                        .filter(|(m, _)| is_tree(m))
                         .map(|(_, &n)| n as u64)
-                        .sum();
-                    report::ManifestTile {
-                        id: id.clone(),
-                        obj,
-                        mtl,
-                        stats: meshes.stats,
-                    }
-                })
+                        .sum(),
+                    None => output::obj_bytes(meshes.meshes.iter().filter(|m| is_tree(m))) as u64,
+                };
+                entry.stats = meshes.stats;
+                Ok(entry)
             })
             .collect()
     };
@@ -432,7 +476,7 @@ fn write_city(
         written.push(r?);
     }
     let tiles_written = written.len();
-    let bytes_written: u64 = written.iter().map(|t| t.obj.bytes + t.mtl.bytes).sum();
+    let bytes_written: u64 = written.iter().map(|t| t.bytes()).sum();
 
     // The manifest's tiles: what this run wrote, plus (for --tiles) the earlier build's
     // entries for the tiles it did not touch.
@@ -467,9 +511,16 @@ fn write_city(
         params: params.clone(),
         input: input_summary(&opts.input, opts.templates.as_deref(), &data, &plan),
         tiles: manifest_tiles,
+        formats: sinks.iter().map(|s| s.format().to_string()).collect(),
+        files: Vec::new(),
         textures,
         species,
     };
+    let mut manifest = manifest;
+    // A shard's tiles are only part of the city: `merge` writes the tileset.
+    if manifest.shard.is_none() {
+        shards::finish_formats(&opts.out, &mut manifest)?;
+    }
     timings.generate_and_write = t.elapsed();
     let t = Instant::now();
     if let Some(png) = image {
@@ -510,15 +561,13 @@ pub fn check(
         .map(|id| {
             let tile = generate::TilePlan::of(&plan, id);
             let meshes = generate::generate_tile(&tile, &catalog, params, plan.origin, &files);
-            let none = report::ManifestFile {
-                path: String::new(),
-                bytes: 0,
-                sha256: String::new(),
-            };
             report::ManifestTile {
                 id: id.clone(),
-                obj: none.clone(),
-                mtl: none,
+                obj: None,
+                mtl: None,
+                glb: None,
+                bounds: None,
+                centre: [0.0; 2],
                 stats: meshes.stats,
             }
         })
@@ -535,6 +584,8 @@ pub fn check(
         params: params.clone(),
         input: input_summary(input, templates, &data, &plan),
         tiles,
+        formats: Vec::new(),
+        files: Vec::new(),
         textures: Vec::new(),
         species: Vec::new(),
     };

@@ -223,7 +223,11 @@ pub fn compare(dir_a: &Path, dir_b: &Path) -> Result<Comparison, BuildError> {
     let hashes = |m: &Manifest| -> BTreeMap<String, String> {
         m.tiles
             .iter()
-            .map(|t| (t.id.clone(), t.obj.sha256.clone()))
+            .map(|t| {
+                // A tile is the same when every file of it is (whatever the formats).
+                let h: Vec<&str> = t.files().map(|f| f.sha256.as_str()).collect();
+                (t.id.clone(), h.join(" "))
+            })
             .collect()
     };
     let (ha, hb) = (hashes(&ma), hashes(&mb));

@@ -13,10 +13,12 @@ use thiserror::Error;
 mod billboards;
 mod crowd;
 mod garden;
+pub mod output;
 mod partial;
 pub use billboards::{PeopleParams, PointsLayer, TreesParams};
 pub use crowd::CrowdParams;
 pub use garden::GardenParams;
+pub use output::OutputParams;
 
 /// The default parameter file, shipped inside the binary.
 pub const DEFAULT_TOML: &str = include_str!("../params/default.toml");
@@ -91,6 +93,12 @@ pub struct Params {
     pub crowd: CrowdParams,
     /// The rock gardens of temple lots (seed 000).
     pub garden: GardenParams,
+    /// The output formats.
+    pub output: OutputParams,
+    /// Where the output origin stands on the globe, `[longitude, latitude, height]`: for the
+    /// tileset's placement when the CRS is local or unknown (else computed from the CRS).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin_lonlat: Option<[f64; 3]>,
     /// Relative weights of the machiya types drawn for lots of unknown type.
     pub type_mix: BTreeMap<String, f64>,
     /// Directory of textures that replace the shipped ones by file name (a texture set, as
@@ -727,6 +735,10 @@ impl Params {
         self.trees.validate().map_err(bad)?;
         self.crowd.validate().map_err(bad)?;
         self.garden.validate().map_err(bad)?;
+        self.output.validate().map_err(bad)?;
+        if let Some(o) = &self.origin_lonlat {
+            output::check_origin_lonlat(o).map_err(bad)?;
+        }
         Ok(())
     }
 }

@@ -142,7 +142,9 @@ fn each_broken_lot_is_skipped_with_its_reason_and_the_rest_built() {
     }
     let built: Vec<String> = std::fs::read_dir(out.join("tiles"))
         .unwrap()
-        .map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .map(|p| std::fs::read_to_string(p).unwrap())
         .flat_map(|t| {
             t.lines()
                 .filter_map(|l| l.strip_prefix("o ").map(String::from))
@@ -158,7 +160,9 @@ fn each_broken_lot_is_skipped_with_its_reason_and_the_rest_built() {
     // The 1 km deep lot's house is machiya.depth (12 m) deep, not 1 km.
     let deep = std::fs::read_dir(out.join("tiles"))
         .unwrap()
-        .map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .map(|p| std::fs::read_to_string(p).unwrap())
         .find(|t| t.contains("o machiya_deep\n"))
         .unwrap();
     let start = deep.find("o machiya_deep\n").unwrap();

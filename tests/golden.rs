@@ -35,7 +35,7 @@ fn snapshot(name: &str, extra: &[&str]) -> serde_json::Value {
     let mut tiles = BTreeMap::new();
     for t in manifest["tiles"].as_array().unwrap() {
         let mut files = BTreeMap::new();
-        for kind in ["obj", "mtl"] {
+        for kind in ["obj", "mtl", "glb"] {
             let f = &t[kind];
             files.insert(kind.to_string(), f["sha256"].clone());
             files.insert(format!("{kind}_bytes"), f["bytes"].clone());

@@ -122,7 +122,9 @@ fn xlsx_table_joins_from_the_named_sheet() {
     assert_eq!(join["rows_without_feature_ids"][0], "123456");
     let obj_text: String = std::fs::read_dir(dir.path().join("out/tiles"))
         .unwrap()
-        .map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .map(|p| std::fs::read_to_string(p).unwrap())
         .collect();
     let start = obj_text.find("o machiya_7\n").expect("lot 7 built");
     let rest = &obj_text[start + 4..];

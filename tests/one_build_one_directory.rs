@@ -97,7 +97,7 @@ fn two_hypotheses_started_together_never_mix_in_one_directory() {
             .as_array()
             .unwrap()
             .iter()
-            .flat_map(|t| [&t["obj"], &t["mtl"]])
+            .flat_map(|t| [&t["obj"], &t["mtl"], &t["glb"]])
             .map(|f| {
                 let path = f["path"].as_str().unwrap().to_string();
                 let bytes = std::fs::read(out.join(&path)).unwrap();

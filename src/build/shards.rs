@@ -246,10 +246,10 @@ pub fn remove_stale_tiles(out: &Path, tiles: &[report::ManifestTile]) {
     };
     let current: HashSet<&str> = tiles
         .iter()
-        .flat_map(|t| [t.obj.path.as_str(), t.mtl.path.as_str()])
+        .flat_map(|t| t.files().map(|f| f.path.as_str()))
         .collect();
     for tile in &old.tiles {
-        for path in [&tile.obj.path, &tile.mtl.path] {
+        for path in tile.files().map(|f| &f.path) {
             let safe = path.starts_with("tiles/") && !path.contains("..");
             if safe && !current.contains(path.as_str()) {
                 let _ = std::fs::remove_file(out.join(path));
@@ -333,7 +333,7 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     for (dir, path, m) in &shards {
         let shard = m.shard.map(|[i, n]| format!("{i}/{n}")).unwrap_or_default();
         for t in &m.tiles {
-            for f in [&t.obj, &t.mtl] {
+            for f in t.files() {
                 let from = dir.join(&f.path);
                 let bytes = std::fs::read(&from).map_err(|e| {
                     BuildError::Config(format!(
@@ -370,6 +370,7 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     let mut merged = first.clone();
     merged.shard = None;
     merged.tiles = tiles.into_values().collect();
+    finish_formats(target, &mut merged)?;
     // The whole city's plan, as a full build draws it (shards leave it to the merge); drawn
     // before the manifest, which is written last, so a failing plan leaves no merged manifest.
     if draw_plan {
@@ -385,6 +386,25 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
         let _ = std::fs::remove_file(path.with_file_name(report_name));
     }
     Ok(rep)
+}
+
+/// Runs every format's whole-build step (`tileset.json`) over `manifest`, listing the files
+/// it writes in the manifest and what it noticed in the warnings.
+pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildError> {
+    let mut warnings = Vec::new();
+    manifest.files.clear();
+    for sink in crate::output::sink::sinks(&manifest.formats) {
+        let files = sink
+            .finish(out, manifest, &mut warnings)
+            .map_err(|e| write_err(out, e))?;
+        manifest.files.extend(files);
+    }
+    manifest.input.warnings.extend(
+        warnings
+            .into_iter()
+            .map(|m| crate::model::Warning::new(crate::model::WarningClass::Build, m)),
+    );
+    Ok(())
 }
 
 /// What makes shard manifest `m` part of another build than `first`: the shard count, the

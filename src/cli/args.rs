@@ -42,6 +42,10 @@ pub struct BuildArgs {
     /// Replace an output directory that holds a build of other parameters or input.
     #[arg(long)]
     pub force: bool,
+    /// The tile formats, comma-separated: obj (OBJ + MTL), glb (binary glTF + tileset.json);
+    /// wins over `output.formats` of the parameter file (default: both).
+    #[arg(long, value_delimiter = ',')]
+    pub format: Option<Vec<String>>,
 }
 
 /// The flags of `edo-city compare`.

@@ -27,8 +27,14 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
         tiles,
         shard,
         force,
+        format,
     } = args;
-    let params = load_params(params.as_deref())?;
+    let mut params = load_params(params.as_deref())?;
+    if let Some(formats) = format {
+        edo_city::params::output::check_formats(&formats)
+            .map_err(|e| anyhow::anyhow!("--format: {e}"))?;
+        params.output.formats = formats;
+    }
     let opts = BuildOptions {
         input,
         out,

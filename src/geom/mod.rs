@@ -4,6 +4,7 @@
 
 pub mod bbox;
 pub mod clip;
+pub mod crs;
 pub mod frame;
 pub mod ring;
 pub mod segment;

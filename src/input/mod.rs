@@ -6,7 +6,8 @@
 //! of points, a `.dbf` that does not match its `.shp`, an unreadable `.prj`) are errors;
 //! problems with single features skip that feature with a reason, and the rest is built.
 
-pub mod crs;
+/// Coordinate reference systems (in [`crate::geom::crs`]: the tileset uses them too).
+pub use crate::geom::crs;
 pub mod dem;
 pub mod fields;
 pub mod geometry;

@@ -1,4 +1,5 @@
-//! Stage 4: output. Writes tiles (OBJ + MTL), textures, `report.json` and `manifest.json`.
+//! Stage 4: output. Writes tiles through one [`sink::Sink`] per format (`obj/`: OBJ + MTL,
+//! `gltf/`: GLB, with `tiles3d/`'s `tileset.json`), textures, `report.json` and `manifest.json`.
 //!
 //! Every file goes through [`atomic::write_atomic`]; `manifest.json` is written last, so a
 //! manifest always describes complete tiles.
@@ -6,15 +7,18 @@
 pub mod accounting;
 pub mod atomic;
 pub mod chart;
+pub mod features;
+pub mod gltf;
 pub mod lock;
-pub mod mtl;
 pub mod obj;
 pub mod plan;
 pub mod render;
 pub mod report;
+pub mod sink;
 pub mod sketch;
 pub mod species;
 pub mod text;
+pub mod tiles3d;
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -29,35 +33,6 @@ use report::ManifestFile;
 pub fn sha256_hex(bytes: &[u8]) -> String {
     let digest = Sha256::digest(bytes);
     digest.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// Writes `<out>/tiles/<tile>.obj` and `.mtl`; returns their manifest entries and the bytes
-/// of each mesh's object in the OBJ.
-pub fn write_tile(
-    out: &Path,
-    tile: &str,
-    origin: [f64; 2],
-    meshes: &[Mesh],
-) -> std::io::Result<(ManifestFile, ManifestFile, Vec<usize>)> {
-    let mut obj = Vec::with_capacity(meshes.len() * 4096);
-    let sizes = obj::write_tile(&mut obj, tile, origin, meshes);
-    let mtl = mtl::mtl_text().into_bytes();
-    let dir = out.join("tiles");
-    atomic::write_atomic(&dir.join(format!("{tile}.obj")), &obj)?;
-    atomic::write_atomic(&dir.join(format!("{tile}.mtl")), &mtl)?;
-    Ok((
-        ManifestFile {
-            path: format!("tiles/{tile}.obj"),
-            bytes: obj.len() as u64,
-            sha256: sha256_hex(&obj),
-        },
-        ManifestFile {
-            path: format!("tiles/{tile}.mtl"),
-            bytes: mtl.len() as u64,
-            sha256: sha256_hex(&mtl),
-        },
-        sizes,
-    ))
 }
 
 /// One texture file: its name in `textures/` and its PNG bytes.
@@ -144,7 +119,7 @@ pub fn write_model(obj_path: &Path, meshes: &[Mesh], texture_set: &str) -> Resul
     obj::write_tile(&mut buf, stem, [0.0, 0.0], meshes);
     atomic::write_atomic(obj_path, &buf).map_err(|e| io(obj_path, e))?;
     let mtl_path = dir.join(format!("{stem}.mtl"));
-    atomic::write_atomic(&mtl_path, mtl::mtl_text_at("textures/").as_bytes())
+    atomic::write_atomic(&mtl_path, obj::mtl::mtl_text_at("textures/").as_bytes())
         .map_err(|e| io(&mtl_path, e))?;
     Ok(textures.len())
 }

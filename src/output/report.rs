@@ -289,9 +289,11 @@ pub struct TileReport {
     pub machiya: usize,
     /// Footprint houses in it.
     pub footprints: usize,
-    /// Bytes of its OBJ.
+    /// Bytes of its OBJ (0 when `obj` was not written).
     pub obj_bytes: u64,
-    /// Of them, bytes of its trees.
+    /// Bytes of its GLB (0 when `glb` was not written).
+    pub glb_bytes: u64,
+    /// Of the OBJ's, bytes of its trees.
     pub tree_bytes: u64,
 }
 
@@ -360,6 +362,12 @@ pub struct Manifest {
     pub input: InputSummary,
     /// Every tile written, with its files and statistics.
     pub tiles: Vec<ManifestTile>,
+    /// The formats written (`obj`, `glb`).
+    #[serde(default)]
+    pub formats: Vec<String>,
+    /// The files that describe the whole build (`tileset.json`).
+    #[serde(default)]
+    pub files: Vec<ManifestFile>,
     /// The texture files.
     pub textures: Vec<ManifestFile>,
     /// `species/`: each planted species' LOD0 and `placements.csv` (empty when no tree has a
@@ -373,12 +381,49 @@ pub struct Manifest {
 pub struct ManifestTile {
     /// The tile's id.
     pub id: String,
-    /// Its OBJ file.
-    pub obj: ManifestFile,
-    /// Its MTL file.
-    pub mtl: ManifestFile,
+    /// Its OBJ file (format `obj`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obj: Option<ManifestFile>,
+    /// Its MTL file (format `obj`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mtl: Option<ManifestFile>,
+    /// Its GLB file (format `glb`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub glb: Option<ManifestFile>,
+    /// The extent of its content, metres relative to the origin: `[east_min, north_min,
+    /// up_min, east_max, north_max, up_max]` (for the tileset's bounding boxes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bounds: Option<[f64; 6]>,
+    /// The point its GLB's coordinates are taken around, metres relative to the origin:
+    /// `[east, north]`.
+    #[serde(default)]
+    pub centre: [f64; 2],
     /// What generation found in it.
     pub stats: TileStats,
+}
+
+impl ManifestTile {
+    /// Every file of the tile, whatever the format, in a fixed order.
+    pub fn files(&self) -> impl Iterator<Item = &ManifestFile> {
+        [&self.obj, &self.mtl, &self.glb].into_iter().flatten()
+    }
+
+    /// Files a sink wrote, each put in its slot by its extension.
+    pub fn add_files(&mut self, files: Vec<ManifestFile>) {
+        for f in files {
+            let slot = match f.path.rsplit('.').next() {
+                Some("obj") => &mut self.obj,
+                Some("mtl") => &mut self.mtl,
+                _ => &mut self.glb,
+            };
+            *slot = Some(f);
+        }
+    }
+
+    /// The bytes of all its files.
+    pub fn bytes(&self) -> u64 {
+        self.files().map(|f| f.bytes).sum()
+    }
 }
 
 /// One file written by the build.
@@ -449,7 +494,8 @@ pub fn assemble_report(m: &Manifest) -> Report {
             id: t.id.clone(),
             machiya: s.machiya,
             footprints: s.footprints,
-            obj_bytes: t.obj.bytes,
+            obj_bytes: t.obj.as_ref().map_or(0, |f| f.bytes),
+            glb_bytes: t.glb.as_ref().map_or(0, |f| f.bytes),
             tree_bytes: s.tree_bytes,
         });
         for (species, lods) in &s.trees_by_species {

@@ -10,7 +10,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::report::ManifestFile;
-use super::{atomic, mtl, obj, sha256_hex};
+use super::{atomic, obj, sha256_hex};
 use crate::generate::tree;
 use crate::model::Plan;
 use crate::params::Params;
@@ -64,7 +64,7 @@ pub fn write_species(
         let mut buf = Vec::new();
         obj::write_tile(&mut buf, &s.name, [0.0, 0.0], [&mesh]);
         put(format!("{}.obj", s.name), &buf)?;
-        put(format!("{}.mtl", s.name), mtl::mtl_text().as_bytes())?;
+        put(format!("{}.mtl", s.name), obj::mtl::mtl_text().as_bytes())?;
         heights.insert(s.name.clone(), s.nominal_height());
     }
     let mut csv = String::from("id,tile,species,lot,x,y,z,rotation,scale,squeeze,style\n");

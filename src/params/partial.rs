@@ -26,6 +26,8 @@ pub struct Params {
     trees: Option<super::billboards::partial::Trees>,
     crowd: Option<super::crowd::partial::Crowd>,
     garden: Option<super::garden::partial::Garden>,
+    output: Option<super::output::partial::Output>,
+    origin_lonlat: Option<[f64; 3]>,
     type_mix: Option<BTreeMap<String, f64>>,
     textures: Option<String>,
     terrain: Option<bool>,

@@ -5,10 +5,47 @@
 //! writer was made, with the same bytes. Faces are grouped by material within each object so
 //! each object has at most one `usemtl` per material.
 
-use std::io::Write;
+pub mod mtl;
 
+use std::io::Write;
+use std::path::Path;
+
+use super::report::ManifestFile;
+use super::sink::{Sink, TileContent, TileFiles};
+use super::{atomic, sha256_hex};
 use crate::generate::mesh::Mesh;
 use crate::materials::MATERIALS;
+
+/// The OBJ format: `tiles/<id>.obj` and its `tiles/<id>.mtl`.
+pub struct ObjSink;
+
+impl Sink for ObjSink {
+    fn format(&self) -> &'static str {
+        "obj"
+    }
+
+    fn write_tile(&self, out: &Path, tile: &TileContent) -> std::io::Result<TileFiles> {
+        let id = tile.id;
+        let mut obj = Vec::with_capacity(tile.meshes.len() * 4096);
+        let sizes = write_tile(&mut obj, id, tile.origin, tile.meshes);
+        let mtl = mtl::mtl_text().into_bytes();
+        let dir = out.join("tiles");
+        atomic::write_atomic(&dir.join(format!("{id}.obj")), &obj)?;
+        atomic::write_atomic(&dir.join(format!("{id}.mtl")), &mtl)?;
+        let entry = |path: String, bytes: &[u8]| ManifestFile {
+            path,
+            bytes: bytes.len() as u64,
+            sha256: sha256_hex(bytes),
+        };
+        Ok(TileFiles {
+            files: vec![
+                entry(format!("tiles/{id}.obj"), &obj),
+                entry(format!("tiles/{id}.mtl"), &mtl),
+            ],
+            mesh_bytes: Some(sizes),
+        })
+    }
+}
 
 /// Appends `v` (millimetres) as metres with three decimals.
 fn push_mm(buf: &mut Vec<u8>, v: i64) {

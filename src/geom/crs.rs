@@ -1,4 +1,5 @@
-//! Coordinate reference systems: read from `.prj`, chosen for the output, and reprojection.
+//! Coordinate reference systems: read from `.prj`, chosen for the output, and reprojection
+//! (input reads the layers with it; the tileset writer places the city on the globe).
 //!
 //! The pipeline works in projected metres. Each layer's `.prj` (ESRI WKT) is turned into a
 //! proj string with `proj4wkt` and coordinates are moved with `proj4rs`, both pure Rust.

@@ -1,0 +1,254 @@
+//! Binary glTF 2.0 tiles (`tiles/<id>.glb`), written by our own writer with serde_json: the
+//! glTF JSON we need is small and fixed, and the extensions (`EXT_mesh_features`,
+//! `EXT_structural_metadata`) are plain JSON that `gltf-json` would hold as untyped values
+//! anyway.
+//!
+//! Frame: y-up, x = east, z = -north, metres around the tile's centre (so f32 keeps
+//! sub-millimetre precision); `tileset.json` places each tile. One node per object kind
+//! (`machiya`, `kura`, `fence`, `people`, ...), so a viewer can hide a kind; one primitive
+//! per material within it, merged across objects; each vertex carries its object's row in
+//! the metadata table (`_FEATURE_ID_0`). Cut-outs are `MASK` at 0.5, double-sided; no BLEND.
+//! Textures are the shared library by relative URI (`../textures/<file>`): one copy per
+//! build, cached by a browser across tiles, loadable from any static server.
+
+pub mod buffer;
+pub mod metadata;
+
+use std::collections::HashMap;
+
+use serde_json::{json, Value};
+
+use crate::generate::mesh::Mesh;
+use crate::materials::MATERIALS;
+use crate::output::features::Feature;
+use buffer::Buffer;
+
+/// One primitive being assembled: interleaving is left to the accessors (one view each).
+#[derive(Default)]
+struct Primitive {
+    positions: Vec<f32>,
+    normals: Vec<f32>,
+    uvs: Vec<f32>,
+    ids: Vec<f32>,
+    indices: Vec<u32>,
+    /// (object, position index, uv index, normal bits) -> vertex.
+    seen: HashMap<(u32, u32, u32, [u32; 3]), u32, foldhash::fast::FixedState>,
+    features: std::collections::BTreeSet<u32>,
+}
+
+/// The face's unit normal from its corners (Newell's method, in f64 millimetres); `None`
+/// for a face with no area.
+fn normal(mesh: &Mesh, corners: &[(u32, u32)]) -> Option<[f32; 3]> {
+    let mut n = [0.0f64; 3];
+    for k in 0..corners.len() {
+        let a = mesh.positions[corners[k].0 as usize];
+        let b = mesh.positions[corners[(k + 1) % corners.len()].0 as usize];
+        let (a, b) = (a.map(|v| v as f64), b.map(|v| v as f64));
+        n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    }
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    (len > 1e-9).then(|| n.map(|v| (v / len) as f32))
+}
+
+impl Primitive {
+    /// Adds one face of object `object` of `mesh`, as a fan of triangles (the OBJ's faces
+    /// are convex or drawn so that clients fan them).
+    fn face(&mut self, object: u32, mesh: &Mesh, corners: &[(u32, u32)], shift: [i64; 3]) {
+        let Some(n) = normal(mesh, corners) else {
+            return;
+        };
+        let nb = n.map(f32::to_bits);
+        self.features.insert(object);
+        let mut idx = Vec::with_capacity(corners.len());
+        for &(p, t) in corners {
+            let next = (self.positions.len() / 3) as u32;
+            let v = *self.seen.entry((object, p, t, nb)).or_insert_with(|| {
+                let q = mesh.positions[p as usize];
+                for k in 0..3 {
+                    self.positions
+                        .push(((q[k] - shift[k]) as f64 / 1000.0) as f32);
+                }
+                self.normals.extend_from_slice(&n);
+                let uv = mesh.uvs.get(t as usize).copied().unwrap_or([0, 0]);
+                self.uvs.push(uv[0] as f32 / 10_000.0);
+                self.uvs.push(1.0 - uv[1] as f32 / 10_000.0);
+                self.ids.push(object as f32);
+                next
+            });
+            idx.push(v);
+        }
+        for k in 1..idx.len().saturating_sub(1) {
+            self.indices
+                .extend_from_slice(&[idx[0], idx[k], idx[k + 1]]);
+        }
+    }
+}
+
+/// sRGB to linear, for `baseColorFactor` (glTF factors are linear).
+fn linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The GLB bytes of one tile. `shift` (millimetres, output frame) is the tile centre the
+/// positions are taken around; `features` has one entry per mesh.
+pub fn tile_glb(tile: &str, meshes: &[Mesh], features: &[Feature], shift: [i64; 3]) -> Vec<u8> {
+    // Node per kind, in order of first appearance; primitive per material, by material id.
+    let mut kinds: Vec<(&str, std::collections::BTreeMap<u16, Primitive>)> = Vec::new();
+    for (i, (mesh, f)) in meshes.iter().zip(features).enumerate() {
+        let k = match kinds.iter().position(|(k, _)| *k == f.kind) {
+            Some(k) => k,
+            None => {
+                kinds.push((&f.kind, Default::default()));
+                kinds.len() - 1
+            }
+        };
+        for face in &mesh.faces {
+            kinds[k]
+                .1
+                .entry(face.material)
+                .or_default()
+                .face(i as u32, mesh, &face.corners, shift);
+        }
+    }
+    let mut buf = Buffer::default();
+    let mut used: Vec<u16> = Vec::new();
+    let mut meshes_json = Vec::new();
+    let mut nodes = Vec::new();
+    for (kind, prims) in &kinds {
+        let mut primitives = Vec::new();
+        for (&material, p) in prims {
+            if p.indices.is_empty() {
+                continue;
+            }
+            let vertices = p.positions.len() / 3;
+            let pos = buf.floats(&p.positions, 3, true);
+            let nor = buf.floats(&p.normals, 3, false);
+            let uv = buf.floats(&p.uvs, 2, false);
+            let fid = buf.floats(&p.ids, 1, false);
+            let ind = buf.indices(&p.indices, vertices);
+            let m = match used.iter().position(|&u| u == material) {
+                Some(m) => m,
+                None => {
+                    used.push(material);
+                    used.len() - 1
+                }
+            };
+            primitives.push(json!({
+                "attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv, "_FEATURE_ID_0": fid},
+                "indices": ind,
+                "material": m,
+                "mode": 4,
+                "extensions": {"EXT_mesh_features": {"featureIds": [{
+                    "featureCount": p.features.len(),
+                    "attribute": 0,
+                    "propertyTable": 0,
+                }]}},
+            }));
+        }
+        if primitives.is_empty() {
+            continue;
+        }
+        nodes.push(json!({"name": kind, "mesh": meshes_json.len()}));
+        meshes_json.push(json!({"name": kind, "primitives": primitives}));
+    }
+    let (materials, images, textures) = materials(&used);
+    let mut doc = json!({
+        "asset": {
+            "version": "2.0",
+            "generator": format!("edo-city {}", env!("CARGO_PKG_VERSION")),
+            "extras": {"tile": tile},
+        },
+        "scene": 0,
+        "scenes": [{"name": tile}],
+    });
+    if !nodes.is_empty() {
+        let metadata = metadata::structural_metadata(features, &mut buf);
+        doc["extensionsUsed"] = json!(["EXT_mesh_features", "EXT_structural_metadata"]);
+        doc["extensions"] = json!({"EXT_structural_metadata": metadata});
+        doc["scenes"][0]["nodes"] = json!((0..nodes.len()).collect::<Vec<_>>());
+        doc["nodes"] = json!(nodes);
+        doc["meshes"] = json!(meshes_json);
+        doc["materials"] = json!(materials);
+        doc["buffers"] = json!([{"byteLength": buf.bin.len().next_multiple_of(4)}]);
+        doc["bufferViews"] = json!(buf.views);
+        doc["accessors"] = json!(buf.accessors);
+    }
+    if !images.is_empty() {
+        doc["images"] = json!(images);
+        doc["textures"] = json!(textures);
+        doc["samplers"] =
+            json!([{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]);
+    }
+    buffer::glb(&doc, &buf.bin)
+}
+
+/// The materials `used` (library ids, in first-use order) as glTF materials, with the
+/// images and textures the textured ones need.
+fn materials(used: &[u16]) -> (Vec<Value>, Vec<Value>, Vec<Value>) {
+    let (mut out, mut images, mut textures) = (Vec::new(), Vec::new(), Vec::new());
+    for &id in used {
+        let m = &MATERIALS[id as usize];
+        let mut pbr = json!({"metallicFactor": 0.0, "roughnessFactor": 0.9});
+        match m.texture {
+            Some(file) => {
+                images.push(json!({"uri": format!("../textures/{file}"), "mimeType": "image/png"}));
+                textures.push(json!({"sampler": 0, "source": images.len() - 1}));
+                pbr["baseColorTexture"] = json!({"index": textures.len() - 1});
+            }
+            None => {
+                let [r, g, b] = m.kd;
+                pbr["baseColorFactor"] = json!([linear(r), linear(g), linear(b), 1.0]);
+            }
+        }
+        let mut mat = json!({"name": m.name, "pbrMetallicRoughness": pbr});
+        if m.alpha {
+            mat["alphaMode"] = json!("MASK");
+            mat["alphaCutoff"] = json!(0.5);
+            mat["doubleSided"] = json!(true);
+        }
+        out.push(mat);
+    }
+    (out, images, textures)
+}
+
+/// The GLB format: `tiles/<id>.glb`, and `tileset.json` over all of them.
+pub struct GlbSink;
+
+impl crate::output::sink::Sink for GlbSink {
+    fn format(&self) -> &'static str {
+        "glb"
+    }
+
+    fn write_tile(
+        &self,
+        out: &std::path::Path,
+        tile: &crate::output::sink::TileContent,
+    ) -> std::io::Result<crate::output::sink::TileFiles> {
+        let bytes = tile_glb(tile.id, tile.meshes, tile.features, tile.centre);
+        let path = format!("tiles/{}.glb", tile.id);
+        crate::output::atomic::write_atomic(&out.join(&path), &bytes)?;
+        Ok(crate::output::sink::TileFiles {
+            files: vec![crate::output::report::ManifestFile {
+                path,
+                bytes: bytes.len() as u64,
+                sha256: crate::output::sha256_hex(&bytes),
+            }],
+            mesh_bytes: None,
+        })
+    }
+
+    fn finish(
+        &self,
+        out: &std::path::Path,
+        manifest: &crate::output::report::Manifest,
+        warnings: &mut Vec<String>,
+    ) -> std::io::Result<Vec<crate::output::report::ManifestFile>> {
+        crate::output::tiles3d::write_tileset(out, manifest, warnings).map(|f| vec![f])
+    }
+}

@@ -1,0 +1,62 @@
+//! `[output]`: which formats a build writes, and `origin_lonlat`, where a city in a local or
+//! unknown CRS stands on the globe (for the 3D Tiles tileset).
+
+use serde::{Deserialize, Serialize};
+
+/// The formats a build can write, as `--format` and `output.formats` spell them.
+pub const FORMATS: &[&str] = &["obj", "glb"];
+
+/// The output's settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputParams {
+    /// The tile formats: `obj` (OBJ + MTL), `glb` (binary glTF, with `tileset.json`).
+    pub formats: Vec<String>,
+}
+
+impl OutputParams {
+    pub(super) fn validate(&self) -> Result<(), String> {
+        check_formats(&self.formats).map_err(|e| format!("`output.formats`: {e}"))
+    }
+}
+
+/// The error for a list of formats that is empty or names an unknown one.
+pub fn check_formats(formats: &[String]) -> Result<(), String> {
+    if formats.is_empty() {
+        return Err(format!("name at least one format ({})", FORMATS.join(", ")));
+    }
+    match formats.iter().find(|f| !FORMATS.contains(&f.as_str())) {
+        Some(f) => Err(format!(
+            "unknown format `{f}`: the formats are {}",
+            FORMATS.join(", ")
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Checks `origin_lonlat = [lon, lat, h]`.
+pub fn check_origin_lonlat(o: &[f64; 3]) -> Result<(), String> {
+    let ok = o.iter().all(|v| v.is_finite())
+        && (-180.0..=180.0).contains(&o[0])
+        && (-90.0..=90.0).contains(&o[1])
+        && (-1000.0..=10_000.0).contains(&o[2]);
+    if ok {
+        Ok(())
+    } else {
+        Err(format!(
+            "`origin_lonlat` must be [longitude -180..180, latitude -90..90, height -1000..10000 m], got {o:?}"
+        ))
+    }
+}
+
+/// The same table with every field optional, for checking a user's partial file.
+pub(super) mod partial {
+    use serde::Deserialize;
+
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    pub struct Output {
+        formats: Option<Vec<String>>,
+    }
+}

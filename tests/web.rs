@@ -1,0 +1,306 @@
+//! The browser's formats: GLB tiles and the 3D Tiles tileset. Its structure (boxes hold
+//! their content and their children, geometric error 0 at the leaves and growing to the
+//! root), its placement on the globe (a house corner lands where proj puts it), `--format`,
+//! and Khronos' glTF-Validator on every GLB (npm, installed by `make viewer-deps`).
+
+mod common;
+
+use std::path::Path;
+
+use common::{build_ok, fixture, read_json};
+use edo_city::output::tiles3d::globe::{geodetic, Affine};
+use serde_json::Value;
+
+/// The JSON chunk of a GLB.
+fn glb_json(bytes: &[u8]) -> Value {
+    assert_eq!(&bytes[0..4], b"glTF");
+    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[16..20], b"JSON");
+    serde_json::from_slice(&bytes[20..20 + len]).unwrap()
+}
+
+/// A column-major 4x4 transform as an affine map.
+fn affine(m: &Value) -> Affine {
+    let v: Vec<f64> = m
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    Affine {
+        cols: [[v[0], v[1], v[2]], [v[4], v[5], v[6]], [v[8], v[9], v[10]]],
+        t: [v[12], v[13], v[14]],
+    }
+}
+
+/// Is `p` inside the box `b` (centre and three axis-aligned half-axes), to `eps`?
+fn inside(b: &Value, p: [f64; 3], eps: f64) -> bool {
+    let b: Vec<f64> = b
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let half = [b[3], b[7], b[11]];
+    (0..3).all(|k| (p[k] - b[k]).abs() <= half[k] + eps)
+}
+
+/// The corners of a box.
+fn corners(b: &Value) -> Vec<[f64; 3]> {
+    let b: Vec<f64> = b
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    (0..8)
+        .map(|i| {
+            let s = |k: usize| if i >> k & 1 == 0 { -1.0 } else { 1.0 };
+            [b[0] + s(0) * b[3], b[1] + s(1) * b[7], b[2] + s(2) * b[11]]
+        })
+        .collect()
+}
+
+/// Walks the tree: every child's box (through its transform) inside its parent's, leaf
+/// errors 0 and inner ones larger than their children's; returns the leaves with their
+/// transform relative to the root.
+fn walk(node: &Value, to_root: Affine, leaves: &mut Vec<(Value, Affine)>) {
+    let here = match node.get("transform") {
+        Some(t) => to_root.then(&affine(t)),
+        None => to_root,
+    };
+    let Some(children) = node.get("children").and_then(|c| c.as_array()) else {
+        assert_eq!(node["geometricError"], 0.0, "a leaf's error is 0");
+        assert!(node["content"]["uri"].as_str().unwrap().ends_with(".glb"));
+        leaves.push((node.clone(), here));
+        return;
+    };
+    let e = node["geometricError"].as_f64().unwrap();
+    for c in children {
+        assert!(
+            c["geometricError"].as_f64().unwrap() < e,
+            "errors grow to the root"
+        );
+        let ct = c.get("transform").map(affine).unwrap_or(Affine::IDENTITY);
+        for p in corners(&c["boundingVolume"]["box"]) {
+            assert!(
+                inside(&node["boundingVolume"]["box"], ct.apply(p), 1e-6),
+                "a child's box leaves its parent's"
+            );
+        }
+        walk(c, here, leaves);
+    }
+}
+
+#[test]
+fn the_tileset_holds_every_tile_and_places_a_house_where_proj_does() {
+    let out = tempfile::tempdir().unwrap();
+    let report = build_ok(
+        &fixture("kyoto-small"),
+        out.path(),
+        &["--quiet", "--no-plan"],
+    );
+    let manifest = read_json(&out.path().join("manifest.json"));
+    assert_eq!(manifest["formats"], serde_json::json!(["obj", "glb"]));
+    assert_eq!(manifest["files"][0]["path"], "tileset.json");
+    let tileset = read_json(&out.path().join("tileset.json"));
+    assert_eq!(tileset["asset"]["version"], "1.1");
+    let root = &tileset["root"];
+    assert_eq!(root["refine"], "ADD");
+    let mut leaves = Vec::new();
+    walk(root, Affine::IDENTITY, &mut leaves);
+    let tiles = manifest["tiles"].as_array().unwrap();
+    assert_eq!(leaves.len(), tiles.len(), "one leaf per tile");
+    assert_eq!(report["tiles"][0]["glb_bytes"], tiles[0]["glb"]["bytes"]);
+
+    // Every vertex of every GLB lies in its leaf's box (glTF y-up turned z-up as 3D Tiles
+    // does: (x, y, z) -> (x, -z, y)).
+    for (leaf, _) in &leaves {
+        let uri = leaf["content"]["uri"].as_str().unwrap();
+        let g = glb_json(&std::fs::read(out.path().join(uri)).unwrap());
+        for mesh in g["meshes"].as_array().unwrap() {
+            for p in mesh["primitives"].as_array().unwrap() {
+                let a = &g["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
+                for m in [&a["min"], &a["max"]] {
+                    let v: Vec<f64> = m
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .map(|x| x.as_f64().unwrap())
+                        .collect();
+                    assert!(
+                        inside(&leaf["boundingVolume"]["box"], [v[0], -v[2], v[1]], 1e-4),
+                        "{uri}: a vertex outside its box"
+                    );
+                }
+                let ext = &p["extensions"]["EXT_mesh_features"]["featureIds"][0];
+                assert_eq!(ext["propertyTable"], 0);
+                assert!(p["attributes"]["_FEATURE_ID_0"].is_u64());
+            }
+        }
+        let table = &g["extensions"]["EXT_structural_metadata"]["propertyTables"][0];
+        assert!(table["count"].as_u64().unwrap() > 0);
+        for mat in g["materials"].as_array().unwrap() {
+            assert_ne!(mat["alphaMode"], "BLEND");
+            if mat["alphaMode"] == "MASK" {
+                assert_eq!(mat["alphaCutoff"], 0.5);
+                assert_eq!(mat["doubleSided"], true);
+            }
+        }
+    }
+
+    // A house's corner in the OBJ, through the tileset's transforms, lands at the longitude
+    // and latitude proj gives its map point (within 5 cm).
+    let origin = [
+        manifest["origin"][0].as_f64().unwrap(),
+        manifest["origin"][1].as_f64().unwrap(),
+    ];
+    let crs = edo_city::input::crs::Crs::from_user(manifest["crs"].as_str().unwrap()).unwrap();
+    let wgs84 =
+        edo_city::input::crs::Crs::from_user("+proj=longlat +datum=WGS84 +no_defs").unwrap();
+    let objects = common::build_objects(out.path());
+    let mut checked = 0;
+    for t in tiles {
+        let uri = t["glb"]["path"].as_str().unwrap();
+        let (_, to_ecef) = leaves
+            .iter()
+            .find(|(l, _)| l["content"]["uri"] == uri)
+            .unwrap();
+        let centre = [
+            t["centre"][0].as_f64().unwrap(),
+            t["centre"][1].as_f64().unwrap(),
+        ];
+        let tile_objects =
+            common::load_tile(&out.path().join(t["obj"]["path"].as_str().unwrap()), origin);
+        let Some(house) = tile_objects.iter().find(|o| o.name.starts_with("machiya_")) else {
+            continue;
+        };
+        for &[e, n, up] in house.vertices.iter().step_by(7).take(5) {
+            let local = [e - origin[0] - centre[0], n - origin[1] - centre[1], up];
+            let g = geodetic(to_ecef.apply(local));
+            let mut truth = [geo_types::Coord { x: e, y: n }];
+            edo_city::input::crs::reproject(&mut truth, &crs, &wgs84).unwrap();
+            let metres_per_degree = 111_320.0;
+            let dx = (g[0] - truth[0].x) * metres_per_degree * g[1].to_radians().cos();
+            let dy = (g[1] - truth[0].y) * metres_per_degree;
+            assert!(
+                dx.hypot(dy) < 0.05,
+                "{}: off by {:.3} m",
+                house.name,
+                dx.hypot(dy)
+            );
+            assert!((g[2] - up).abs() < 0.05, "height {} for {up}", g[2]);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 10, "{checked} corners checked");
+    assert!(!objects.is_empty());
+}
+
+#[test]
+fn formats_are_chosen_and_a_city_without_a_crs_is_built_unplaced_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let glb = dir.path().join("glb");
+    build_ok(
+        &fixture("kyoto-small"),
+        &glb,
+        &["--quiet", "--no-plan", "--format", "glb"],
+    );
+    let m = read_json(&glb.join("manifest.json"));
+    assert!(m["tiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|t| t["obj"].is_null() && t["glb"].is_object()));
+    assert!(!std::fs::read_dir(glb.join("tiles")).unwrap().any(|e| e
+        .unwrap()
+        .path()
+        .extension()
+        .is_some_and(|x| x == "obj")));
+    let obj = dir.path().join("obj");
+    build_ok(
+        &fixture("kyoto-small"),
+        &obj,
+        &["--quiet", "--no-plan", "--format", "obj"],
+    );
+    assert!(!obj.join("tileset.json").exists());
+    let bad = common::edo_city()
+        .args(["build", fixture("kyoto-small").to_str().unwrap(), "--out"])
+        .arg(dir.path().join("bad"))
+        .args(["--format", "obj,gltf"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown format `gltf`"));
+
+    // The same town with no .prj anywhere: identity transform and a warning; placed again
+    // with origin_lonlat.
+    let town = dir.path().join("town");
+    common::copy_fixture("kyoto-small", &town);
+    for e in std::fs::read_dir(&town).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "prj") {
+            std::fs::remove_file(p).unwrap();
+        }
+    }
+    let unplaced = dir.path().join("unplaced");
+    let r = build_ok(&town, &unplaced, &["--quiet", "--no-plan"]);
+    let t = read_json(&unplaced.join("tileset.json"));
+    assert_eq!(
+        t["root"]["transform"],
+        serde_json::json!([
+            1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0
+        ])
+    );
+    assert!(r["warnings"]
+        .to_string()
+        .contains("not placed on the globe"));
+    let params = dir.path().join("p.toml");
+    std::fs::write(&params, "origin_lonlat = [135.7681, 35.0116, 40.0]\n").unwrap();
+    let placed = dir.path().join("placed");
+    let r = build_ok(
+        &town,
+        &placed,
+        &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
+    );
+    assert!(!r["warnings"]
+        .to_string()
+        .contains("not placed on the globe"));
+    let t = read_json(&placed.join("tileset.json"));
+    let root = affine(&t["root"]["transform"]);
+    let g = geodetic(root.apply([0.0, 0.0, 0.0]));
+    assert!(
+        (g[0] - 135.7681).abs() < 1e-9
+            && (g[1] - 35.0116).abs() < 1e-9
+            && (g[2] - 40.0).abs() < 1e-3
+    );
+}
+
+#[test]
+fn every_glb_passes_the_khronos_validator() {
+    let viewer = Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer");
+    assert!(
+        viewer.join("node_modules/gltf-validator").is_dir(),
+        "viewer/node_modules is missing: run `make viewer-deps` (npm ci in viewer/)"
+    );
+    let out = tempfile::tempdir().unwrap();
+    // Houses, kura, walls, gates, people, trees and a garden: every kind the example has.
+    build_ok(
+        &fixture("kyoto-small"),
+        out.path(),
+        &["--quiet", "--no-plan", "--format", "glb"],
+    );
+    let o = std::process::Command::new("node")
+        .current_dir(&viewer)
+        .arg("test/validate.mjs")
+        .arg(out.path())
+        .output()
+        .expect("node runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{text}");
+    assert!(text.contains("0 with errors or warnings"), "{text}");
+}
