@@ -15,11 +15,9 @@ test: viewer-deps
 	$(CARGO) test --doc
 
 ## The viewer's npm packages (three.js, 3d-tiles-renderer, gltf-validator, playwright-core),
-## exactly as viewer/package-lock.json pins them.
-viewer-deps: viewer/node_modules/.package-lock.json
-
-viewer/node_modules/.package-lock.json: viewer/package.json viewer/package-lock.json
-	cd viewer && npm ci --no-audit --no-fund
+## exactly as viewer/package-lock.json pins them, and Debian's chromium for the browser test.
+viewer-deps:
+	bash scripts/viewer-deps.sh
 
 ## The suite again under faketime a year ahead and on a leap day (needs faketime:
 ## scripts/ci-deps.sh installs it); CI runs it after `make test`.

@@ -23,6 +23,7 @@ use cli::args::*;
 use cli::commands::*;
 use cli::garden::*;
 use cli::plants::*;
+use cli::serve::*;
 use cli::Problems;
 
 #[derive(Parser)]
@@ -74,6 +75,8 @@ enum Command {
     /// Design a dry rock garden (karesansui) by the GA of seed 000 with the Ryoanji rules;
     /// `--interactive` shows each generation's best and breeds from your picks.
     Garden(GardenArgs),
+    /// Serve the web viewer and one or more builds (hypotheses) on 127.0.0.1.
+    Serve(ServeArgs),
 }
 
 fn main() -> ExitCode {
@@ -113,6 +116,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Lsystem(args) => lsystem_command(args),
         Command::Tree(args) => tree_command(args),
         Command::Garden(args) => garden_command(args),
+        Command::Serve(args) => serve_command(args),
         Command::Init(args) => init_command(args),
         Command::Params => params_command(),
         Command::Template(args) => template_command(args),

@@ -5,6 +5,7 @@ pub mod commands;
 pub mod garden;
 pub mod plants;
 pub mod progress;
+pub mod serve;
 pub mod summary;
 
 /// `check` found features it would skip or warnings: not an error, exit code 1.

@@ -154,7 +154,8 @@ pub fn tile_glb(tile: &str, meshes: &[Mesh], features: &[Feature], shift: [i64; 
         if primitives.is_empty() {
             continue;
         }
-        nodes.push(json!({"name": kind, "mesh": meshes_json.len()}));
+        // The kind in `extras` too: three.js copies it into the object's userData.
+        nodes.push(json!({"name": kind, "mesh": meshes_json.len(), "extras": {"kind": kind}}));
         meshes_json.push(json!({"name": kind, "primitives": primitives}));
     }
     let (materials, images, textures) = materials(&used);

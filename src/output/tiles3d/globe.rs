@@ -164,8 +164,14 @@ impl Globe {
                 let (e1, e0, n1, n0) = (p(d, 0.0)?, p(-d, 0.0)?, p(0.0, d)?, p(0.0, -d)?);
                 let diff = |a: [f64; 3], b: [f64; 3]| [0, 1, 2].map(|i| (a[i] - b[i]) / (2.0 * d));
                 let (lon, lat) = self.lonlat(at[0], at[1])?;
+                let (e, n) = (diff(e1, e0), diff(n1, n0));
+                // A conformal projection scales east and north alike; up takes the same
+                // scale (1 + a few 1e-4: a millimetre in 10 m of height), so the frame is a
+                // rotation and one scale, which viewers' screen-space error needs.
+                let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                let s = (len(e) + len(n)) / 2.0;
                 Ok(Affine {
-                    cols: [diff(e1, e0), diff(n1, n0), up(lon, lat)],
+                    cols: [e, n, up(lon, lat).map(|v| v * s)],
                     t: ecef(lon, lat, *h),
                 })
             }

@@ -1,0 +1,265 @@
+//! `edo-city serve <out> [<more outs>]`: the web viewer and one or more builds of the same
+//! place (hypotheses, eras) on 127.0.0.1, with the right MIME types, by `tiny_http` (a small,
+//! synchronous, well-kept server: a static file server needs no async runtime).
+//!
+//! Routes: `/` the viewer page; `/viewer/<file>` its scripts; `/node_modules/<pkg>/...` the
+//! npm packages it imports (three.js, 3d-tiles-renderer), from `viewer/node_modules`;
+//! `/hypotheses.json` the builds, in the order given; `/h/<k>/<path>` a file of build k.
+//! Nothing outside those directories is ever served.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+
+/// The flags of `edo-city serve`.
+#[derive(Args)]
+pub struct ServeArgs {
+    /// Build directories (each with a tileset.json: build with the glb format), in the order
+    /// the viewer's hypothesis button steps through them; `/?h=K` opens the K-th (from 0).
+    #[arg(required = true)]
+    pub outs: Vec<PathBuf>,
+    /// Port on 127.0.0.1; 0 picks a free one (the URL printed says which).
+    #[arg(long, default_value_t = 8080)]
+    pub port: u16,
+    /// Open the page in the machine's browser (xdg-open).
+    #[arg(long)]
+    pub open: bool,
+    /// The viewer directory (index.html, main.js, node_modules/); default: the one of the
+    /// source tree edo-city was built from.
+    #[arg(long)]
+    pub viewer: Option<PathBuf>,
+}
+
+/// One build being served.
+struct Hypothesis {
+    name: String,
+    dir: PathBuf,
+    tiles: usize,
+}
+
+/// The MIME type of a file, by its extension.
+fn mime(path: &Path) -> &'static str {
+    match path.extension().and_then(|e| e.to_str()).unwrap_or("") {
+        "html" => "text/html; charset=utf-8",
+        "js" | "mjs" => "text/javascript; charset=utf-8",
+        "json" => "application/json",
+        "glb" => "model/gltf-binary",
+        "gltf" => "model/gltf+json",
+        "png" => "image/png",
+        "jpg" | "jpeg" => "image/jpeg",
+        "css" => "text/css; charset=utf-8",
+        "wasm" => "application/wasm",
+        "svg" => "image/svg+xml",
+        "obj" | "mtl" | "csv" | "txt" | "map" => "text/plain; charset=utf-8",
+        _ => "application/octet-stream",
+    }
+}
+
+/// `rel` under `root`, or `None` when it would leave it (`..`, absolute, a link out).
+fn contained(root: &Path, rel: &str) -> Option<PathBuf> {
+    let rel = rel.trim_start_matches('/');
+    if rel.split('/').any(|p| p == ".." || p.contains('\\')) {
+        return None;
+    }
+    let path = root.join(rel);
+    let real = path.canonicalize().ok()?;
+    let root = root.canonicalize().ok()?;
+    (real.starts_with(&root) && real.is_file()).then_some(real)
+}
+
+/// The file a URL path names, if any.
+fn route(url: &str, viewer: &Path, builds: &[Hypothesis]) -> Option<PathBuf> {
+    let path = url.split(['?', '#']).next().unwrap_or("");
+    let path = percent_decode(path)?;
+    if path == "/" || path == "/index.html" {
+        return contained(viewer, "index.html");
+    }
+    if let Some(rest) = path.strip_prefix("/viewer/") {
+        return contained(viewer, rest);
+    }
+    if path.starts_with("/node_modules/") {
+        return contained(viewer, &path);
+    }
+    let rest = path.strip_prefix("/h/")?;
+    let (k, file) = rest.split_once('/')?;
+    let b = builds.get(k.parse::<usize>().ok()?)?;
+    contained(&b.dir, file)
+}
+
+/// `%xx` escapes decoded; `None` when the result is not UTF-8.
+fn percent_decode(s: &str) -> Option<String> {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() {
+            let hex = std::str::from_utf8(&b[i + 1..i + 3]).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// The builds, checked: each has a manifest and a tileset.
+fn hypotheses(outs: &[PathBuf]) -> Result<Vec<Hypothesis>> {
+    let mut hs = Vec::new();
+    for dir in outs {
+        let manifest = dir.join("manifest.json");
+        let text = std::fs::read_to_string(&manifest).with_context(|| {
+            format!(
+                "{} is not a build directory (no manifest.json): give the --out of `edo-city build`",
+                dir.display()
+            )
+        })?;
+        if !dir.join("tileset.json").is_file() {
+            bail!(
+                "{} has no tileset.json: build it with the glb format (`--format obj,glb`, the default)",
+                dir.display()
+            );
+        }
+        let m: serde_json::Value = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not a manifest", manifest.display()))?;
+        let tiles = m["tiles"].as_array().map_or(0, |t| t.len());
+        let name = dir
+            .canonicalize()
+            .ok()
+            .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .unwrap_or_else(|| dir.display().to_string());
+        hs.push(Hypothesis {
+            name,
+            dir: dir.clone(),
+            tiles,
+        });
+    }
+    Ok(hs)
+}
+
+/// The viewer directory: given, else the source tree's.
+fn viewer_dir(given: Option<PathBuf>) -> Result<PathBuf> {
+    let dir = given.unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer"));
+    if !dir.join("index.html").is_file() {
+        bail!(
+            "{}: no viewer here (index.html); give the viewer directory with --viewer",
+            dir.display()
+        );
+    }
+    if !dir.join("node_modules/three").is_dir() {
+        bail!(
+            "{}: the viewer's npm packages are missing: run `make viewer-deps` (npm ci in {})",
+            dir.display(),
+            dir.display()
+        );
+    }
+    Ok(dir)
+}
+
+/// `edo-city serve`.
+pub fn serve_command(args: ServeArgs) -> Result<()> {
+    let viewer = viewer_dir(args.viewer)?;
+    let builds = hypotheses(&args.outs)?;
+    let list = serde_json::to_vec(&serde_json::json!(builds
+        .iter()
+        .enumerate()
+        .map(|(k, b)| serde_json::json!({
+            "index": k,
+            "name": b.name,
+            "tileset": format!("/h/{k}/tileset.json"),
+            "base": format!("/h/{k}/"),
+            "tiles": b.tiles,
+        }))
+        .collect::<Vec<_>>()))?;
+    let server = tiny_http::Server::http(("127.0.0.1", args.port))
+        .map_err(|e| anyhow::anyhow!("cannot listen on 127.0.0.1:{}: {e}", args.port))?;
+    let port = server
+        .server_addr()
+        .to_ip()
+        .map(|a| a.port())
+        .unwrap_or(args.port);
+    let url = format!("http://127.0.0.1:{port}/");
+    say!("serving {} build(s) at {url}", builds.len());
+    for (k, b) in builds.iter().enumerate() {
+        say!("  {url}?h={k}  {} ({} tiles)", b.dir.display(), b.tiles);
+    }
+    say!("press Ctrl-C to stop");
+    if args.open {
+        let _ = std::process::Command::new("xdg-open").arg(&url).spawn();
+    }
+    let server = std::sync::Arc::new(server);
+    let shared = std::sync::Arc::new((viewer, builds, list));
+    let workers: Vec<_> = (0..4)
+        .map(|_| {
+            let (server, shared) = (server.clone(), shared.clone());
+            std::thread::spawn(move || {
+                for req in server.incoming_requests() {
+                    let (viewer, builds, list) = &*shared;
+                    answer(req, viewer, builds, list);
+                }
+            })
+        })
+        .collect();
+    for w in workers {
+        let _ = w.join();
+    }
+    Ok(())
+}
+
+/// Answers one request: a file, the hypotheses list, or 404.
+fn answer(req: tiny_http::Request, viewer: &Path, builds: &[Hypothesis], list: &[u8]) {
+    let header = |k: &str, v: &str| tiny_http::Header::from_bytes(k, v).expect("valid header");
+    if req.method() != &tiny_http::Method::Get && req.method() != &tiny_http::Method::Head {
+        let _ = req.respond(tiny_http::Response::empty(405));
+        return;
+    }
+    if req.url().split('?').next() == Some("/hypotheses.json") {
+        let r = tiny_http::Response::from_data(list.to_vec())
+            .with_header(header("Content-Type", "application/json"))
+            .with_header(header("Cache-Control", "no-cache"));
+        let _ = req.respond(r);
+        return;
+    }
+    match route(req.url(), viewer, builds).and_then(|p| Some((std::fs::File::open(&p).ok()?, p))) {
+        Some((file, path)) => {
+            let r = tiny_http::Response::from_file(file)
+                .with_header(header("Content-Type", mime(&path)))
+                .with_header(header("Cache-Control", "no-cache"));
+            let _ = req.respond(r);
+        }
+        None => {
+            let r = tiny_http::Response::from_string(format!("not found: {}", req.url()))
+                .with_status_code(404)
+                .with_header(header("Content-Type", "text/plain; charset=utf-8"));
+            let _ = req.respond(r);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_stay_inside_their_directories() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("index.html"), "x").unwrap();
+        std::fs::create_dir(dir.path().join("b")).unwrap();
+        std::fs::write(dir.path().join("b/tileset.json"), "{}").unwrap();
+        let builds = [Hypothesis {
+            name: "b".into(),
+            dir: dir.path().join("b"),
+            tiles: 0,
+        }];
+        assert!(route("/", dir.path(), &builds).is_some());
+        assert!(route("/h/0/tileset.json?x=1", dir.path(), &builds).is_some());
+        assert!(route("/h/0/../index.html", dir.path(), &builds).is_none());
+        assert!(route("/h/0/%2e%2e/index.html", dir.path(), &builds).is_none());
+        assert!(route("/h/1/tileset.json", dir.path(), &builds).is_none());
+        assert!(route("/viewer/../b/tileset.json", dir.path(), &builds).is_none());
+        assert_eq!(mime(Path::new("a.glb")), "model/gltf-binary");
+        assert_eq!(mime(Path::new("a.js")), "text/javascript; charset=utf-8");
+    }
+}

@@ -1,0 +1,112 @@
+//! The viewer in a real browser: two hypotheses of the example town served by `edo-city
+//! serve`, opened in Debian's chromium by playwright-core (`viewer/test/browser.mjs`): ready,
+//! nothing failed, roofs and plaster drawn, a click on a known house shows its lot id, and the
+//! hypothesis switch keeps the camera and changes the picture. Chromium and the npm packages
+//! come from `make viewer-deps` (scripts/viewer-deps.sh).
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+
+use common::{build_ok, fixture, read_json};
+
+/// Stops the server however the test ends.
+struct Server(Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+#[test]
+fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
+    let viewer = Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer");
+    let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
+    assert!(
+        Path::new(&chromium).exists() && viewer.join("node_modules/playwright-core").is_dir(),
+        "chromium or playwright-core is missing: run `make viewer-deps`"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("edo"), dir.path().join("other-seed"));
+    build_ok(&fixture("kyoto-small"), &a, &["--quiet", "--no-plan"]);
+    let params = dir.path().join("seed.toml");
+    std::fs::write(&params, "seed = 7\n").unwrap();
+    build_ok(
+        &fixture("kyoto-small"),
+        &b,
+        &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
+    );
+
+    // The largest house of the first build, and a point on its roof.
+    let m = read_json(&a.join("manifest.json"));
+    let origin = [
+        m["origin"][0].as_f64().unwrap(),
+        m["origin"][1].as_f64().unwrap(),
+    ];
+    let objects = common::build_objects(&a);
+    let house = objects
+        .iter()
+        .filter(|o| o.name.starts_with("machiya_"))
+        .max_by_key(|o| o.vertices.len())
+        .unwrap();
+    let n = house.vertices.len() as f64;
+    let east = house.vertices.iter().map(|v| v[0]).sum::<f64>() / n - origin[0];
+    let north = house.vertices.iter().map(|v| v[1]).sum::<f64>() / n - origin[1];
+    let up = house.vertices.iter().map(|v| v[2]).fold(f64::MIN, f64::max);
+    let lot = house.name.trim_start_matches("machiya_");
+    let house_file = dir.path().join("house.json");
+    std::fs::write(
+        &house_file,
+        serde_json::json!({"lot": lot, "east": east, "north": north, "up": up}).to_string(),
+    )
+    .unwrap();
+
+    let mut child = Command::new(assert_cmd::cargo::cargo_bin("edo-city"))
+        .args(["serve", "--port", "0"])
+        .arg(&a)
+        .arg(&b)
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stdout = child.stdout.take().unwrap();
+    let server = Server(child);
+    let mut first = String::new();
+    BufReader::new(stdout).read_line(&mut first).unwrap();
+    let url = first
+        .split_whitespace()
+        .find(|w| w.starts_with("http://127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no URL in {first:?}"))
+        .to_string();
+
+    let o = Command::new("node")
+        .current_dir(&viewer)
+        .arg("test/browser.mjs")
+        .arg(&url)
+        .arg(&house_file)
+        .env("CHROMIUM", &chromium)
+        // The browser runs on the real clock: under scripts/test-future.sh libfaketime would
+        // be preloaded into chromium's processes too, whose timers it stalls (the page never
+        // loads). Our own processes (the build, the server) keep the faked date.
+        .env_remove("LD_PRELOAD")
+        .env_remove("FAKETIME")
+        .output()
+        .expect("node runs");
+    drop(server);
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{text}");
+    let line = String::from_utf8_lossy(&o.stdout);
+    let last = line.lines().last().unwrap();
+    eprintln!("viewer measurements: {last}");
+    let out: serde_json::Value = serde_json::from_str(last).unwrap();
+    assert_eq!(out["clicked"]["lot"], lot, "{text}");
+    assert_eq!(out["clicked"]["kind"], "machiya");
+    assert_eq!(out["hypotheses"], serde_json::json!(["edo", "other-seed"]));
+}

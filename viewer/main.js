@@ -1,0 +1,394 @@
+// The edo-city viewer: the builds `edo-city serve` lists (hypotheses of one place), each a
+// 3D Tiles 1.1 tileset of GLB tiles, in one scene with one camera, so switching between them
+// (button, [ ] or H keys, /?h=K, window.edoCity.show(K)) keeps the view; a split view shows
+// the current one left and the next one right. Clicking an object shows its metadata
+// (EXT_structural_metadata); links of the build (links.json) are markers that open their page.
+//
+// The scene frame is the build's own: x east, y up, z south, metres from the output origin
+// (the OBJ tiles' frame): the tileset's root transform (origin -> ECEF) is undone and z-up
+// turned y-up, so every hypothesis placed on the globe lands in the same place here.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { TilesRenderer } from '3d-tiles-renderer';
+import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
+
+const SKY = 0xbcd6ea;
+const EYE = 1.6;
+
+const api = (window.edoCity = {
+  ready: false,
+  tiles: 0,
+  hypotheses: [],
+  current: 0,
+  info: null,
+  errors: [],
+  show: (k) => show(k),
+  lookAt: (east, north, up, height) => lookAt(east, north, up, height),
+  lookFrom: (east, north, up) => lookFrom(east, north, up),
+  camera: () => ({ position: camera.position.toArray(), target: controls.target.toArray() }),
+  screenOf: (east, north, up) => screenOf(east, north, up),
+  sample: () => sample(),
+  setSplit: (on) => setSplit(on),
+});
+
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+renderer.setSize(window.innerWidth, window.innerHeight);
+renderer.setClearColor(SKY);
+renderer.setScissorTest(false);
+document.body.appendChild(renderer.domElement);
+
+const scene = new THREE.Scene();
+scene.add(new THREE.HemisphereLight(0xffffff, 0x8a7f6a, 2.2));
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+sun.position.set(0.4, 1.0, 0.25);
+scene.add(sun);
+
+const camera = new THREE.PerspectiveCamera(50, window.innerWidth / window.innerHeight, 0.5, 20000);
+const controls = new OrbitControls(camera, renderer.domElement);
+controls.enableDamping = false;
+controls.maxPolarAngle = Math.PI * 0.495;
+
+const params = new URLSearchParams(location.search);
+const hidden = new Set();
+let split = false;
+let walking = false;
+let placement = null; // Matrix4: ECEF -> scene
+const cities = []; // per hypothesis: { tiles, models: Set, links: Group|null }
+const status = document.getElementById('status');
+
+/** The matrix taking ECEF to the scene: inverse of the first build's root transform, then z-up to y-up. */
+function placementOf(tileset) {
+  const root = new THREE.Matrix4().fromArray(tileset.root.transform);
+  const zUpToYUp = new THREE.Matrix4().makeRotationX(-Math.PI / 2);
+  return zUpToYUp.multiply(root.invert());
+}
+
+/** Hides or shows the nodes of the hidden kinds in one loaded model. */
+function applyToggles(object) {
+  object.traverse((o) => {
+    if (o.userData.kind !== undefined) o.visible = !hidden.has(o.userData.kind);
+  });
+}
+
+function city(k) {
+  if (cities[k]) return cities[k];
+  const h = api.hypotheses[k];
+  const tiles = new TilesRenderer(h.tileset);
+  tiles.registerPlugin(new GLTFExtensionsPlugin({ metadata: true, rtc: true }));
+  tiles.errorTarget = 8;
+  tiles.setCamera(camera);
+  tiles.setResolutionFromRenderer(camera, renderer);
+  tiles.group.matrixAutoUpdate = false;
+  tiles.group.matrix.copy(placement);
+  tiles.group.matrixWorldNeedsUpdate = true;
+  const c = { tiles, models: new Set(), links: null, loaded: false };
+  tiles.addEventListener('load-model', ({ scene: model, tile }) => {
+    // Each node of a tile is one object kind (machiya, kura, fence, people, ...): its
+    // glTF extras, which three.js puts in userData.kind.
+    applyToggles(model);
+    c.models.add(tile);
+    if (k === api.current) api.tiles = c.models.size;
+  });
+  tiles.addEventListener('load-error', ({ url, error }) => {
+    api.errors.push(`${url}: ${error}`);
+    console.error('tile failed to load', url, error);
+  });
+  tiles.addEventListener('tiles-load-end', () => {
+    c.loaded = true;
+    if (k === api.current) markReady();
+  });
+  scene.add(tiles.group);
+  if (h.links) loadLinks(k, c);
+  cities[k] = c;
+  return c;
+}
+
+function markReady() {
+  const c = cities[api.current];
+  if (!c || c.models.size === 0) return;
+  api.tiles = c.models.size;
+  status.textContent = `${api.hypotheses[api.current].name}: ${c.models.size} tile(s)`;
+  requestAnimationFrame(() => {
+    render();
+    api.ready = true;
+  });
+}
+
+async function loadLinks(k, c) {
+  const base = api.hypotheses[k].base;
+  const links = await (await fetch(`${base}links.json`)).json();
+  const group = new THREE.Group();
+  group.name = 'links';
+  for (const l of links) {
+    const marker = new THREE.Mesh(
+      new THREE.OctahedronGeometry(2.5),
+      new THREE.MeshStandardMaterial({ color: 0xd23a2a, emissive: 0x551010 }),
+    );
+    marker.position.set(l.x, l.z + 12, -l.y);
+    marker.userData.link = l;
+    const pole = new THREE.Mesh(
+      new THREE.CylinderGeometry(0.15, 0.15, 10),
+      new THREE.MeshStandardMaterial({ color: 0x553322 }),
+    );
+    pole.position.set(l.x, l.z + 5, -l.y);
+    pole.userData.link = l;
+    group.add(marker, pole);
+  }
+  c.links = group;
+  group.visible = k === api.current || split;
+  scene.add(group);
+}
+
+function show(k) {
+  k = ((Number(k) % api.hypotheses.length) + api.hypotheses.length) % api.hypotheses.length;
+  api.current = k;
+  api.ready = false;
+  const c = city(k);
+  cities.forEach((o, i) => {
+    if (!o) return;
+    o.tiles.group.visible = i === k || (split && i === partner());
+    if (o.links) o.links.visible = o.tiles.group.visible;
+  });
+  document.getElementById('hname').textContent = `${k}: ${api.hypotheses[k].name}`;
+  const url = new URL(location.href);
+  url.searchParams.set('h', k);
+  history.replaceState(null, '', url);
+  api.tiles = c.models.size;
+  if (c.loaded) markReady();
+  return k;
+}
+
+function partner() {
+  return (api.current + 1) % api.hypotheses.length;
+}
+
+function setSplit(on) {
+  split = on && api.hypotheses.length > 1;
+  document.getElementById('split').checked = split;
+  document.getElementById('divider').style.display = split ? 'block' : 'none';
+  if (split) city(partner());
+  show(api.current);
+}
+
+/** The scene point of map metres (east, north from the origin; up). */
+function point(east, north, up) {
+  return new THREE.Vector3(east, up, -north);
+}
+
+function lookAt(east, north, up = 0, height = 60) {
+  const p = point(east, north, up);
+  camera.position.set(p.x, p.y + height, p.z + height * 0.02);
+  controls.target.copy(p);
+  controls.update();
+  render();
+}
+
+/** A view of a point from 18 m away at 45 degrees azimuth, 8 m above it. */
+function lookFrom(east, north, up = 0) {
+  const p = point(east, north, up);
+  camera.position.set(p.x + 13, p.y + 8, p.z + 13);
+  controls.target.copy(p);
+  controls.update();
+  render();
+}
+
+function screenOf(east, north, up) {
+  const v = point(east, north, up).project(camera);
+  const r = renderer.domElement.getBoundingClientRect();
+  return { x: r.left + ((v.x + 1) / 2) * r.width, y: r.top + ((1 - v.y) / 2) * r.height };
+}
+
+/** Pixel statistics of the current picture, for tests: drawn, roof grey, plaster white, a hash. */
+function sample() {
+  render();
+  const gl = renderer.getContext();
+  const w = gl.drawingBufferWidth;
+  const h = gl.drawingBufferHeight;
+  const px = new Uint8Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  // The clear colour as drawn (sRGB bytes of the hex).
+  const [sr, sg, sb] = [(SKY >> 16) & 255, (SKY >> 8) & 255, SKY & 255];
+  let drawn = 0;
+  let grey = 0;
+  let white = 0;
+  let hash = 2166136261;
+  for (let i = 0; i < px.length; i += 4) {
+    const [r, g, b] = [px[i], px[i + 1], px[i + 2]];
+    hash = Math.imul(hash ^ (r ^ (g << 8) ^ (b << 16)), 16777619) >>> 0;
+    if (Math.abs(r - sr) + Math.abs(g - sg) + Math.abs(b - sb) < 12) continue;
+    drawn += 1;
+    const spread = Math.max(r, g, b) - Math.min(r, g, b);
+    if (spread < 18 && r > 45 && r < 150) grey += 1;
+    // Lime plaster (shikkui) as lit: warm off-white.
+    if (Math.min(r, g, b) > 150 && spread < 50) white += 1;
+  }
+  return { pixels: w * h, drawn, grey, white, hash };
+}
+
+function render() {
+  const w = window.innerWidth;
+  const h = window.innerHeight;
+  camera.updateMatrixWorld();
+  const visible = cities.map((c) => c && c.tiles.group.visible);
+  for (const c of cities) if (c && c.tiles.group.visible) c.tiles.update();
+  if (!split) {
+    renderer.setScissorTest(false);
+    renderer.setViewport(0, 0, w, h);
+    renderer.render(scene, camera);
+    return;
+  }
+  // Left half: the current hypothesis; right half: the next one.
+  const sides = [api.current, partner()];
+  renderer.setScissorTest(true);
+  sides.forEach((k, side) => {
+    cities.forEach((c, i) => {
+      if (!c) return;
+      c.tiles.group.visible = i === k;
+      if (c.links) c.links.visible = i === k;
+    });
+    renderer.setScissor(side * (w / 2), 0, w / 2, h);
+    renderer.setViewport(0, 0, w, h);
+    renderer.render(scene, camera);
+  });
+  cities.forEach((c, i) => {
+    if (c) c.tiles.group.visible = visible[i];
+  });
+  renderer.setScissorTest(false);
+}
+
+// Walking: eye height above the city's zero, W/S or arrows forward and back, A/D turn.
+const keys = new Set();
+function walkStep(dt) {
+  if (!walking) return;
+  const dir = new THREE.Vector3();
+  camera.getWorldDirection(dir);
+  dir.y = 0;
+  dir.normalize();
+  const speed = 6 * dt;
+  if (keys.has('w') || keys.has('arrowup')) camera.position.addScaledVector(dir, speed);
+  if (keys.has('s') || keys.has('arrowdown')) camera.position.addScaledVector(dir, -speed);
+  const turn = (keys.has('a') || keys.has('arrowleft') ? 1 : 0) - (keys.has('d') || keys.has('arrowright') ? 1 : 0);
+  if (turn) camera.rotateOnWorldAxis(new THREE.Vector3(0, 1, 0), turn * 1.5 * dt);
+  camera.position.y = EYE;
+}
+
+function toggleWalk() {
+  walking = !walking;
+  controls.enabled = !walking;
+  if (walking) {
+    const t = controls.target.clone();
+    camera.position.set(t.x, EYE, t.z + 20);
+    camera.lookAt(t.x, EYE, t.z);
+  } else {
+    controls.target.set(camera.position.x, 0, camera.position.z - 40);
+    camera.position.y = 120;
+    controls.update();
+  }
+  document.getElementById('walk').textContent = walking ? 'orbit (K)' : 'walk (K)';
+}
+
+function pick(event) {
+  const r = renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((event.clientX - r.left) / r.width) * 2 - 1, -((event.clientY - r.top) / r.height) * 2 + 1);
+  const ray = new THREE.Raycaster();
+  ray.setFromCamera(ndc, camera);
+  const c = cities[split && event.clientX > r.left + r.width / 2 ? partner() : api.current];
+  const targets = [c.tiles.group];
+  if (c.links) targets.push(c.links);
+  const shown = (o) => {
+    for (; o; o = o.parent) if (!o.visible) return false;
+    return true;
+  };
+  const hit = ray.intersectObjects(targets, true).find((h) => shown(h.object));
+  const info = document.getElementById('info');
+  if (!hit) {
+    info.textContent = '';
+    api.info = null;
+    return;
+  }
+  const link = hit.object.userData.link;
+  if (link) {
+    api.info = { link: link.title, url: link.url };
+    info.innerHTML = '';
+    const a = document.createElement('a');
+    a.href = link.url || link.image;
+    a.target = '_blank';
+    a.textContent = link.title || a.href;
+    info.appendChild(a);
+    if (event.type === 'click' && !event.testOnly) window.open(a.href, '_blank', 'noopener');
+    return;
+  }
+  const features = hit.object.userData.meshFeatures;
+  const metadata = hit.object.userData.structuralMetadata;
+  if (!features || !metadata) return;
+  const ids = features.getFeatures(hit.faceIndex, hit.barycoord);
+  const tables = features.getFeatureInfo().map((f) => f.propertyTable);
+  const rows = metadata.getPropertyTableData(tables, ids);
+  const row = rows[0] || {};
+  api.info = row;
+  info.textContent = Object.entries(row)
+    .filter(([, v]) => v !== '' && v !== null && v !== undefined)
+    .map(([k, v]) => `${k}: ${v}`)
+    .join('\n');
+}
+
+async function main() {
+  const list = await (await fetch('/hypotheses.json')).json();
+  api.hypotheses = list;
+  const first = await (await fetch(list[0].tileset)).json();
+  placement = placementOf(first);
+  // Frame the whole city: the root box's centre and size, in the scene.
+  const b = first.root.boundingVolume.box;
+  const centre = new THREE.Vector3(b[0], b[2], -b[1]);
+  const radius = Math.max(Math.hypot(b[3], b[4], b[5]), Math.hypot(b[6], b[7], b[8]), 50);
+  camera.position.set(centre.x + radius * 0.55, centre.y + radius * 0.75, centre.z + radius * 0.8);
+  controls.target.copy(centre);
+  controls.update();
+  const asked = Number(params.get('h') ?? 0);
+  show(Number.isFinite(asked) ? asked : 0);
+  if (params.get('split') === '1') setSplit(true);
+
+  document.getElementById('prev').onclick = () => show(api.current - 1);
+  document.getElementById('next').onclick = () => show(api.current + 1);
+  document.getElementById('split').onchange = (e) => setSplit(e.target.checked);
+  document.getElementById('walk').onclick = toggleWalk;
+  for (const box of document.querySelectorAll('#toggles input')) {
+    box.onchange = () => {
+      for (const k of box.dataset.kinds.split(',')) {
+        if (box.checked) hidden.delete(k);
+        else hidden.add(k);
+      }
+      for (const c of cities) if (c) applyToggles(c.tiles.group);
+      render();
+    };
+  }
+  renderer.domElement.addEventListener('click', pick);
+  window.addEventListener('keydown', (e) => {
+    const k = e.key.toLowerCase();
+    if (k === ']' || k === 'h') show(api.current + 1);
+    else if (k === '[') show(api.current - 1);
+    else if (k === 'k') toggleWalk();
+    else if (k === 's' && !walking) setSplit(!split);
+    else keys.add(k);
+  });
+  window.addEventListener('keyup', (e) => keys.delete(e.key.toLowerCase()));
+  window.addEventListener('resize', () => {
+    camera.aspect = window.innerWidth / window.innerHeight;
+    camera.updateProjectionMatrix();
+    renderer.setSize(window.innerWidth, window.innerHeight);
+    for (const c of cities) if (c) c.tiles.setResolutionFromRenderer(camera, renderer);
+  });
+  let last = performance.now();
+  renderer.setAnimationLoop((now) => {
+    walkStep(Math.min((now - last) / 1000, 0.1));
+    last = now;
+    if (!walking) controls.update();
+    render();
+  });
+}
+
+main().catch((e) => {
+  status.textContent = `error: ${e.message}`;
+  console.error(e);
+});
