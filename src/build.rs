@@ -517,6 +517,9 @@ fn write_city(
         species,
     };
     let mut manifest = manifest;
+    let links = output::links::write_links(&opts.out, &data, plan.origin)
+        .map_err(|e| write_err(&opts.out.join("links.json"), e))?;
+    manifest.files.extend(links);
     // A shard's tiles are only part of the city: `merge` writes the tileset.
     if manifest.shard.is_none() {
         shards::finish_formats(&opts.out, &mut manifest)?;

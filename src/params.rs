@@ -237,6 +237,8 @@ pub struct Layers {
     pub trees: PointsLayer,
     /// Polygons where rock gardens are laid out (whatever the lot's use).
     pub gardens: GardensLayer,
+    /// Links placed in the city (pages and images the viewer opens).
+    pub links: LinksLayer,
     /// The terrain grid.
     pub dem: DemLayer,
 }
@@ -276,6 +278,30 @@ pub struct GardensLayer {
     pub encoding: String,
     /// Field holding the polygon's id (else its record number from 1).
     pub id_field: String,
+}
+
+/// Links (the paper's hyperlinks): a point layer, or a CSV table with x, y in the output CRS.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinksLayer {
+    /// `links.shp` or `links.csv`, relative to the input directory; "" = none (a missing
+    /// default file is no layer).
+    pub file: String,
+    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
+    #[serde(default)]
+    pub encoding: String,
+    /// Field holding the link's id (else its record number from 1).
+    pub id_field: String,
+    /// Field holding the marker's title.
+    pub title_field: String,
+    /// Field holding the page's address (http or https).
+    pub url_field: String,
+    /// Field holding an image's address (http or https).
+    pub image_field: String,
+    /// A table's column of x (easting, output CRS).
+    pub x_field: String,
+    /// A table's column of y (northing, output CRS).
+    pub y_field: String,
 }
 
 /// District polygons (chiku 地区): a lot or footprint without a district attribute gets the

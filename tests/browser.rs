@@ -75,7 +75,10 @@ fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
     let stdout = child.stdout.take().unwrap();
     let server = Server(child);
     let mut first = String::new();
-    BufReader::new(stdout).read_line(&mut first).unwrap();
+    let mut reader = BufReader::new(stdout);
+    reader.read_line(&mut first).unwrap();
+    // The rest of what it prints is read (and dropped) as it comes.
+    std::thread::spawn(move || std::io::copy(&mut reader, &mut std::io::sink()));
     let url = first
         .split_whitespace()
         .find(|w| w.starts_with("http://127.0.0.1:"))

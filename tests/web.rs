@@ -102,7 +102,11 @@ fn the_tileset_holds_every_tile_and_places_a_house_where_proj_does() {
     );
     let manifest = read_json(&out.path().join("manifest.json"));
     assert_eq!(manifest["formats"], serde_json::json!(["obj", "glb"]));
-    assert_eq!(manifest["files"][0]["path"], "tileset.json");
+    assert!(manifest["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|f| f["path"] == "tileset.json"));
     let tileset = read_json(&out.path().join("tileset.json"));
     assert_eq!(tileset["asset"]["version"], "1.1");
     let root = &tileset["root"];
@@ -303,4 +307,56 @@ fn every_glb_passes_the_khronos_validator() {
     );
     assert!(o.status.success(), "{text}");
     assert!(text.contains("0 with errors or warnings"), "{text}");
+}
+
+#[test]
+fn links_become_markers_and_a_malformed_address_is_skipped_with_its_record() {
+    let dir = tempfile::tempdir().unwrap();
+    let town = dir.path().join("town");
+    common::copy_fixture("kyoto-small", &town);
+    let mut csv = std::fs::read_to_string(town.join("links.csv")).unwrap();
+    csv.push_str("3,A broken address,htp:/not a url,,-22700.0,-109800.0\n");
+    std::fs::write(town.join("links.csv"), csv).unwrap();
+    let out = dir.path().join("out");
+    let r = build_ok(&town, &out, &["--quiet", "--no-plan"]);
+    let links = read_json(&out.join("links.json"));
+    let titles: Vec<&str> = links
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["title"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        titles,
+        ["Rakuchu rakugai-zu (Uesugi screens)", "Sanjo Ohashi"]
+    );
+    // links.csv's x, y are in the output CRS; links.json's are from the origin.
+    let m = read_json(&out.join("manifest.json"));
+    let ox = m["origin"][0].as_f64().unwrap();
+    assert_eq!(links[0]["x"].as_f64().unwrap(), -22880.0 - ox);
+    assert!(m["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|f| f["path"] == "links.json"));
+    let skipped = r["skipped"].as_array().unwrap();
+    let bad = skipped
+        .iter()
+        .find(|s| s["layer"] == "links")
+        .expect("the malformed link is listed");
+    assert_eq!(
+        (bad["id"].as_str(), bad["record"].as_u64()),
+        (Some("3"), Some(2))
+    );
+    assert!(bad["reason"].as_str().unwrap().contains("htp:/not a url"));
+    let ledger = r["accounting"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["role"] == "links")
+        .unwrap();
+    assert_eq!(
+        (ledger["read"].as_u64(), ledger["unaccounted"].as_u64()),
+        (Some(3), Some(0))
+    );
 }

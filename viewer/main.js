@@ -22,6 +22,7 @@ const api = (window.edoCity = {
   current: 0,
   info: null,
   errors: [],
+  openLinks: true,
   show: (k) => show(k),
   lookAt: (east, north, up, height) => lookAt(east, north, up, height),
   lookFrom: (east, north, up) => lookFrom(east, north, up),
@@ -104,13 +105,18 @@ function city(k) {
   return c;
 }
 
+/** Ready once the current hypothesis has tiles and nothing is loading, after one frame drawn. */
+let readyPending = false;
 function markReady() {
   const c = cities[api.current];
-  if (!c || c.models.size === 0) return;
-  api.tiles = c.models.size;
-  status.textContent = `${api.hypotheses[api.current].name}: ${c.models.size} tile(s)`;
+  if (api.ready || readyPending || !c || c.models.size === 0 || c.tiles.loadProgress < 1) return;
+  readyPending = true;
   requestAnimationFrame(() => {
+    readyPending = false;
+    if (c !== cities[api.current] || c.tiles.loadProgress < 1) return;
     render();
+    api.tiles = c.models.size;
+    status.textContent = `${api.hypotheses[api.current].name}: ${c.models.size} tile(s)`;
     api.ready = true;
   });
 }
@@ -316,7 +322,7 @@ function pick(event) {
     a.target = '_blank';
     a.textContent = link.title || a.href;
     info.appendChild(a);
-    if (event.type === 'click' && !event.testOnly) window.open(a.href, '_blank', 'noopener');
+    if (api.openLinks) window.open(a.href, '_blank', 'noopener');
     return;
   }
   const features = hit.object.userData.meshFeatures;
@@ -385,6 +391,7 @@ async function main() {
     last = now;
     if (!walking) controls.update();
     render();
+    markReady();
   });
 }
 

@@ -361,6 +361,15 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
             tiles.insert(t.id.clone(), t.clone());
         }
     }
+    // The links are the same in every shard: the first one's, when it is elsewhere.
+    if let Some((dir, _, m)) = shards.first() {
+        for f in m.files.iter().filter(|f| f.path == "links.json") {
+            if dir != target {
+                let bytes = std::fs::read(dir.join(&f.path)).map_err(|e| write_err(dir, e))?;
+                copies.push((target.join(&f.path), bytes));
+            }
+        }
+    }
     for (to, bytes) in &copies {
         if let Some(parent) = to.parent() {
             std::fs::create_dir_all(parent).map_err(|e| write_err(parent, e))?;
@@ -392,7 +401,8 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
 /// it writes in the manifest and what it noticed in the warnings.
 pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildError> {
     let mut warnings = Vec::new();
-    manifest.files.clear();
+    // What the sinks wrote before is written again; the build's own files (links.json) stay.
+    manifest.files.retain(|f| f.path == "links.json");
     for sink in crate::output::sink::sinks(&manifest.formats) {
         let files = sink
             .finish(out, manifest, &mut warnings)

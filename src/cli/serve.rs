@@ -171,6 +171,7 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
             "tileset": format!("/h/{k}/tileset.json"),
             "base": format!("/h/{k}/"),
             "tiles": b.tiles,
+            "links": b.dir.join("links.json").is_file(),
         }))
         .collect::<Vec<_>>()))?;
     let server = tiny_http::Server::http(("127.0.0.1", args.port))
@@ -181,11 +182,18 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
         .map(|a| a.port())
         .unwrap_or(args.port);
     let url = format!("http://127.0.0.1:{port}/");
-    say!("serving {} build(s) at {url}", builds.len());
+    // Printed once, ignoring a closed stdout: the server goes on whoever reads it.
+    let mut text = format!("serving {} build(s) at {url}\n", builds.len());
     for (k, b) in builds.iter().enumerate() {
-        say!("  {url}?h={k}  {} ({} tiles)", b.dir.display(), b.tiles);
+        text += &format!("  {url}?h={k}  {} ({} tiles)\n", b.dir.display(), b.tiles);
     }
-    say!("press Ctrl-C to stop");
+    text += "press Ctrl-C to stop\n";
+    {
+        use std::io::Write as _;
+        let mut out = std::io::stdout();
+        let _ = out.write_all(text.as_bytes());
+        let _ = out.flush();
+    }
     if args.open {
         let _ = std::process::Command::new("xdg-open").arg(&url).spawn();
     }

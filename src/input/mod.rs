@@ -19,6 +19,7 @@ pub mod widths;
 
 mod areas;
 mod lines;
+mod links;
 mod polygons;
 mod target;
 
@@ -197,6 +198,7 @@ struct Layers {
     people: Option<Opened>,
     trees: Option<Opened>,
     gardens: Option<Opened>,
+    links: Option<Opened>,
 }
 
 impl Layers {
@@ -234,6 +236,11 @@ impl Layers {
                 &l.gardens.encoding,
                 &d.gardens.file,
             )?,
+            // A table of links is read by its own reader.
+            links: match is_table(&links_file(dir, params, d)) {
+                true => None,
+                false => role("links", &l.links.file, &l.links.encoding, &d.links.file)?,
+            },
         })
     }
 
@@ -250,6 +257,7 @@ impl Layers {
             &self.people,
             &self.trees,
             &self.gardens,
+            &self.links,
         ]
         .into_iter()
         .flatten()
@@ -268,6 +276,7 @@ impl Layers {
             &mut self.people,
             &mut self.trees,
             &mut self.gardens,
+            &mut self.links,
         ]
         .into_iter()
         .flatten()
@@ -409,12 +418,40 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
     if let Some(o) = &layers.gardens {
         areas::read_garden_areas(params, o, &target, &mut data)?;
     }
+    if let Some(o) = &layers.links {
+        links::read_link_points(&l.links, o, &target, &mut data)?;
+    } else if is_table(&links_file(dir, params, dl)) {
+        let path = dir.join(links_file(dir, params, dl));
+        if !path.exists() {
+            return Err(InputError::Missing(format!(
+                "no links table: {} does not exist (set `layers.links.file` to the right path, \
+                 or to \"\")",
+                path.display()
+            )));
+        }
+        links::read_link_table(&l.links, &path, &mut data)?;
+    }
     data.dem = read_dem(dir, params, &target, &dl.dem.file, &mut data.warnings)?;
     for o in layers.all() {
         data.warnings.extend(o.winding_warning());
     }
     simplify::generalise(&mut data, &params.simplify);
     Ok(data)
+}
+
+/// The links layer's file: the parameter's, where the default `links.shp` is missing but a
+/// `links.csv` is there that one (as the DEM's default finds a GeoTIFF).
+fn links_file(dir: &Path, params: &Params, d: &crate::params::Layers) -> String {
+    let file = &params.layers.links.file;
+    if *file == d.links.file && !dir.join(file).exists() && dir.join("links.csv").exists() {
+        return "links.csv".into();
+    }
+    file.clone()
+}
+
+/// Whether a layer file is a table (CSV) rather than a shapefile.
+fn is_table(file: &str) -> bool {
+    file.to_lowercase().ends_with(".csv")
 }
 
 /// The skip entry for a record of `o` whose shape is null (no geometry, only attributes).

@@ -126,6 +126,23 @@ pub struct GardenArea {
     pub outline: Polygon<f64>,
 }
 
+/// A link placed in the city (the paper's hyperlinks): a point that opens a page or image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Link {
+    /// Its id (the id field, else its record number from 1).
+    pub id: String,
+    /// Its record (a table's row from 0).
+    pub record: usize,
+    /// Where it stands, in the output CRS.
+    pub at: Coord<f64>,
+    /// What the marker is called.
+    pub title: String,
+    /// The page it opens (http(s)), or empty.
+    pub url: String,
+    /// The image it opens (http(s)), or empty.
+    pub image: String,
+}
+
 /// A person or a tree given as a point (`people.shp`, `trees.shp`).
 #[derive(Debug, Clone)]
 pub struct PointFeature {
@@ -233,6 +250,8 @@ pub struct Dataset {
     pub blocks: Vec<Polygon<f64>>,
     /// The polygons of the gardens layer, each to get a rock garden.
     pub gardens: Vec<GardenArea>,
+    /// The links layer's points.
+    pub links: Vec<Link>,
     /// Street centrelines with their widths.
     pub streets: Vec<Street>,
     /// Building footprints, each built to its own height.

@@ -78,6 +78,11 @@ pub fn ledgers(data: &Dataset) -> Vec<Ledger> {
                     .iter()
                     .map(|g| (g.record, g.id.as_str()))
                     .collect(),
+                "links" => data
+                    .links
+                    .iter()
+                    .map(|g| (g.record, g.id.as_str()))
+                    .collect(),
                 "people" | "trees" => {
                     let points = match layer.role.as_str() {
                         "people" => &data.people,

@@ -9,6 +9,7 @@ pub mod atomic;
 pub mod chart;
 pub mod features;
 pub mod gltf;
+pub mod links;
 pub mod lock;
 pub mod obj;
 pub mod plan;

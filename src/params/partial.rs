@@ -61,7 +61,21 @@ struct Layers {
     people: Option<super::billboards::partial::PointsLayer>,
     trees: Option<super::billboards::partial::PointsLayer>,
     gardens: Option<FencesLayer>,
+    links: Option<LinksLayer>,
     dem: Option<DemLayer>,
+}
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)]
+struct LinksLayer {
+    file: Option<String>,
+    encoding: Option<String>,
+    id_field: Option<String>,
+    title_field: Option<String>,
+    url_field: Option<String>,
+    image_field: Option<String>,
+    x_field: Option<String>,
+    y_field: Option<String>,
 }
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -116,6 +116,26 @@ try {
   out.street = street;
   if (street.white < street.pixels * 0.01) fail(`too few plaster-white pixels: ${street.white}`);
 
+  // A link marker: clicking it names its page (the test does not follow it: no network).
+  const links = await page.evaluate(async () => {
+    const h = window.edoCity.hypotheses[0];
+    return h.links ? (await fetch(`${h.base}links.json`)).json() : [];
+  });
+  out.links = links.length;
+  if (links.length === 0) fail('the fixture build has no links.json');
+  for (const l of links.slice(0, 1)) {
+    await page.evaluate((l) => {
+      window.edoCity.openLinks = false;
+      window.edoCity.lookFrom(l.x, l.y, l.z + 12);
+    }, l);
+    await page.waitForTimeout(200);
+    const p = await page.evaluate((l) => window.edoCity.screenOf(l.x, l.y, l.z + 12), l);
+    await page.mouse.click(p.x, p.y);
+    const info = await page.evaluate(() => window.edoCity.info);
+    if (!info || info.link !== l.title) fail(`clicking link ${l.title} showed ${JSON.stringify(info)}`);
+    out.link = info;
+  }
+
   if (await page.evaluate(() => window.edoCity.errors.length)) fail(`tile errors: ${await page.evaluate(() => window.edoCity.errors.join('; '))}`);
 } catch (e) {
   fail(`${e.message}`);
