@@ -109,7 +109,8 @@ function city(k) {
 let readyPending = false;
 function markReady() {
   const c = cities[api.current];
-  if (api.ready || readyPending || !c || c.models.size === 0 || c.tiles.loadProgress < 1) return;
+  const loaded = (o) => o && o.models.size > 0 && o.tiles.loadProgress === 1;
+  if (api.ready || readyPending || !loaded(c) || (split && !loaded(cities[partner()]))) return;
   readyPending = true;
   requestAnimationFrame(() => {
     readyPending = false;
@@ -171,6 +172,7 @@ function partner() {
 
 function setSplit(on) {
   split = on && api.hypotheses.length > 1;
+  api.ready = false;
   document.getElementById('split').checked = split;
   document.getElementById('divider').style.display = split ? 'block' : 'none';
   if (split) city(partner());
