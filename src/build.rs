@@ -254,7 +254,9 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcom
         )));
     }
     let catalog = load_catalog(&opts.params, opts.templates.as_deref())?;
-    let textures = output::texture_library(&opts.params.textures).map_err(BuildError::Config)?;
+    let textures = output::texture_library(&opts.params.textures)
+        .and_then(output::with_masks)
+        .map_err(BuildError::Config)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .build()
@@ -319,8 +321,8 @@ fn run(
     if written.is_err() && !existed {
         // Leave no directory behind that the user did not have before (only empty ones go).
         for dir in [
+            opts.out.join(output::TEXTURE_DIR),
             opts.out.join("tiles"),
-            opts.out.join("textures"),
             opts.out.clone(),
         ] {
             let _ = std::fs::remove_dir(dir);
@@ -356,11 +358,11 @@ fn write_city(
     let tiles_dir = opts.out.join("tiles");
     std::fs::create_dir_all(&tiles_dir).map_err(|e| write_err(&tiles_dir, e))?;
     // A run killed before its renames leaves temporaries; they are never valid output.
-    for dir in [&opts.out, &tiles_dir, &opts.out.join("textures")] {
+    for dir in [&opts.out, &tiles_dir, &opts.out.join(output::TEXTURE_DIR)] {
         output::atomic::remove_leftover_temporaries(dir);
     }
     let textures = output::write_textures(&opts.out, texture_set)
-        .map_err(|e| write_err(&opts.out.join("textures"), e))?;
+        .map_err(|e| write_err(&opts.out.join(output::TEXTURE_DIR), e))?;
     let species = output::species::write_species(&opts.out, &plan, catalog, params)
         .map_err(|e| write_err(&opts.out.join("species"), e))?;
 
@@ -532,6 +534,7 @@ fn write_city(
     }
     if opts.selection == Selection::All {
         shards::remove_stale_tiles(&opts.out, &manifest.tiles);
+        shards::remove_stale_textures(&opts.out, &manifest.textures);
     }
     // Drawn beside the tiles: its own time, not the wall time it added.
     timings.plan = plan_time + t.elapsed();

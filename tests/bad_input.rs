@@ -328,7 +328,7 @@ fn run_case(case: &Path) {
                 if out.is_dir() {
                     let files = all_files(&out);
                     assert!(
-                        files.keys().all(|f| f.starts_with("textures/")),
+                        files.keys().all(|f| f.starts_with("tiles/textures/")),
                         "{name}: wrote {:?}",
                         files.keys().collect::<Vec<_>>()
                     );

@@ -180,15 +180,19 @@ fn billboards_are_one_object_per_kind_with_cut_out_alpha_textures() {
                 "trees" => quads_trees += triangles / 2,
                 _ => continue,
             }
-            // map_Kd and map_d name the same RGBA picture: Blender and web viewers cut
-            // the figure out of it.
+            // map_d names the RGBA picture's mask (a,a,a,a): Blender and three.js cut the
+            // figure out of it alike.
             let kd = material.diffuse_texture.as_ref().expect("map_Kd");
-            assert_eq!(
-                material.dissolve_texture.as_ref(),
-                Some(kd),
-                "{}",
-                material.name
+            let d = material.dissolve_texture.as_ref().expect("map_d");
+            assert_eq!(d, &kd.replace(".png", "_mask.png"), "{}", material.name);
+            let dir = obj.parent().unwrap();
+            let (rgba, mask) = (
+                image::open(dir.join(kd)).unwrap().to_rgba8(),
+                image::open(dir.join(d)).unwrap().to_rgba8(),
             );
+            for (c, m) in rgba.pixels().zip(mask.pixels()) {
+                assert_eq!(m.0, [c[3]; 4], "{d}: the mask is the texture's alpha");
+            }
             let png = image::open(obj.parent().unwrap().join(kd)).unwrap();
             assert!(png.color().has_alpha(), "{kd}");
             let alpha: Vec<u8> = png.to_rgba8().pixels().map(|p| p.0[3]).collect();

@@ -244,6 +244,14 @@ fn a_tile_attribute_wins_and_a_rebuild_leaves_no_stale_tiles() {
     std::fs::remove_file(dir.path().join("lots.csv")).unwrap();
     build_ok(dir.path(), &out, &["--quiet"]);
     assert!(!out.join("tiles/sanjo.obj").exists());
-    let files = std::fs::read_dir(out.join("tiles")).unwrap().count() as u64;
+    let files = std::fs::read_dir(out.join("tiles"))
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().is_file())
+        .count() as u64;
     assert_eq!(files, 3 * first_tiles, "an OBJ, an MTL and a GLB a tile");
+    assert!(out.join("tiles/textures/kawara.png").exists());
+    assert!(
+        !out.join("textures").exists(),
+        "no second texture directory"
+    );
 }

@@ -246,12 +246,12 @@ fn a_full_disk_loses_nothing() {
     } = old_and_new(&town, work.path());
     let textures: usize = new_files
         .iter()
-        .filter(|(k, _)| k.starts_with("textures/"))
+        .filter(|(k, _)| k.starts_with("tiles/textures/"))
         .map(|(_, v)| v.len())
         .sum();
     let tiles: usize = new_files
         .iter()
-        .filter(|(k, _)| k.starts_with("tiles/"))
+        .filter(|(k, _)| k.starts_with("tiles/") && !k.starts_with("tiles/textures/"))
         .map(|(_, v)| v.len())
         .sum();
 

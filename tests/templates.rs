@@ -139,7 +139,7 @@ fn template_command_writes_an_obj_that_tobj_reads_with_its_alpha_maps() {
             if name == "tree" {
                 assert_eq!(
                     m.dissolve_texture.as_ref(),
-                    Some(tex),
+                    Some(&tex.replace(".png", "_mask.png")),
                     "alpha map of {}",
                     m.name
                 );
@@ -312,7 +312,7 @@ fn a_texture_set_replaces_textures_by_name() {
         &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
     );
     assert_eq!(
-        std::fs::read(out.join("textures/kawara.png")).unwrap(),
+        std::fs::read(out.join("tiles/textures/kawara.png")).unwrap(),
         std::fs::read(set.join("kawara.png")).unwrap()
     );
     // A file that replaces nothing, or is not a PNG, stops the build before it writes.

@@ -397,6 +397,23 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     Ok(rep)
 }
 
+/// Deletes the texture files an earlier build listed that this one did not write (an
+/// earlier layout kept them in `textures/`), and that directory once it is empty.
+pub fn remove_stale_textures(out: &Path, textures: &[report::ManifestFile]) {
+    let Ok(old) = read_manifest(&out.join("manifest.json")) else {
+        return;
+    };
+    let current: HashSet<&str> = textures.iter().map(|f| f.path.as_str()).collect();
+    for f in &old.textures {
+        let safe = (f.path.starts_with("textures/") || f.path.starts_with("tiles/textures/"))
+            && !f.path.contains("..");
+        if safe && !current.contains(f.path.as_str()) {
+            let _ = std::fs::remove_file(out.join(&f.path));
+        }
+    }
+    let _ = std::fs::remove_dir(out.join("textures"));
+}
+
 /// Runs every format's whole-build step (`tileset.json`) over `manifest`, listing the files
 /// it writes in the manifest and what it noticed in the warnings.
 pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildError> {

@@ -36,7 +36,12 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// One texture file: its name in `textures/` and its PNG bytes.
+/// Where the texture library is written, relative to the output directory: inside `tiles/`,
+/// so a tile's MTL and GLB reach it as `textures/<file>` without climbing out of the tile's
+/// folder (trimesh 5 refuses `../` paths).
+pub const TEXTURE_DIR: &str = "tiles/textures";
+
+/// One texture file: its name in the texture directory and its PNG bytes.
 pub type Texture = (&'static str, Cow<'static, [u8]>);
 
 /// The texture library: the shipped PNGs, each replaced by the file of the same name in the
@@ -80,9 +85,43 @@ pub fn texture_library(set: &str) -> Result<Vec<Texture>, String> {
     Ok(lib)
 }
 
-/// Writes the texture library to `<out>/textures/`.
+/// The library with the cut-out materials' masks added (see
+/// [`crate::materials::Material::mask`]), each derived from the texture as it is now (a
+/// replaced tree texture gets its own mask).
+pub fn with_masks(mut lib: Vec<Texture>) -> Result<Vec<Texture>, String> {
+    for m in crate::materials::MATERIALS {
+        let (Some(mask), Some(tex)) = (m.mask, m.texture) else {
+            continue;
+        };
+        if lib.iter().any(|(n, _)| *n == mask) {
+            continue;
+        }
+        let Some((_, bytes)) = lib.iter().find(|(n, _)| *n == tex) else {
+            continue;
+        };
+        lib.push((
+            mask,
+            Cow::Owned(mask_png(bytes).map_err(|e| format!("{tex}: {e}"))?),
+        ));
+    }
+    Ok(lib)
+}
+
+/// RGBA = (a, a, a, a) of a PNG.
+pub fn mask_png(png: &[u8]) -> Result<Vec<u8>, image::ImageError> {
+    let mut img = image::load_from_memory_with_format(png, image::ImageFormat::Png)?.to_rgba8();
+    for p in img.pixels_mut() {
+        let a = p[3];
+        p.0 = [a, a, a, a];
+    }
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png)?;
+    Ok(out.into_inner())
+}
+
+/// Writes the texture library to `<out>/tiles/textures/` ([`TEXTURE_DIR`]).
 pub fn write_textures(out: &Path, library: &[Texture]) -> std::io::Result<Vec<ManifestFile>> {
-    let dir = out.join("textures");
+    let dir = out.join(TEXTURE_DIR);
     std::fs::create_dir_all(&dir)?;
     library
         .iter()
@@ -90,7 +129,7 @@ pub fn write_textures(out: &Path, library: &[Texture]) -> std::io::Result<Vec<Ma
             let bytes: &[u8] = bytes;
             atomic::write_atomic(&dir.join(name), bytes)?;
             Ok(ManifestFile {
-                path: format!("textures/{name}"),
+                path: format!("{TEXTURE_DIR}/{name}"),
                 bytes: bytes.len() as u64,
                 sha256: sha256_hex(bytes),
             })
@@ -109,7 +148,7 @@ pub fn write_model(obj_path: &Path, meshes: &[Mesh], texture_set: &str) -> Resul
         .ok_or_else(|| format!("{}: give a file name ending in .obj", obj_path.display()))?;
     let dir = obj_path.parent().unwrap_or(Path::new(""));
     let io = |p: &Path, e: std::io::Error| format!("cannot write {}: {e}", p.display());
-    let textures = texture_library(texture_set)?;
+    let textures = with_masks(texture_library(texture_set)?)?;
     let tex_dir = dir.join("textures");
     std::fs::create_dir_all(&tex_dir).map_err(|e| io(&tex_dir, e))?;
     for (name, bytes) in &textures {

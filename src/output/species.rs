@@ -64,7 +64,10 @@ pub fn write_species(
         let mut buf = Vec::new();
         obj::write_tile(&mut buf, &s.name, [0.0, 0.0], [&mesh]);
         put(format!("{}.obj", s.name), &buf)?;
-        put(format!("{}.mtl", s.name), obj::mtl::mtl_text().as_bytes())?;
+        put(
+            format!("{}.mtl", s.name),
+            obj::mtl::mtl_text_at("../tiles/textures/").as_bytes(),
+        )?;
         heights.insert(s.name.clone(), s.nominal_height());
     }
     let mut csv = String::from("id,tile,species,lot,x,y,z,rotation,scale,squeeze,style\n");

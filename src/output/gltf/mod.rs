@@ -8,7 +8,7 @@
 //! (`machiya`, `kura`, `fence`, `people`, ...), so a viewer can hide a kind; one primitive
 //! per material within it, merged across objects; each vertex carries its object's row in
 //! the metadata table (`_FEATURE_ID_0`). Cut-outs are `MASK` at 0.5, double-sided; no BLEND.
-//! Textures are the shared library by relative URI (`../textures/<file>`): one copy per
+//! Textures are the shared library by relative URI (`textures/<file>`, in `tiles/`): one copy per
 //! build, cached by a browser across tiles, loadable from any static server.
 
 pub mod buffer;
@@ -198,7 +198,7 @@ fn materials(used: &[u16]) -> (Vec<Value>, Vec<Value>, Vec<Value>) {
         let mut pbr = json!({"metallicFactor": 0.0, "roughnessFactor": 0.9});
         match m.texture {
             Some(file) => {
-                images.push(json!({"uri": format!("../textures/{file}"), "mimeType": "image/png"}));
+                images.push(json!({"uri": format!("textures/{file}"), "mimeType": "image/png"}));
                 textures.push(json!({"sampler": 0, "source": images.len() - 1}));
                 pbr["baseColorTexture"] = json!({"index": textures.len() - 1});
             }

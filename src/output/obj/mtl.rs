@@ -2,17 +2,19 @@
 //!
 //! Textured materials get a white `Kd`: three.js multiplies the texture by `Kd`, Blender and
 //! MeshLab ignore it when a texture is present, so white shows the texture right everywhere.
-//! Billboards (trees, people) are cut out by their texture's alpha: `map_d` names the same
-//! PNG, which Blender's importer turns into an alpha link and three.js's MTLLoader into
-//! `alphaMap`/transparency; viewers that read only `map_Kd` still get the RGBA texture.
+//! Billboards (trees, people) are cut out by their texture's alpha: `map_d` names its mask
+//! (RGBA = a,a,a,a of the texture, written beside it), which Blender's importer reads as
+//! alpha and three.js's MTLLoader as an `alphaMap` (from the green channel): the same cut
+//! in both. Viewers that read only `map_Kd` still get the RGBA texture.
 
 use std::fmt::Write;
 
 use crate::materials::MATERIALS;
 
-/// MTL text listing every material; textures are referenced as `../textures/<file>`.
+/// MTL text listing every material, for a tile in `tiles/`: textures are referenced as
+/// `textures/<file>` (the library is in `tiles/textures/`, no `..`).
 pub fn mtl_text() -> String {
-    mtl_text_at("../textures/")
+    mtl_text_at("textures/")
 }
 
 /// MTL text with textures referenced as `<prefix><file>`.
@@ -35,8 +37,8 @@ pub fn mtl_text_at(prefix: &str) -> String {
                     s,
                     "Ks 0.000 0.000 0.000\nd 1.0\nillum 1\nmap_Kd {prefix}{t}"
                 );
-                if m.alpha {
-                    let _ = writeln!(s, "map_d {prefix}{t}");
+                if let (true, Some(mask)) = (m.alpha, m.mask) {
+                    let _ = writeln!(s, "map_d {prefix}{mask}");
                 }
             }
             None => {
