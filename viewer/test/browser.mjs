@@ -48,7 +48,10 @@ try {
 
   const ready = () => page.waitForFunction(() => window.edoCity && window.edoCity.ready, null, { timeout: 120000 });
   const t0 = Date.now();
-  await page.goto(`${url}?h=0`);
+  // A loaded machine (CI, the whole suite at once) can take long to start the page: the test
+  // waits for the viewer's own readiness, not for the load event, with a generous timeout.
+  page.setDefaultTimeout(120000);
+  await page.goto(`${url}?h=0`, { waitUntil: 'domcontentloaded', timeout: 120000 });
   await ready();
   out.ready_ms = Date.now() - t0;
   out.tiles = await page.evaluate(() => window.edoCity.tiles);
