@@ -43,6 +43,17 @@ raw=$(${CARGO_TARGET_DIR:-target}/release/examples/raw_write "$bytes" "$work/raw
 rm -f "$work/raw.obj"
 echo "tiles: $bytes bytes; raw write: $raw s ($(echo "$bytes / $raw / 1000000" | bc -l | cut -c1-6) MB/s)"
 
+echo "== the formats (30,052 lots): OBJ only, GLB only, both (the default above)"
+for f in obj glb; do
+  rm -rf "$work/out-$f"
+  /usr/bin/time -f "%e s, peak RSS %M KB" -o "$work/rss" $bin build "$work/town-30052" --out "$work/out-$f" --quiet --timings --format "$f" 2> "$work/timings"
+  printf '%s: %s | %s\n' "$f" "$(cat "$work/rss")" "$(sed -n 's/^timings: //p' "$work/timings")"
+done
+python3 -c "
+import json; r = json.load(open('$work/out-30052/report.json')); t = r['tiles']
+g = max(t, key=lambda x: x['glb_bytes'])
+print('tiles', len(t), '| OBJ', round(sum(x['obj_bytes'] for x in t) / 1e6, 1), 'MB, GLB', round(sum(x['glb_bytes'] for x in t) / 1e6, 1), 'MB | densest GLB', g['id'], g['glb_bytes'], 'bytes (its OBJ', g['obj_bytes'], ')')"
+
 echo "== single-tile regeneration (30,052 lots, the largest tile)"
 tile=$(python3 -c "import json,sys; r=json.load(open('$work/out-30052/report.json')); print(max(r['tiles'], key=lambda t: t['obj_bytes'])['id'])")
 for i in $(seq 1 "$RUNS"); do
