@@ -367,7 +367,7 @@ fn write_city(
         .map_err(|e| write_err(&opts.out.join("species"), e))?;
 
     let files = layer_files(&opts.input, params);
-    let sinks = output::sink::sinks(&params.output.formats);
+    let sinks = output::sink::sinks(&params.output);
     let directory = output::features::Directory::of(&data, &plan, params);
     let tiles: Vec<&String> = plan
         .tiles

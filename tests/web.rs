@@ -360,3 +360,60 @@ fn links_become_markers_and_a_malformed_address_is_skipped_with_its_record() {
         (Some(3), Some(0))
     );
 }
+
+#[test]
+fn obj_objects_by_kind_keep_every_face_in_a_few_objects() {
+    let dir = tempfile::tempdir().unwrap();
+    let each = dir.path().join("each");
+    build_ok(
+        &fixture("kyoto-small"),
+        &each,
+        &["--quiet", "--no-plan", "--format", "obj"],
+    );
+    let params = dir.path().join("kind.toml");
+    std::fs::write(&params, "[output]\nobj_objects = \"kind\"\n").unwrap();
+    let kind = dir.path().join("kind");
+    build_ok(
+        &fixture("kyoto-small"),
+        &kind,
+        &[
+            "--quiet",
+            "--no-plan",
+            "--format",
+            "obj",
+            "--params",
+            params.to_str().unwrap(),
+        ],
+    );
+    let (a, b) = (common::build_objects(&each), common::build_objects(&kind));
+    let faces = |objs: &[common::ObjObject]| objs.iter().map(|o| o.vertices.len()).sum::<usize>();
+    assert_eq!(faces(&a), faces(&b), "the same triangles");
+    let names: std::collections::BTreeSet<&str> = b.iter().map(|o| o.name.as_str()).collect();
+    assert!(names.len() < 10, "{names:?}");
+    assert!(
+        names.contains("machiya") && names.contains("kura"),
+        "{names:?}"
+    );
+    let m = read_json(&kind.join("manifest.json"));
+    let obj = kind.join(m["tiles"][0]["obj"]["path"].as_str().unwrap());
+    let text = std::fs::read_to_string(obj).unwrap();
+    let each_text =
+        std::fs::read_to_string(each.join(m["tiles"][0]["obj"]["path"].as_str().unwrap())).unwrap();
+    let runs = |t: &str| t.lines().filter(|l| l.starts_with("usemtl ")).count();
+    assert!(
+        runs(&text) * 10 < runs(&each_text),
+        "{} vs {}",
+        runs(&text),
+        runs(&each_text)
+    );
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[output]\nobj_objects = \"houses\"\n").unwrap();
+    let o = common::edo_city()
+        .args(["build", fixture("kyoto-small").to_str().unwrap(), "--out"])
+        .arg(dir.path().join("x"))
+        .args(["--params", bad.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("obj_objects"));
+}

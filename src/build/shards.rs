@@ -420,7 +420,11 @@ pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildEr
     let mut warnings = Vec::new();
     // What the sinks wrote before is written again; the build's own files (links.json) stay.
     manifest.files.retain(|f| f.path == "links.json");
-    for sink in crate::output::sink::sinks(&manifest.formats) {
+    let output = crate::params::OutputParams {
+        formats: manifest.formats.clone(),
+        ..manifest.params.output.clone()
+    };
+    for sink in crate::output::sink::sinks(&output) {
         let files = sink
             .finish(out, manifest, &mut warnings)
             .map_err(|e| write_err(out, e))?;

@@ -50,13 +50,15 @@ pub trait Sink: Sync {
     }
 }
 
-/// The sinks of `formats` (names as [`crate::params::output::FORMATS`] has them), in the
-/// order given; unknown names were refused when the parameters were read.
-pub fn sinks(formats: &[String]) -> Vec<Box<dyn Sink>> {
+/// The sinks of `output.formats` (names as [`crate::params::output::FORMATS`] has them), in
+/// the order given; unknown names were refused when the parameters were read.
+pub fn sinks(output: &crate::params::OutputParams) -> Vec<Box<dyn Sink>> {
     let mut out: Vec<Box<dyn Sink>> = Vec::new();
-    for f in formats {
+    for f in &output.formats {
         let s: Box<dyn Sink> = match f.as_str() {
-            "obj" => Box::new(super::obj::ObjSink),
+            "obj" => Box::new(super::obj::ObjSink {
+                by_kind: output.obj_objects == "kind",
+            }),
             "glb" => Box::new(super::gltf::GlbSink),
             _ => continue,
         };

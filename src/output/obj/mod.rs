@@ -17,7 +17,11 @@ use crate::generate::mesh::Mesh;
 use crate::materials::MATERIALS;
 
 /// The OBJ format: `tiles/<id>.obj` and its `tiles/<id>.mtl`.
-pub struct ObjSink;
+pub struct ObjSink {
+    /// `output.obj_objects = "kind"`: one object per kind of object (all machiya, all kura,
+    /// ...) with one `usemtl` run per material, instead of one object per house.
+    pub by_kind: bool,
+}
 
 impl Sink for ObjSink {
     fn format(&self) -> &'static str {
@@ -27,7 +31,13 @@ impl Sink for ObjSink {
     fn write_tile(&self, out: &Path, tile: &TileContent) -> std::io::Result<TileFiles> {
         let id = tile.id;
         let mut obj = Vec::with_capacity(tile.meshes.len() * 4096);
-        let sizes = write_tile(&mut obj, id, tile.origin, tile.meshes);
+        let sizes = if self.by_kind {
+            let kinds: Vec<&str> = tile.features.iter().map(|f| f.kind.as_str()).collect();
+            write_tile_by_kind(&mut obj, id, tile.origin, tile.meshes, &kinds);
+            None
+        } else {
+            Some(write_tile(&mut obj, id, tile.origin, tile.meshes))
+        };
         let mtl = mtl::mtl_text().into_bytes();
         let dir = out.join("tiles");
         atomic::write_atomic(&dir.join(format!("{id}.obj")), &obj)?;
@@ -42,7 +52,7 @@ impl Sink for ObjSink {
                 entry(format!("tiles/{id}.obj"), &obj),
                 entry(format!("tiles/{id}.mtl"), &mtl),
             ],
-            mesh_bytes: Some(sizes),
+            mesh_bytes: sizes,
         })
     }
 }
@@ -69,13 +79,8 @@ fn push_fixed(buf: &mut Vec<u8>, v: i64, scale: i64, digits: usize) {
     buf.extend_from_slice(frac);
 }
 
-/// Writes a whole tile into `buf`; returns the bytes each mesh's object took.
-pub fn write_tile<'a>(
-    buf: &mut Vec<u8>,
-    tile: &str,
-    origin: [f64; 2],
-    meshes: impl IntoIterator<Item = &'a Mesh>,
-) -> Vec<usize> {
+/// The tile's header: version, origin, frame, the MTL.
+fn header(buf: &mut Vec<u8>, tile: &str, origin: [f64; 2]) {
     let _ = write!(
         buf,
         "# edo-city {} tile {tile}\n\
@@ -86,7 +91,60 @@ pub fn write_tile<'a>(
         origin[0],
         origin[1]
     );
+}
+
+/// Appends a mesh's positions and texture coordinates.
+fn vertices(buf: &mut Vec<u8>, mesh: &Mesh) {
+    for p in &mesh.positions {
+        buf.extend_from_slice(b"v ");
+        push_mm(buf, p[0]);
+        buf.push(b' ');
+        push_mm(buf, p[1]);
+        buf.push(b' ');
+        push_mm(buf, p[2]);
+        buf.push(b'\n');
+    }
+    for t in &mesh.uvs {
+        buf.extend_from_slice(b"vt ");
+        push_fixed(buf, i64::from(t[0]), 10_000, 4);
+        buf.push(b' ');
+        push_fixed(buf, i64::from(t[1]), 10_000, 4);
+        buf.push(b'\n');
+    }
+}
+
+/// Appends one face, its indices offset by the bases of its mesh.
+fn face(buf: &mut Vec<u8>, f: &crate::generate::mesh::Face, v_base: u64, vt_base: u64) {
     let mut itoa_buf = itoa::Buffer::new();
+    buf.push(b'f');
+    for &(v, t) in &f.corners {
+        buf.push(b' ');
+        buf.extend_from_slice(itoa_buf.format(v_base + u64::from(v)).as_bytes());
+        buf.push(b'/');
+        buf.extend_from_slice(itoa_buf.format(vt_base + u64::from(t)).as_bytes());
+    }
+    buf.push(b'\n');
+}
+
+/// Appends `usemtl` when the material changes.
+fn use_material(buf: &mut Vec<u8>, current: &mut Option<u16>, material: u16) {
+    if *current != Some(material) {
+        *current = Some(material);
+        buf.extend_from_slice(b"usemtl ");
+        buf.extend_from_slice(MATERIALS[material as usize].name.as_bytes());
+        buf.push(b'\n');
+    }
+}
+
+/// Writes a whole tile into `buf`, one object per mesh; returns the bytes each mesh's object
+/// took.
+pub fn write_tile<'a>(
+    buf: &mut Vec<u8>,
+    tile: &str,
+    origin: [f64; 2],
+    meshes: impl IntoIterator<Item = &'a Mesh>,
+) -> Vec<usize> {
+    header(buf, tile, origin);
     let (mut v_base, mut vt_base) = (1u64, 1u64);
     let mut sizes = Vec::new();
     for mesh in meshes {
@@ -94,47 +152,68 @@ pub fn write_tile<'a>(
         buf.extend_from_slice(b"o ");
         buf.extend_from_slice(mesh.name.as_bytes());
         buf.push(b'\n');
-        for p in &mesh.positions {
-            buf.extend_from_slice(b"v ");
-            push_mm(buf, p[0]);
-            buf.push(b' ');
-            push_mm(buf, p[1]);
-            buf.push(b' ');
-            push_mm(buf, p[2]);
-            buf.push(b'\n');
-        }
-        for t in &mesh.uvs {
-            buf.extend_from_slice(b"vt ");
-            push_fixed(buf, i64::from(t[0]), 10_000, 4);
-            buf.push(b' ');
-            push_fixed(buf, i64::from(t[1]), 10_000, 4);
-            buf.push(b'\n');
-        }
+        vertices(buf, mesh);
         let mut order: Vec<usize> = (0..mesh.faces.len()).collect();
         order.sort_by_key(|&i| mesh.faces[i].material);
         let mut current = None;
         for i in order {
             let f = &mesh.faces[i];
-            if current != Some(f.material) {
-                current = Some(f.material);
-                buf.extend_from_slice(b"usemtl ");
-                buf.extend_from_slice(MATERIALS[f.material as usize].name.as_bytes());
-                buf.push(b'\n');
-            }
-            buf.push(b'f');
-            for &(v, t) in &f.corners {
-                buf.push(b' ');
-                buf.extend_from_slice(itoa_buf.format(v_base + u64::from(v)).as_bytes());
-                buf.push(b'/');
-                buf.extend_from_slice(itoa_buf.format(vt_base + u64::from(t)).as_bytes());
-            }
-            buf.push(b'\n');
+            use_material(buf, &mut current, f.material);
+            face(buf, f, v_base, vt_base);
         }
         v_base += mesh.positions.len() as u64;
         vt_base += mesh.uvs.len() as u64;
         sizes.push(buf.len() - start);
     }
     sizes
+}
+
+/// Writes a whole tile into `buf` with one object per kind (`kinds[i]` is mesh i's, e.g.
+/// `machiya`), in order of first appearance, and in each one `usemtl` run per material over
+/// all its meshes: a loader makes one draw call per kind and material instead of one per
+/// house and material. The houses' own names are gone (the GLB's metadata keeps them).
+pub fn write_tile_by_kind(
+    buf: &mut Vec<u8>,
+    tile: &str,
+    origin: [f64; 2],
+    meshes: &[Mesh],
+    kinds: &[&str],
+) {
+    header(buf, tile, origin);
+    let mut order: Vec<&str> = Vec::new();
+    for k in kinds {
+        if !order.contains(k) {
+            order.push(k);
+        }
+    }
+    let (mut v_base, mut vt_base) = (1u64, 1u64);
+    for kind in order {
+        buf.extend_from_slice(b"o ");
+        buf.extend_from_slice(kind.as_bytes());
+        buf.push(b'\n');
+        // (material, mesh, face) over the kind's meshes, with each mesh's index bases.
+        let mut faces: Vec<(u16, usize, usize)> = Vec::new();
+        let mut bases = Vec::new();
+        for (i, mesh) in meshes.iter().enumerate().filter(|(i, _)| kinds[*i] == kind) {
+            vertices(buf, mesh);
+            bases.push((i, v_base, vt_base));
+            v_base += mesh.positions.len() as u64;
+            vt_base += mesh.uvs.len() as u64;
+            faces.extend(
+                mesh.faces
+                    .iter()
+                    .enumerate()
+                    .map(|(k, f)| (f.material, i, k)),
+            );
+        }
+        faces.sort();
+        let mut current = None;
+        for (material, i, k) in faces {
+            let &(_, vb, tb) = bases.iter().find(|b| b.0 == i).expect("a base per mesh");
+            use_material(buf, &mut current, material);
+            face(buf, &meshes[i].faces[k], vb, tb);
+        }
+    }
 }
 
 #[cfg(test)]
