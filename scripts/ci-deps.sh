@@ -12,13 +12,9 @@ fi
 cargo fmt --version >/dev/null
 cargo clippy --version >/dev/null
 
+# shellcheck source=scripts/apt-install.sh
+. "$(dirname "$0")/apt-install.sh"
 if ! command -v faketime >/dev/null 2>&1; then
-  if [ "$(id -u)" = 0 ]; then
-    apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq faketime >/dev/null
-  else
-    sudo apt-get update -qq
-    sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq faketime >/dev/null
-  fi
+  apt_install faketime
 fi
 command -v faketime >/dev/null

@@ -11,13 +11,9 @@ if [ ! -f viewer/node_modules/.package-lock.json ] \
   (cd viewer && npm ci --no-audit --no-fund)
 fi
 
+# shellcheck source=scripts/apt-install.sh
+. scripts/apt-install.sh
 if ! command -v chromium >/dev/null 2>&1; then
-  if [ "$(id -u)" = 0 ]; then
-    apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
-  else
-    sudo apt-get update -qq
-    sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
-  fi
+  apt_install chromium
 fi
 command -v chromium >/dev/null

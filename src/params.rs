@@ -251,34 +251,27 @@ pub struct DemLayer {
     pub file: String,
 }
 
-/// Free-standing fences (a PolyLine layer), walled like lot outlines: a closed line encloses
-/// its inside, an open one has its wall on its left. Attributes as `[fence]` names them.
+/// A layer whose features need only an id (fences, gardens).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct FencesLayer {
-    /// Shapefile path, relative to the input directory; "" = no such layer.
-    pub file: String,
-    /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
-    #[serde(default)]
-    pub encoding: String,
-    /// Field holding the line's id (else its record number from 1).
-    pub id_field: String,
-}
-
-/// Garden polygons: each gets a rock garden (karesansui) in the largest rectangle that fits
-/// it clear of the planned buildings, besides the lots of `garden.uses`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GardensLayer {
+pub struct IdLayer {
     /// Shapefile path, relative to the input directory; "" = no such layer (a missing
     /// default file is no layer).
     pub file: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
-    /// Field holding the polygon's id (else its record number from 1).
+    /// Field holding the feature's id (else its record number from 1).
     pub id_field: String,
 }
+
+/// Free-standing fences (a PolyLine layer), walled like lot outlines: a closed line encloses
+/// its inside, an open one has its wall on its left. Attributes as `[fence]` names them.
+pub type FencesLayer = IdLayer;
+
+/// Garden polygons: each gets a rock garden (karesansui) in the largest rectangle that fits
+/// it clear of the planned buildings, besides the lots of `garden.uses`.
+pub type GardensLayer = IdLayer;
 
 /// Links (the paper's hyperlinks): a point layer, or a CSV table with x, y in the output CRS.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

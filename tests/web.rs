@@ -11,6 +11,13 @@ use common::{build_ok, fixture, read_json};
 use edo_city::output::tiles3d::globe::{geodetic, Affine};
 use serde_json::Value;
 
+/// Builds the example town into `out` (quiet, no plan) with `extra` flags.
+fn build_example(out: &Path, extra: &[&str]) -> Value {
+    let mut args = vec!["--quiet", "--no-plan"];
+    args.extend_from_slice(extra);
+    build_ok(&fixture("kyoto-small"), out, &args)
+}
+
 /// The JSON chunk of a GLB.
 fn glb_json(bytes: &[u8]) -> Value {
     assert_eq!(&bytes[0..4], b"glTF");
@@ -95,11 +102,7 @@ fn walk(node: &Value, to_root: Affine, leaves: &mut Vec<(Value, Affine)>) {
 #[test]
 fn the_tileset_holds_every_tile_and_places_a_house_where_proj_does() {
     let out = tempfile::tempdir().unwrap();
-    let report = build_ok(
-        &fixture("kyoto-small"),
-        out.path(),
-        &["--quiet", "--no-plan"],
-    );
+    let report = build_example(out.path(), &[]);
     let manifest = read_json(&out.path().join("manifest.json"));
     assert_eq!(manifest["formats"], serde_json::json!(["obj", "glb"]));
     assert!(manifest["files"]
@@ -205,11 +208,7 @@ fn the_tileset_holds_every_tile_and_places_a_house_where_proj_does() {
 fn formats_are_chosen_and_a_city_without_a_crs_is_built_unplaced_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
     let glb = dir.path().join("glb");
-    build_ok(
-        &fixture("kyoto-small"),
-        &glb,
-        &["--quiet", "--no-plan", "--format", "glb"],
-    );
+    build_example(&glb, &["--format", "glb"]);
     let m = read_json(&glb.join("manifest.json"));
     assert!(m["tiles"]
         .as_array()
@@ -222,11 +221,7 @@ fn formats_are_chosen_and_a_city_without_a_crs_is_built_unplaced_with_a_warning(
         .extension()
         .is_some_and(|x| x == "obj")));
     let obj = dir.path().join("obj");
-    build_ok(
-        &fixture("kyoto-small"),
-        &obj,
-        &["--quiet", "--no-plan", "--format", "obj"],
-    );
+    build_example(&obj, &["--format", "obj"]);
     assert!(!obj.join("tileset.json").exists());
     let bad = common::edo_city()
         .args(["build", fixture("kyoto-small").to_str().unwrap(), "--out"])
@@ -289,11 +284,7 @@ fn every_glb_passes_the_khronos_validator() {
     );
     let out = tempfile::tempdir().unwrap();
     // Houses, kura, walls, gates, people, trees and a garden: every kind the example has.
-    build_ok(
-        &fixture("kyoto-small"),
-        out.path(),
-        &["--quiet", "--no-plan", "--format", "glb"],
-    );
+    build_example(out.path(), &["--format", "glb"]);
     let o = std::process::Command::new("node")
         .current_dir(&viewer)
         .arg("test/validate.mjs")
@@ -365,25 +356,13 @@ fn links_become_markers_and_a_malformed_address_is_skipped_with_its_record() {
 fn obj_objects_by_kind_keep_every_face_in_a_few_objects() {
     let dir = tempfile::tempdir().unwrap();
     let each = dir.path().join("each");
-    build_ok(
-        &fixture("kyoto-small"),
-        &each,
-        &["--quiet", "--no-plan", "--format", "obj"],
-    );
+    build_example(&each, &["--format", "obj"]);
     let params = dir.path().join("kind.toml");
     std::fs::write(&params, "[output]\nobj_objects = \"kind\"\n").unwrap();
     let kind = dir.path().join("kind");
-    build_ok(
-        &fixture("kyoto-small"),
+    build_example(
         &kind,
-        &[
-            "--quiet",
-            "--no-plan",
-            "--format",
-            "obj",
-            "--params",
-            params.to_str().unwrap(),
-        ],
+        &["--format", "obj", "--params", params.to_str().unwrap()],
     );
     let (a, b) = (common::build_objects(&each), common::build_objects(&kind));
     let faces = |objs: &[common::ObjObject]| objs.iter().map(|o| o.vertices.len()).sum::<usize>();
