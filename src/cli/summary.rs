@@ -198,6 +198,10 @@ pub fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<(
         );
     }
     say!("  in {:.2} s", o.timings.total.as_secs_f64());
+    if opts.out.join("tileset.json").is_file() && opts.selection == edo_city::build::Selection::All
+    {
+        say!("  in a browser: edo-city serve {}", opts.out.display());
+    }
     Ok(())
 }
 
