@@ -220,7 +220,7 @@ fn check_billboards(plan: &Plan, data: &Dataset) -> Result<(), TestCaseError> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(200))]
+    #![proptest_config(ProptestConfig { rng_seed: proptest::test_runner::RngSeed::Fixed(2008), ..ProptestConfig::with_cases(200) })]
 
     #[test]
     fn any_town_builds_inside_its_lots_or_says_why(

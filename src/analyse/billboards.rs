@@ -659,8 +659,9 @@ fn keep_spaced(points: Vec<PlannedBillboard>, spacing: f64) -> Vec<PlannedBillbo
     let mut kept = Vec::new();
     for b in points {
         let (i, j) = cell(b.at);
-        let crowded = (i - 1..=i + 1).any(|x| {
-            (j - 1..=j + 1).any(|y| {
+        // A spacing of 1e-300 m puts every point in a cell at the ends of i64: saturate.
+        let crowded = (i.saturating_sub(1)..=i.saturating_add(1)).any(|x| {
+            (j.saturating_sub(1)..=j.saturating_add(1)).any(|y| {
                 grid.get(&(x, y)).is_some_and(|v| {
                     v.iter()
                         .any(|q| (q.x - b.at.x).hypot(q.y - b.at.y) < spacing)
