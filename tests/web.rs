@@ -26,14 +26,18 @@ fn glb_json(bytes: &[u8]) -> Value {
     serde_json::from_slice(&bytes[20..20 + len]).unwrap()
 }
 
-/// A column-major 4x4 transform as an affine map.
-fn affine(m: &Value) -> Affine {
-    let v: Vec<f64> = m
-        .as_array()
+/// A JSON array of numbers.
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array()
         .unwrap()
         .iter()
         .map(|x| x.as_f64().unwrap())
-        .collect();
+        .collect()
+}
+
+/// A column-major 4x4 transform as an affine map.
+fn affine(m: &Value) -> Affine {
+    let v = floats(m);
     Affine {
         cols: [[v[0], v[1], v[2]], [v[4], v[5], v[6]], [v[8], v[9], v[10]]],
         t: [v[12], v[13], v[14]],
@@ -42,24 +46,14 @@ fn affine(m: &Value) -> Affine {
 
 /// Is `p` inside the box `b` (centre and three axis-aligned half-axes), to `eps`?
 fn inside(b: &Value, p: [f64; 3], eps: f64) -> bool {
-    let b: Vec<f64> = b
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect();
+    let b = floats(b);
     let half = [b[3], b[7], b[11]];
     (0..3).all(|k| (p[k] - b[k]).abs() <= half[k] + eps)
 }
 
 /// The corners of a box.
 fn corners(b: &Value) -> Vec<[f64; 3]> {
-    let b: Vec<f64> = b
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect();
+    let b = floats(b);
     (0..8)
         .map(|i| {
             let s = |k: usize| if i >> k & 1 == 0 { -1.0 } else { 1.0 };
@@ -129,12 +123,7 @@ fn the_tileset_holds_every_tile_and_places_a_house_where_proj_does() {
             for p in mesh["primitives"].as_array().unwrap() {
                 let a = &g["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
                 for m in [&a["min"], &a["max"]] {
-                    let v: Vec<f64> = m
-                        .as_array()
-                        .unwrap()
-                        .iter()
-                        .map(|x| x.as_f64().unwrap())
-                        .collect();
+                    let v = floats(m);
                     assert!(
                         inside(&leaf["boundingVolume"]["box"], [v[0], -v[2], v[1]], 1e-4),
                         "{uri}: a vertex outside its box"
