@@ -130,12 +130,13 @@ pub struct SynthArgs {
 pub struct TemplateArgs {
     /// Template name (machiya type, kura, fence, tsuiji, gate, tree, person or your own).
     pub name: Option<String>,
-    /// Frontage width of the site, metres (the u axis).
-    #[arg(long, default_value_t = 5.454)]
-    pub width: f64,
-    /// Depth of the site, metres (the v axis).
-    #[arg(long, default_value_t = 20.0)]
-    pub depth: f64,
+    /// Frontage width of the site, metres (the u axis); default 5.454 (3 ken), or a hall's
+    /// own `plot_width`.
+    #[arg(long)]
+    pub width: Option<f64>,
+    /// Depth of the site, metres (the v axis); default 20, or a hall's `plot_depth`.
+    #[arg(long)]
+    pub depth: Option<f64>,
     /// The OBJ to write; its MTL and a textures/ directory go beside it.
     #[arg(short, long, default_value = "template.obj")]
     pub output: PathBuf,

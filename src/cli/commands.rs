@@ -253,8 +253,8 @@ fn load_params(path: Option<&Path>) -> Result<Params> {
 /// `edo-city template`: list the templates, or build one alone.
 fn template_alone(
     name: Option<String>,
-    width: f64,
-    depth: f64,
+    width: Option<f64>,
+    depth: Option<f64>,
     output: &Path,
     params: Option<PathBuf>,
     templates: Option<PathBuf>,
@@ -295,6 +295,10 @@ fn template_alone(
                 .join(", ")
         ),
     };
+    // A hall is tried on the plot it asks for; every other template on a 3-ken town lot.
+    let plot = |key: &str, fallback: f64| t.param(&[], key).unwrap_or(fallback);
+    let width = width.unwrap_or_else(|| plot("plot_width", 5.454));
+    let depth = depth.unwrap_or_else(|| plot("plot_depth", 20.0));
     let mut sets = Vec::new();
     for s in set {
         let (k, v) = s

@@ -13,9 +13,10 @@ use geo_types::Coord;
 use super::clip::{
     area, clip_band, clip_band_u, dedup, extent_at, is_convex, LocalPoly, LocalRing,
 };
+use super::envelope;
 use super::mesh::{open_edges_of, Frame, Mesh};
 use crate::templates::expr::{Expr, Lot};
-use crate::templates::template::{FaceSpec, Faces, Prism, Shape};
+use crate::templates::template::{FaceSpec, Faces, Prism, Roof, Shape};
 use crate::templates::Template;
 
 /// Texture base of walls, floors and faces without a base of their own: one repeat per 2 m.
@@ -98,6 +99,7 @@ pub fn instantiate(
                 let cx = PartCx {
                     t,
                     name: &part.name,
+                    loc: &part.loc,
                     site,
                     cell: &cell,
                     scalar: &scalar,
@@ -126,6 +128,8 @@ type Scalar<'a> = dyn Fn(&Expr, &str, &str) -> Result<f64, String> + 'a;
 struct PartCx<'a> {
     t: &'a Template,
     name: &'a str,
+    /// Where the part is written, for errors only a site can reveal.
+    loc: &'a crate::templates::file::Loc,
     site: &'a Site,
     /// The template's slots, with the `u` and `v` slots set per point by [`PartCx::at`].
     cell: &'a RefCell<Vec<f64>>,
@@ -167,6 +171,9 @@ fn prism(cx: &PartCx, p: &Prism, frame: Frame, mesh: &mut Mesh) -> Result<(), St
     for b in clip_band(&outline, v0, v1) {
         pieces.extend(clip_band_u(&b, u0, u1));
     }
+    if let Some(roof) = &p.roof {
+        return roof_prism(cx, p, roof, &pieces, v0, frame, mesh);
+    }
     // Where the roof line bends: split there so that every top face is planar.
     let splits = |exprs: &[Expr], what: &str| -> Result<Vec<f64>, String> {
         exprs.iter().map(|e| cx.scalar(e, what)).collect()
@@ -195,6 +202,27 @@ fn prism(cx: &PartCx, p: &Prism, frame: Frame, mesh: &mut Mesh) -> Result<(), St
             .map(|q| q[1])
             .fold(f64::INFINITY, f64::min)
     };
+    let dress = dress_of(cx, p, front_v)?;
+    let (g, slope) = (cx.site.ground, cx.site.slope);
+    let top = |q: [f64; 2]| g + slope * q[0] + cx.at(&p.top, q);
+    extrude(
+        mesh,
+        frame,
+        cx.site.local,
+        &pieces,
+        &|q| g + slope * q[0] + cx.at(&p.bottom, q),
+        &top,
+        &|_, q| top(q),
+        &|a, b| on_split(a, b, &splits_v, &splits_u),
+        &dress,
+        g,
+    );
+    Ok(())
+}
+
+/// How a part's walls and faces are dressed: its materials, and the facade on its front line
+/// `front_v` when it has one.
+fn dress_of(cx: &PartCx, p: &Prism, front_v: f64) -> Result<Dress, String> {
     let facade = match p.front_material {
         Some(material) => Some(Facade {
             material,
@@ -204,26 +232,151 @@ fn prism(cx: &PartCx, p: &Prism, frame: Frame, mesh: &mut Mesh) -> Result<(), St
         }),
         None => None,
     };
-    let dress = Dress {
+    Ok(Dress {
         top: p.top_material,
         bottom: p.bottom_material,
         wall: p.side_material,
         facade,
+    })
+}
+
+/// A prism under a roof of planes: the pieces cut into the regions where each plane is the
+/// lowest (`envelope::regions`), each region's top on its plane, walls only on the outline.
+#[allow(clippy::too_many_arguments)]
+fn roof_prism(
+    cx: &PartCx,
+    p: &Prism,
+    roof: &Roof,
+    pieces: &[LocalPoly],
+    v0: f64,
+    frame: Frame,
+    mesh: &mut Mesh,
+) -> Result<(), String> {
+    if pieces.is_empty() {
+        return Ok(());
+    }
+    let planes = roof_planes(cx, roof, pieces)?;
+    if planes.is_empty() {
+        return Err(format!(
+            "template {}: part `{}`: the roof has no plane",
+            cx.t.name, cx.name
+        ));
+    }
+    let regions = envelope::regions(pieces, &planes);
+    let thickness = match &roof.thickness {
+        Some(e) => Some(cx.scalar(e, "thickness")?),
+        None => None,
     };
     let (g, slope) = (cx.site.ground, cx.site.slope);
+    let top = |q: [f64; 2]| g + slope * q[0] + envelope::lowest(&planes, q);
+    let bottom = |q: [f64; 2]| match thickness {
+        Some(t) => top(q) - t,
+        None => g + slope * q[0] + cx.at(&p.bottom, q),
+    };
+    for q in regions.iter().flat_map(|(r, _)| r.rings().flatten()) {
+        let (b, h) = (bottom(*q), top(*q));
+        if !(b.is_finite() && h.is_finite()) || h < b - 1e-6 {
+            return Err(format!(
+                "template {}: part `{}`: the roof at u={:.2}, v={:.2} is {h:.2} m, below its \
+                 bottom {b:.2} m (or not a number)",
+                cx.t.name, cx.name, q[0], q[1]
+            ));
+        }
+    }
+    let front_v = if p.v0.is_some() {
+        v0
+    } else {
+        pieces
+            .iter()
+            .flat_map(|x| &x.exterior)
+            .map(|q| q[1])
+            .fold(f64::INFINITY, f64::min)
+    };
+    let dress = dress_of(cx, p, front_v)?;
+    // An edge two regions share (run both ways) is inside the roof: no wall there.
+    let key = |q: [f64; 2]| ((q[0] * 1e4).round() as i64, (q[1] * 1e4).round() as i64);
+    let mut edges = std::collections::HashSet::new();
+    for (r, _) in &regions {
+        for ring in r.rings() {
+            for k in 0..ring.len() {
+                edges.insert((key(ring[k]), key(ring[(k + 1) % ring.len()])));
+            }
+        }
+    }
+    let polys: Vec<LocalPoly> = regions.iter().map(|(r, _)| r.clone()).collect();
+    let owner: Vec<usize> = regions.iter().map(|(_, i)| *i).collect();
     extrude(
         mesh,
         frame,
         cx.site.local,
-        &pieces,
-        &|q| g + slope * q[0] + cx.at(&p.bottom, q),
-        &|q| g + slope * q[0] + cx.at(&p.top, q),
-        &splits_v,
-        &splits_u,
+        &polys,
+        &bottom,
+        &top,
+        &|k, q| envelope::height(&planes[owner[k]], q),
+        &|a, b| edges.contains(&(key(b), key(a))),
         &dress,
         g,
     );
     Ok(())
+}
+
+/// The roof's planes on this site: each `planes` expression read off at three points (and
+/// checked flat at a fourth), then one plane per outline edge for a hip roof.
+fn roof_planes(
+    cx: &PartCx,
+    roof: &Roof,
+    pieces: &[LocalPoly],
+) -> Result<Vec<envelope::Plane>, String> {
+    let o = pieces[0].exterior[0];
+    // Probes: every corner of the pieces and the middle of their box, so that a plane bent
+    // anywhere over the part (an abs or a min inside it) is caught.
+    let corners: Vec<[f64; 2]> = pieces
+        .iter()
+        .flat_map(|x| x.rings().flatten())
+        .copied()
+        .collect();
+    let (lo, hi) = corners
+        .iter()
+        .fold(([f64::MAX; 2], [f64::MIN; 2]), |(l, h), q| {
+            (
+                [l[0].min(q[0]), l[1].min(q[1])],
+                [h[0].max(q[0]), h[1].max(q[1])],
+            )
+        });
+    let middle = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0];
+    let mut planes = Vec::new();
+    for (k, e) in roof.planes.iter().enumerate() {
+        let h0 = cx.at(e, o);
+        let hu = cx.at(e, [o[0] + 1.0, o[1]]) - h0;
+        let hv = cx.at(e, [o[0], o[1] + 1.0]) - h0;
+        let plane = [h0 - hu * o[0] - hv * o[1], hu, hv];
+        let bent = corners.iter().chain([&middle]).any(|q| {
+            let off = cx.at(e, *q) - envelope::height(&plane, *q);
+            off.is_nan() || off.abs() > 1e-6 * (1.0 + plane[0].abs())
+        });
+        if !plane.iter().all(|x| x.is_finite()) || bent {
+            return Err(format!(
+                "template {}: part `{}` ({}): plane {} is not flat (a roof plane is linear in u \
+                 and v: no abs, min or max inside one plane; give each slope as its own plane)",
+                cx.t.name,
+                cx.name,
+                cx.loc,
+                k + 1
+            ));
+        }
+        planes.push(plane);
+    }
+    if let Some((eave, pitch)) = &roof.hip {
+        let (eave, pitch) = (cx.scalar(eave, "hip_eave")?, cx.scalar(pitch, "hip_pitch")?);
+        // The planes rise from the edges of the pieces' hull: on a lot with a reflex corner
+        // the plane of an inner edge would cut through the other wing, so the inner sides
+        // rise as gables instead.
+        let r = envelope::hull(&corners);
+        for k in 0..r.len() {
+            planes.extend(envelope::from_eave(r[k], r[(k + 1) % r.len()], eave, pitch));
+        }
+    }
+    Ok(planes)
 }
 
 /// The outline a prism is cut from: the lot, or the part's own points (counter-clockwise,
@@ -406,8 +559,9 @@ fn on_split(p: [f64; 2], q: [f64; 2], splits_v: &[f64], splits_u: &[f64]) -> boo
 }
 
 /// Extrudes planar pieces between a bottom and a top height, each a function of (u, v) that
-/// is linear on every piece. Walls on a split line are left out: there two pieces meet and
-/// the shell continues. The result is closed when the pieces tile a closed region.
+/// is linear on every piece. Walls on `internal` edges are left out: there two pieces meet and
+/// the shell continues. The result is closed when the pieces tile a closed region. `uv_top`
+/// is piece k's own top, for the roof texture's slope.
 #[allow(clippy::too_many_arguments)]
 fn extrude(
     mesh: &mut Mesh,
@@ -416,17 +570,17 @@ fn extrude(
     parts: &[LocalPoly],
     bottom: &dyn Fn([f64; 2]) -> f64,
     top: &dyn Fn([f64; 2]) -> f64,
-    splits_v: &[f64],
-    splits_u: &[f64],
+    uv_top: &dyn Fn(usize, [f64; 2]) -> f64,
+    internal: &dyn Fn([f64; 2], [f64; 2]) -> bool,
     dress: &Dress,
     base: f64,
 ) {
-    for part in parts {
+    for (k, part) in parts.iter().enumerate() {
         let tris = triangles(part);
         // Roof texture follows the slope, so tiles keep their size on steep roofs.
         let stretch = |p: [f64; 2]| {
-            let gu = top([p[0] + 0.5, p[1]]) - top([p[0] - 0.5, p[1]]);
-            let gv = top([p[0], p[1] + 0.5]) - top([p[0], p[1] - 0.5]);
+            let gu = uv_top(k, [p[0] + 0.5, p[1]]) - uv_top(k, [p[0] - 0.5, p[1]]);
+            let gv = uv_top(k, [p[0], p[1] + 0.5]) - uv_top(k, [p[0], p[1] - 0.5]);
             ((1.0 + gu * gu).sqrt(), (1.0 + gv * gv).sqrt())
         };
         for tri in &tris {
@@ -463,7 +617,7 @@ fn extrude(
             .rings()
             .flat_map(|r| (0..r.len()).map(move |i| (r[i], r[(i + 1) % r.len()])))
         {
-            if on_split(p, q, splits_v, splits_u) {
+            if internal(p, q) {
                 continue;
             }
             let (hp0, hq0, hp1, hq1) = (bottom(p), bottom(q), top(p), top(q));

@@ -5,6 +5,7 @@
 
 pub mod billboards;
 pub mod clip;
+pub mod envelope;
 pub mod fences;
 pub mod garden;
 pub mod instance;

@@ -68,6 +68,11 @@ struct RawPart {
     split: Vec<Spanned<NumOrText>>,
     #[serde(default)]
     split_u: Vec<Spanned<NumOrText>>,
+    #[serde(default)]
+    planes: Vec<Spanned<NumOrText>>,
+    hip_eave: Option<Spanned<NumOrText>>,
+    hip_pitch: Option<Spanned<NumOrText>>,
+    thickness: Option<Spanned<NumOrText>>,
     top_material: Option<Spanned<String>>,
     bottom_material: Option<Spanned<String>>,
     side_material: Option<Spanned<String>>,
@@ -181,6 +186,14 @@ pub struct PartSource {
     pub split: Vec<Text>,
     /// Positions along the street where it bends.
     pub split_u: Vec<Text>,
+    /// A roof as the lower envelope of planes, each linear in u and v.
+    pub planes: Vec<Text>,
+    /// A hip roof on the outline: one plane per edge from this eave height ...
+    pub hip_eave: Option<Text>,
+    /// ... rising at this pitch.
+    pub hip_pitch: Option<Text>,
+    /// A roof slab: the bottom is the top this much lower.
+    pub thickness: Option<Text>,
     /// Material of the top faces.
     pub top_material: Option<Src<String>>,
     /// Material of the bottom faces.
@@ -321,6 +334,10 @@ pub fn parse(file: &str, text: &str) -> Result<Source, String> {
             top: cx.opt(p.top),
             split: cx.list(p.split),
             split_u: cx.list(p.split_u),
+            planes: cx.list(p.planes),
+            hip_eave: cx.opt(p.hip_eave),
+            hip_pitch: cx.opt(p.hip_pitch),
+            thickness: cx.opt(p.thickness),
             top_material: p.top_material.map(|s| cx.src(s)),
             bottom_material: p.bottom_material.map(|s| cx.src(s)),
             side_material: p.side_material.map(|s| cx.src(s)),

@@ -65,6 +65,26 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("gate.toml", include_str!("../../templates/gate.toml")),
     ("tree.toml", include_str!("../../templates/tree.toml")),
     ("person.toml", include_str!("../../templates/person.toml")),
+    (
+        "halls/hondo.toml",
+        include_str!("../../templates/halls/hondo.toml"),
+    ),
+    (
+        "halls/sanmon.toml",
+        include_str!("../../templates/halls/sanmon.toml"),
+    ),
+    (
+        "halls/goju-no-to.toml",
+        include_str!("../../templates/halls/goju-no-to.toml"),
+    ),
+    (
+        "halls/omoya.toml",
+        include_str!("../../templates/halls/omoya.toml"),
+    ),
+    (
+        "halls/shinden.toml",
+        include_str!("../../templates/halls/shinden.toml"),
+    ),
 ];
 
 /// The tree species shipped with the tool (`templates/trees/`), compiled in.

@@ -25,17 +25,22 @@ pub enum Kind {
     Tree,
     /// A person billboard.
     Person,
+    /// A hall of an estate or a temple (a temple's main hall, gate and pagoda, a samurai's
+    /// main house, a court noble's residence), built on the open plot analysis finds for it
+    /// behind the lot's gate: `u` across the plot, `v` away from the gate.
+    Hall,
 }
 
 impl Kind {
     /// Every kind with the name template files use.
-    pub const ALL: [(&'static str, Kind); 6] = [
+    pub const ALL: [(&'static str, Kind); 7] = [
         ("machiya", Kind::Machiya),
         ("kura", Kind::Kura),
         ("fence", Kind::Fence),
         ("gate", Kind::Gate),
         ("tree", Kind::Tree),
         ("person", Kind::Person),
+        ("hall", Kind::Hall),
     ];
     /// The name template files use.
     pub fn name(self) -> &'static str {
@@ -268,6 +273,8 @@ pub struct Prism {
     pub split: Vec<Expr>,
     /// Positions along the street where it bends.
     pub split_u: Vec<Expr>,
+    /// A roof as the lower envelope of planes (`generate::envelope`): then `top` is unused.
+    pub roof: Option<Roof>,
     /// Material of the top faces.
     pub top_material: u16,
     /// Material of the bottom faces.
@@ -282,6 +289,18 @@ pub struct Prism {
     pub front_height: Expr,
     /// Whether the part must be a closed shell.
     pub closed: bool,
+}
+
+/// A roof surface: the lowest of its planes at every point (hip, irimoya, pyramidal, a
+/// tier of a pagoda), cut into flat faces where the planes cross.
+#[derive(Debug, Clone)]
+pub struct Roof {
+    /// Planes given by expressions linear in `u` and `v`.
+    pub planes: Vec<Expr>,
+    /// One plane per edge of the outline, from `(eave, pitch)`: a hip roof on any shape.
+    pub hip: Option<(Expr, Expr)>,
+    /// A slab: the bottom is the roof this much lower (else the part's `bottom`).
+    pub thickness: Option<Expr>,
 }
 
 /// Explicit vertices (u, v, h) and faces over them.
@@ -572,13 +591,20 @@ fn material_slots(s: &Source, kind: Kind, here: &Loc) -> Result<Vec<(String, u16
 
 fn compile_part(p: &PartSource, scalar: &Names, all: &Names, slots: Slots) -> Result<Part, String> {
     let loc = p.name.loc.clone();
-    let is_prism = p.top.is_some() || p.outline.is_some();
+    let is_roof = !p.planes.is_empty() || p.hip_pitch.is_some() || p.hip_eave.is_some();
+    let is_prism = p.top.is_some() || p.outline.is_some() || is_roof;
     let is_faces = !p.vertices.is_empty() || !p.faces.is_empty();
     let shape = match (is_prism, is_faces) {
         (true, true) => return Err(err(&loc, "a part is either a prism (`top`, `outline`) or explicit `vertices` and `faces`, not both")),
         (false, false) => return Err(err(&loc, "the part has neither `top` (a prism) nor `vertices` and `faces`")),
         (true, false) => {
-            let top = p.top.as_ref().ok_or_else(|| err(&loc, "a prism needs `top`"))?;
+            let roof = roof(p, scalar, all, &loc)?;
+            let top = match (&p.top, &roof) {
+                (Some(top), None) => all.compile(top)?,
+                (None, Some(_)) => all.or(&None, 0.0)?,
+                (None, None) => return Err(err(&loc, "a prism needs `top` (or a roof: `planes`, `hip_pitch`)")),
+                (Some(_), Some(_)) => return Err(err(&loc, "a prism has either `top` or a roof (`planes`, `hip_pitch`), not both")),
+            };
             let outline = match &p.outline {
                 None => None,
                 Some(Src { value: OutlineSource::Lot, .. }) => None,
@@ -602,7 +628,8 @@ fn compile_part(p: &PartSource, scalar: &Names, all: &Names, slots: Slots) -> Re
                 u0: scalar.opt(&p.u0)?,
                 u1: scalar.opt(&p.u1)?,
                 bottom: all.or(&p.bottom, 0.0)?,
-                top: all.compile(top)?,
+                top,
+                roof,
                 split: p.split.iter().map(|t| scalar.compile(t)).collect::<Result<_, _>>()?,
                 split_u: p.split_u.iter().map(|t| scalar.compile(t)).collect::<Result<_, _>>()?,
                 top_material: material(slots, &p.top_material, "kawara_roof")?,
@@ -664,6 +691,49 @@ fn compile_part(p: &PartSource, scalar: &Names, all: &Names, slots: Slots) -> Re
         when: scalar.opt(&p.when)?,
         shape,
     })
+}
+
+/// A prism's roof keys, checked: `planes` and `hip_pitch` with `hip_eave`, optionally
+/// `thickness`; never with `split` (the planes say where the roof bends).
+fn roof(p: &PartSource, scalar: &Names, all: &Names, loc: &Loc) -> Result<Option<Roof>, String> {
+    if p.planes.is_empty() && p.hip_pitch.is_none() && p.hip_eave.is_none() {
+        if p.thickness.is_some() {
+            return Err(err(
+                loc,
+                "`thickness` belongs to a roof (`planes`, `hip_pitch`); give `bottom` instead",
+            ));
+        }
+        return Ok(None);
+    }
+    if !p.split.is_empty() || !p.split_u.is_empty() {
+        return Err(err(
+            loc,
+            "a roof of `planes` bends where its planes cross: leave out `split` and `split_u`",
+        ));
+    }
+    let hip = match (&p.hip_eave, &p.hip_pitch) {
+        (Some(e), Some(pi)) => Some((scalar.compile(e)?, scalar.compile(pi)?)),
+        (None, None) => None,
+        _ => return Err(err(
+            loc,
+            "a hip roof needs both `hip_eave` (its eave height) and `hip_pitch` (rise per metre)",
+        )),
+    };
+    if p.thickness.is_some() && p.bottom.is_some() {
+        return Err(err(
+            loc,
+            "a roof slab has `thickness` or `bottom`, not both",
+        ));
+    }
+    Ok(Some(Roof {
+        planes: p
+            .planes
+            .iter()
+            .map(|t| all.compile(t))
+            .collect::<Result<_, _>>()?,
+        hip,
+        thickness: scalar.opt(&p.thickness)?,
+    }))
 }
 
 impl Template {
