@@ -517,6 +517,38 @@ fn main() {
         shade([214, 208, 196], furrow + noise(x, y, 98) * 0.07)
     });
     c.save("gravel_raked.png");
+    // The ground of the tiles: a street's packed earth with cart ruts along it (4 m a
+    // repeat), the white gravel (shirasu 白州) of temple and court grounds, and water.
+    let mut c = Canvas::new(128, 128);
+    c.band(0.0, 1.0, |x, y| {
+        let rut = if (x % 64).abs_diff(20) < 3 {
+            -0.08
+        } else {
+            0.0
+        };
+        shade(
+            [122, 108, 90],
+            noise(x, y, 120) * 0.07 + noise(x / 5, y / 5, 121) * 0.06 + rut,
+        )
+    });
+    c.save("street.png");
+    let mut c = Canvas::new(128, 128);
+    c.band(0.0, 1.0, |x, y| {
+        shade(
+            [178, 172, 160],
+            noise(x, y, 122) * 0.12 + noise(x / 2, y / 2, 123) * 0.05,
+        )
+    });
+    c.save("gravel.png");
+    let mut c = Canvas::new(128, 128);
+    c.band(0.0, 1.0, |x, y| {
+        let ripple = ((y as f32 / 128.0 * std::f32::consts::TAU * 6.0
+            + (x as f32 / 128.0 * std::f32::consts::TAU * 2.0).sin() * 0.8)
+            .sin())
+            * 0.06;
+        shade([66, 102, 122], ripple + noise(x / 4, y / 4, 124) * 0.05)
+    });
+    c.save("water.png");
     let mut c = Canvas::new(64, 64);
     c.band(0.0, 1.0, |x, y| {
         shade(

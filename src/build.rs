@@ -196,6 +196,7 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
         }
     }
     check_billboards(&catalog, params)?;
+    check_halls_and_ground(&catalog, params)?;
     let mixes = std::iter::once(("type_mix".to_string(), &params.type_mix)).chain(
         params
             .district
@@ -454,15 +455,27 @@ fn write_city(
                 progress.inc(1);
                 // The bytes the trees' objects take in the OBJ, exactly.
                 let is_tree = |m: &Mesh| m.name == "trees" || m.name == "trees_grown";
-                meshes.stats.tree_bytes = match mesh_bytes {
+                meshes.stats.tree_bytes = match &mesh_bytes {
                     Some(sizes) => meshes
                         .meshes
                         .iter()
-                        .zip(&sizes)
+                        .zip(sizes)
                         .filter(|(m, _)| is_tree(m))
                         .map(|(_, &n)| n as u64)
                         .sum(),
                     None => output::obj_bytes(meshes.meshes.iter().filter(|m| is_tree(m))) as u64,
+                };
+                // And the ground's (the OBJ writer's count when it wrote one).
+                let is_ground = |m: &Mesh| m.name == "ground" || m.name == "streets";
+                meshes.stats.ground_bytes = match &mesh_bytes {
+                    Some(sizes) => meshes
+                        .meshes
+                        .iter()
+                        .zip(sizes)
+                        .filter(|(m, _)| is_ground(m))
+                        .map(|(_, &n)| n as u64)
+                        .sum(),
+                    None => output::obj_bytes(meshes.meshes.iter().filter(|m| is_ground(m))) as u64,
                 };
                 entry.stats = meshes.stats;
                 Ok(entry)
@@ -565,7 +578,11 @@ pub fn check(
         .tiles
         .par_iter()
         .map(|id| {
-            let tile = generate::TilePlan::of(&plan, id);
+            // The ground is never skipped: checking needs no boolean operations.
+            let tile = generate::TilePlan {
+                surface: None,
+                ..generate::TilePlan::of(&plan, id)
+            };
             let meshes = generate::generate_tile(&tile, &catalog, params, plan.origin, &files);
             report::ManifestTile {
                 id: id.clone(),
@@ -645,6 +662,35 @@ fn terrain_of<'a>(
     let dem = data.dem.as_ref().filter(|_| params.terrain)?;
     let b = crate::model::tile::tile_bounds(tile, params.tile_size, params.tile_origin)?;
     Some((dem, tile, b))
+}
+
+/// `halls.uses` names hall templates, and `ground.materials` library materials.
+fn check_halls_and_ground(catalog: &Catalog, params: &Params) -> Result<(), BuildError> {
+    if params.halls.enabled {
+        for (u, names) in &params.halls.uses {
+            for name in names {
+                if catalog
+                    .get(name)
+                    .is_none_or(|t| t.kind != Kind::Hall || t.is_abstract)
+                {
+                    return Err(BuildError::Config(format!(
+                        "halls.uses.{u} names `{name}`, which is not a hall template (hall \
+                         templates: {})",
+                        catalog.names_of(Kind::Hall).join(", ")
+                    )));
+                }
+            }
+        }
+    }
+    for (u, m) in &params.ground.materials {
+        if crate::materials::find(m).is_none() {
+            return Err(BuildError::Config(format!(
+                "ground.materials.{u} names `{m}`, which is not a library material (e.g. \
+                 ground, gravel, street, water, moss, stone)"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// `people.template` / `trees.template` name templates of their kind, and every texture
@@ -740,6 +786,7 @@ fn input_summary(
     s.ledgers = output::accounting::ledgers(data);
     s.crowds = plan.crowds.clone();
     s.gardens = plan.garden_reports.clone();
+    s.halls = plan.hall_reports.clone();
     // A skip that names only its feature gets its record, so the ledger closes after the
     // manifest's round trip too (`--tiles`, `merge`).
     for skip in s.skipped.iter_mut().filter(|k| k.record.is_none()) {

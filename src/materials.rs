@@ -344,6 +344,29 @@ pub const MATERIALS: &[Material] = &[
         mask: None,
         texture: None,
     },
+    // The ground of a tile (`generate::ground`): street surfaces, the white gravel of
+    // temple and court grounds, water.
+    Material {
+        name: "street",
+        kd: [0.47, 0.42, 0.36],
+        alpha: false,
+        mask: None,
+        texture: Some("street.png"),
+    },
+    Material {
+        name: "gravel",
+        kd: [0.70, 0.68, 0.63],
+        alpha: false,
+        mask: None,
+        texture: Some("gravel.png"),
+    },
+    Material {
+        name: "water",
+        kd: [0.26, 0.40, 0.48],
+        alpha: false,
+        mask: None,
+        texture: Some("water.png"),
+    },
 ];
 
 /// Texture files, compiled in: (file name, PNG bytes).
@@ -437,6 +460,9 @@ pub const TEXTURES: &[(&str, &[u8])] = &[
         "leaf_bamboo.png",
         include_bytes!("../textures/leaf_bamboo.png"),
     ),
+    ("street.png", include_bytes!("../textures/street.png")),
+    ("gravel.png", include_bytes!("../textures/gravel.png")),
+    ("water.png", include_bytes!("../textures/water.png")),
 ];
 
 /// Index of a material by name.

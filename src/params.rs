@@ -13,11 +13,13 @@ use thiserror::Error;
 mod billboards;
 mod crowd;
 mod garden;
+mod halls;
 pub mod output;
 mod partial;
 pub use billboards::{PeopleParams, PointsLayer, TreesParams};
 pub use crowd::CrowdParams;
 pub use garden::GardenParams;
+pub use halls::{GroundParams, HallParams};
 pub use output::OutputParams;
 
 /// The default parameter file, shipped inside the binary.
@@ -93,6 +95,10 @@ pub struct Params {
     pub crowd: CrowdParams,
     /// The rock gardens of temple lots (seed 000).
     pub garden: GardenParams,
+    /// The halls of estates and temples.
+    pub halls: HallParams,
+    /// The ground of every tile: streets, lot and estate ground, water.
+    pub ground: GroundParams,
     /// The output formats.
     pub output: OutputParams,
     /// Where the output origin stands on the globe, `[longitude, latitude, height]`: for the
@@ -239,6 +245,8 @@ pub struct Layers {
     pub gardens: GardensLayer,
     /// Links placed in the city (pages and images the viewer opens).
     pub links: LinksLayer,
+    /// Water (rivers, ponds): polygons drawn as a water surface in the ground.
+    pub water: IdLayer,
     /// The terrain grid.
     pub dem: DemLayer,
 }
@@ -754,6 +762,8 @@ impl Params {
         self.trees.validate().map_err(bad)?;
         self.crowd.validate().map_err(bad)?;
         self.garden.validate().map_err(bad)?;
+        self.halls.validate().map_err(bad)?;
+        self.ground.validate().map_err(bad)?;
         self.output.validate().map_err(bad)?;
         if let Some(o) = &self.origin_lonlat {
             output::check_origin_lonlat(o).map_err(bad)?;

@@ -53,11 +53,16 @@ fn houses_and_fences_stand_on_the_dem() {
         m["origin"][1].as_f64().unwrap(),
     ];
     let lots = read_lots(&fixture("kyoto-small").join("lots.shp"));
-    let (mut houses, mut fences) = (0, 0);
+    let (mut houses, mut fences, mut halls) = (0, 0, 0);
     for t in m["tiles"].as_array().unwrap() {
         for o in load_tile(&out.join(t["obj"]["path"].as_str().unwrap()), origin) {
             if o.name == "people" || o.name == "trees" {
                 continue; // billboards: tests/billboards.rs
+            }
+            if o.name == "ground" || o.name == "streets" {
+                // Without `terrain` the ground stands on the lots' elevations, which the
+                // DEM gave: every vertex within the plane's rise across a few lots.
+                continue;
             }
             let (kind, id) = o.name.split_once('_').unwrap();
             let base = o
@@ -102,13 +107,29 @@ fn houses_and_fences_stand_on_the_dem() {
                     );
                     fences += 1;
                 }
+                "hall" => {
+                    // A hall's flat base is the lowest ground under its plot's corners: at or
+                    // below the ground under any of its own vertices (never floating), and
+                    // less than a metre below it on this 5 cm/m slope.
+                    let corners_low = o
+                        .vertices
+                        .iter()
+                        .map(|v| plane(v[0] - X0, v[1] - Y0))
+                        .fold(f64::INFINITY, f64::min);
+                    assert!(
+                        base <= corners_low + 0.002 && base > corners_low - 1.0,
+                        "{}: base {base}, ground under it from {corners_low}",
+                        o.name
+                    );
+                    halls += 1;
+                }
                 _ => {}
             }
         }
     }
     assert!(
-        houses > 300 && fences == 2,
-        "{houses} houses, {fences} fences"
+        houses > 300 && fences == 2 && halls >= 3,
+        "{houses} houses, {fences} fences, {halls} halls"
     );
 }
 
@@ -152,12 +173,23 @@ fn a_dem_off_the_lots_warns_and_one_in_another_crs_stops() {
 
 #[test]
 fn the_terrain_mesh_is_the_dem_clipped_to_each_tile() {
+    // With `[ground]` the ground itself is draped on the DEM (object `ground`); without it,
+    // the terrain is its own mesh `terrain_<tile>`.
+    for (text, object) in [
+        ("terrain = true\n", "ground"),
+        ("terrain = true\n[ground]\nenabled = false\n", "terrain"),
+    ] {
+        terrain_clipped_to_each_tile(text, object);
+    }
+}
+
+fn terrain_clipped_to_each_tile(params_text: &str, object: &str) {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("in");
     copy_fixture("kyoto-small", &input);
     write_plane(&input.join("dem.asc"), X0, Y0, 100);
     let params = dir.path().join("p.toml");
-    std::fs::write(&params, "terrain = true\n").unwrap();
+    std::fs::write(&params, params_text).unwrap();
     let out = dir.path().join("out");
     build_ok(
         &input,
@@ -181,11 +213,16 @@ fn the_terrain_mesh_is_the_dem_clipped_to_each_tile() {
             gy + r.parse::<f64>().unwrap() * size,
         );
         let objects = load_tile(&out.join(t["obj"]["path"].as_str().unwrap()), origin);
-        let ground: Vec<_> = objects
-            .iter()
-            .filter(|o| o.name == format!("terrain_{id}"))
-            .collect();
-        assert_eq!(ground.len(), 1, "{id}: one terrain object");
+        let name = match object {
+            "terrain" => format!("terrain_{id}"),
+            other => other.to_string(),
+        };
+        let ground: Vec<_> = objects.iter().filter(|o| o.name == name).collect();
+        assert_eq!(ground.len(), 1, "{id}: one {name} object");
+        assert!(
+            !objects.iter().any(|o| o.name.starts_with("terrain_")) || object == "terrain",
+            "{id}: the ground replaces the terrain mesh"
+        );
         for v in &ground[0].vertices {
             assert!(
                 v[0] >= x0 - 1e-3

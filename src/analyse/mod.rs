@@ -6,6 +6,8 @@ pub mod crowds;
 pub mod fences;
 pub mod frontage;
 pub mod gardens;
+pub mod ground;
+pub mod halls;
 pub mod house;
 pub mod kura;
 pub mod obstacles;
@@ -131,9 +133,11 @@ pub fn analyse(
         }
     }
     let t = std::time::Instant::now();
+    halls::plan_halls(data, &mut plan, &edges, catalog, params);
     gardens::plan_gardens(data, &mut plan, catalog, params);
     billboards::plan_billboards(data, &mut plan, catalog, params);
     trees::plant(data, &mut plan, catalog, params);
+    ground::plan_ground(data, &mut plan, params);
     plan.billboards_time = t.elapsed();
     if off_dem > 0 {
         if let Some(dem) = &data.dem {

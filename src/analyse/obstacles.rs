@@ -79,7 +79,8 @@ impl Obstacles {
         }
     }
 
-    /// Everything `plan` builds so far: houses, kura, fences and gates, and rock gardens.
+    /// Everything `plan` builds so far: houses, kura, fences and gates, halls and rock
+    /// gardens.
     pub fn of_plan(plan: &crate::model::Plan, catalog: &Catalog, params: &Params) -> Obstacles {
         Obstacles::new(
             plan.houses.values().flatten(),
@@ -87,17 +88,20 @@ impl Obstacles {
             catalog,
             params,
         )
-        .with_gardens(plan.gardens.values().flatten())
+        .with_areas(
+            plan.halls
+                .values()
+                .flatten()
+                .map(|h| h.outline())
+                .chain(plan.gardens.values().flatten().map(|g| g.outline())),
+        )
     }
 
-    /// The same with the plan's rock gardens as obstacles too: trees and people keep out.
-    pub fn with_gardens<'a>(
-        mut self,
-        gardens: impl Iterator<Item = &'a crate::model::PlannedGarden>,
-    ) -> Obstacles {
+    /// The same with more rectangles (halls' plots, rock gardens) as obstacles too: gardens,
+    /// trees and people keep out.
+    pub fn with_areas(mut self, areas: impl Iterator<Item = Vec<Coord<f64>>>) -> Obstacles {
         let mut added = false;
-        for g in gardens {
-            let mut ring = g.outline();
+        for mut ring in areas {
             ring.push(ring[0]);
             self.items
                 .push(Obstacle::Rect(Polygon::new(ring.into(), vec![])));

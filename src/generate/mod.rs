@@ -8,6 +8,8 @@ pub mod clip;
 pub mod envelope;
 pub mod fences;
 pub mod garden;
+pub mod ground;
+pub mod halls;
 pub mod instance;
 pub mod kura;
 pub mod machiya;
@@ -59,6 +61,10 @@ pub struct TilePlan<'a> {
     pub billboards: &'a [PlannedBillboard],
     /// The tile's rock gardens.
     pub gardens: &'a [crate::model::PlannedGarden],
+    /// The tile's halls.
+    pub halls: &'a [crate::model::PlannedHall],
+    /// What the tile's ground is cut from, when `[ground]` is on.
+    pub surface: Option<&'a crate::model::PlannedGround>,
     /// The DEM, the tile's id and its bounds, when the terrain is to be written.
     pub ground: Option<(&'a crate::model::dem::Dem, &'a str, [f64; 4])>,
 }
@@ -71,6 +77,8 @@ impl<'a> TilePlan<'a> {
             fences: plan.fences.get(id).map_or(&[][..], Vec::as_slice),
             billboards: plan.billboards.get(id).map_or(&[][..], Vec::as_slice),
             gardens: plan.gardens.get(id).map_or(&[][..], Vec::as_slice),
+            halls: plan.halls.get(id).map_or(&[][..], Vec::as_slice),
+            surface: plan.grounds.get(id),
             ground: None,
         }
     }
@@ -169,6 +177,7 @@ pub fn generate_tile(
             Err(reason) => out.stats.skipped.push(skip(format!("its kura: {reason}"))),
         }
     }
+    build_halls(tile.halls, catalog, params, frame, files, &mut out);
     build_fences(tile.fences, catalog, params, frame, files, &mut out);
     let people_and_trees = billboards::build(
         tile.billboards,
@@ -183,15 +192,58 @@ pub fn generate_tile(
         out.meshes.extend(garden::planned(g, params.seed, frame));
         out.stats.gardens += 1;
     }
-    if let Some((dem, id, bounds)) = tile.ground {
-        out.meshes.extend(terrain::terrain_mesh(
-            format!("terrain_{id}"),
-            dem,
-            bounds,
-            frame,
-        ));
+    let dem = tile.ground.map(|g| g.0);
+    match tile.surface {
+        // The ground drapes the DEM itself: no separate terrain mesh under it.
+        Some(surface) => {
+            let (ground, streets) = ground::tile_ground(surface, &params.ground, dem, frame);
+            out.meshes.push(ground);
+            out.meshes.extend(streets);
+        }
+        None => {
+            if let Some((dem, id, bounds)) = tile.ground {
+                out.meshes.extend(terrain::terrain_mesh(
+                    format!("terrain_{id}"),
+                    dem,
+                    bounds,
+                    frame,
+                ));
+            }
+        }
     }
     out
+}
+
+/// The halls of a tile, each its own object; a hall whose template fails on its plot is
+/// skipped with the reason (the lot keeps its walls).
+fn build_halls(
+    halls: &[crate::model::PlannedHall],
+    catalog: &Catalog,
+    params: &Params,
+    frame: Frame,
+    files: &LayerFiles,
+    out: &mut TileMeshes,
+) {
+    for h in halls {
+        let Some(t) = catalog.get(&h.template) else {
+            continue;
+        };
+        let overrides = catalog.overrides(&t.name, h.district.as_deref());
+        let random = template_random(params.seed, "halls", &format!("{}/{}", h.lot, h.template));
+        match halls::build(h, t, &overrides, &params.machiya, random, frame) {
+            Ok(mesh) => {
+                out.meshes.push(mesh);
+                *out.stats.halls.entry(h.template.clone()).or_default() += 1;
+            }
+            Err(reason) => out.stats.skipped.push(Skipped {
+                layer: "lots".into(),
+                file: files.lots.clone(),
+                id: h.lot.clone(),
+                record: Some(h.record),
+                reason: format!("its {}: {reason}", h.template),
+            }),
+        }
+    }
 }
 
 /// The fences and gates of a tile: a lot's walls in one object, each gate in its own. A

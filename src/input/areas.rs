@@ -1,4 +1,5 @@
-//! The gardens layer: polygons where the user has drawn a rock garden's ground. Every part
+//! The gardens and water layers: polygons where the user has drawn a rock garden's ground,
+//! or a river or pond. Every part
 //! of a multipart record is an area of its own (`<id>-<n>`); a record without a usable
 //! outline is skipped with the reason.
 
@@ -19,19 +20,56 @@ pub(super) fn read_garden_areas(
     target: &Option<Crs>,
     data: &mut Dataset,
 ) -> Result<(), InputError> {
-    let id_field = resolve_field(
+    let mut areas = Vec::new();
+    read_areas(
         &params.layers.gardens.id_field,
-        &o.layer.fields,
-        o.layer.text_encoding,
-    );
+        "the garden's outline",
+        o,
+        target,
+        &mut areas,
+        data,
+    )?;
+    data.gardens = areas;
+    Ok(())
+}
+
+/// Reads every polygon of the water layer into `data.water`.
+pub(super) fn read_water(
+    params: &Params,
+    o: &Opened,
+    target: &Option<Crs>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let mut areas = Vec::new();
+    read_areas(
+        &params.layers.water.id_field,
+        "the water's outline",
+        o,
+        target,
+        &mut areas,
+        data,
+    )?;
+    data.water = areas;
+    Ok(())
+}
+
+/// Every polygon of a layer whose features need only an id, each part an area of its own.
+fn read_areas(
+    id_field: &str,
+    what: &str,
+    o: &Opened,
+    target: &Option<Crs>,
+    out: &mut Vec<GardenArea>,
+    data: &mut Dataset,
+) -> Result<(), InputError> {
+    let id_field = resolve_field(id_field, &o.layer.fields, o.layer.text_encoding);
     let mut seen = HashSet::new();
     for f in &o.layer.features {
         let read =
             polygons_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polygons"))?;
         o.count_winding(read.against_winding);
         if read.polygons.is_empty() {
-            data.skipped
-                .push(super::null_shape(o, f.record, "the garden's outline"));
+            data.skipped.push(super::null_shape(o, f.record, what));
             continue;
         }
         let id = id_field
@@ -49,7 +87,7 @@ pub(super) fn read_garden_areas(
             &mut data.skipped,
         );
         for (id, outline) in parts {
-            data.gardens.push(GardenArea {
+            out.push(GardenArea {
                 id,
                 record: f.record,
                 outline,

@@ -198,6 +198,7 @@ struct Layers {
     people: Option<Opened>,
     trees: Option<Opened>,
     gardens: Option<Opened>,
+    water: Option<Opened>,
     links: Option<Opened>,
 }
 
@@ -236,6 +237,7 @@ impl Layers {
                 &l.gardens.encoding,
                 &d.gardens.file,
             )?,
+            water: role("water", &l.water.file, &l.water.encoding, &d.water.file)?,
             // A table of links is read by its own reader.
             links: match is_table(&links_file(dir, params, d)) {
                 true => None,
@@ -257,6 +259,7 @@ impl Layers {
             &self.people,
             &self.trees,
             &self.gardens,
+            &self.water,
             &self.links,
         ]
         .into_iter()
@@ -276,6 +279,7 @@ impl Layers {
             &mut self.people,
             &mut self.trees,
             &mut self.gardens,
+            &mut self.water,
             &mut self.links,
         ]
         .into_iter()
@@ -417,6 +421,9 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
     }
     if let Some(o) = &layers.gardens {
         areas::read_garden_areas(params, o, &target, &mut data)?;
+    }
+    if let Some(o) = &layers.water {
+        areas::read_water(params, o, &target, &mut data)?;
     }
     if let Some(o) = &layers.links {
         links::read_link_points(&l.links, o, &target, &mut data)?;

@@ -250,6 +250,8 @@ pub struct Dataset {
     pub blocks: Vec<Polygon<f64>>,
     /// The polygons of the gardens layer, each to get a rock garden.
     pub gardens: Vec<GardenArea>,
+    /// Polygons of the water layer (rivers, ponds), each with its id and record.
+    pub water: Vec<GardenArea>,
     /// The links layer's points.
     pub links: Vec<Link>,
     /// Street centrelines with their widths.
@@ -609,6 +611,119 @@ pub struct Plan {
     pub gardens: BTreeMap<TileId, Vec<PlannedGarden>>,
     /// What became of every lot that could have had a garden.
     pub garden_reports: Vec<GardenStat>,
+    /// The halls of estates and temples, per tile (the tile of their plot's centre).
+    pub halls: BTreeMap<TileId, Vec<PlannedHall>>,
+    /// What became of every hall a lot's use asked for.
+    pub hall_reports: Vec<HallStat>,
+    /// The ground of every tile to write (`[ground]`): the surfaces it is cut from.
+    pub grounds: BTreeMap<TileId, PlannedGround>,
+}
+
+/// A hall (a template of kind `hall`: a temple's main hall, gate or pagoda, a samurai's main
+/// house, a court noble's residence) on the plot analysis found for it in an estate or
+/// temple lot, facing the lot's gate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannedHall {
+    /// The lot's id.
+    pub lot: String,
+    /// The lot's record in its layer.
+    pub record: usize,
+    /// The hall template.
+    pub template: String,
+    /// Map point of the plot's (0, 0): the left end of its side facing the gate.
+    pub corner: Coord<f64>,
+    /// Unit vector of the plot's u axis (along the side facing the gate); v is it turned a
+    /// quarter to the left, away from the gate.
+    pub u: Coord<f64>,
+    /// Width (u) and depth (v) of the plot, metres.
+    pub size: [f64; 2],
+    /// Ground elevation.
+    pub ground: f64,
+    /// The lot's district.
+    pub district: Option<String>,
+    /// The tile it is written to.
+    pub tile: TileId,
+}
+
+impl PlannedHall {
+    /// Its object name: `hall_<lot>_<template>`.
+    pub fn object_name(&self) -> String {
+        format!("hall_{}_{}", self.lot, self.template)
+    }
+
+    /// The plot's unit v axis: u turned a quarter to the left.
+    pub fn v(&self) -> Coord<f64> {
+        Coord {
+            x: -self.u.y,
+            y: self.u.x,
+        }
+    }
+
+    /// The plot on the map, counter-clockwise.
+    pub fn outline(&self) -> Vec<Coord<f64>> {
+        let v = self.v();
+        [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+            .iter()
+            .map(|&(a, b)| Coord {
+                x: self.corner.x + a * self.size[0] * self.u.x + b * self.size[1] * v.x,
+                y: self.corner.y + a * self.size[0] * self.u.y + b * self.size[1] * v.y,
+            })
+            .collect()
+    }
+}
+
+/// One hall a lot's use asked for, in the report: placed (with its plot) or not (why).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HallStat {
+    /// The lot's id.
+    pub lot: String,
+    /// The lot's use.
+    #[serde(rename = "use")]
+    pub lot_use: String,
+    /// The hall template.
+    pub template: String,
+    /// Whether it was placed.
+    pub placed: bool,
+    /// Why not, when it was not.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub reason: String,
+    /// Width and depth of its plot, metres (placed halls).
+    #[serde(default)]
+    pub size: [f64; 2],
+}
+
+/// What a tile's ground is cut from: the surfaces near the tile, unclipped, and how high the
+/// ground stands. Generation clips them to `bounds` (see `generate::ground`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlannedGround {
+    /// The tile's square, `[xmin, ymin, xmax, ymax]`.
+    pub bounds: [f64; 4],
+    /// Street surfaces (buffered centrelines) touching the tile.
+    pub streets: Vec<Polygon<f64>>,
+    /// When the streets are the ground between city blocks: the blocks touching the tile.
+    pub blocks: Option<Vec<Polygon<f64>>>,
+    /// Water (rivers, ponds) touching the tile.
+    pub water: Vec<Polygon<f64>>,
+    /// Lots touching the tile, with their use's ground material.
+    pub lots: Vec<(Polygon<f64>, String)>,
+    /// How high the ground stands where there is no DEM.
+    pub height: GroundHeight,
+}
+
+/// The ground's height without a DEM: flat where every lot stands at one elevation, else
+/// interpolated from the lots' own elevations (inverse distance, the nearest few).
+#[derive(Debug, Clone, PartialEq)]
+pub enum GroundHeight {
+    /// One elevation everywhere.
+    Flat(f64),
+    /// Lot centres and their elevations near the tile.
+    Points(Vec<([f64; 2], f64)>),
+}
+
+impl Default for GroundHeight {
+    fn default() -> Self {
+        GroundHeight::Flat(0.0)
+    }
 }
 
 /// A dry rock garden (karesansui 枯山水) planned in a lot (seed 000).
@@ -720,6 +835,12 @@ pub struct TileStats {
     /// Rock gardens built in the tile.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub gardens: usize,
+    /// Halls built in the tile, per template.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub halls: BTreeMap<String, usize>,
+    /// Bytes of the tile's OBJ taken by its ground (objects `ground` and `streets`).
+    #[serde(default, skip_serializing_if = "is_zero_u64")]
+    pub ground_bytes: u64,
     /// Bytes of the tile's OBJ taken by its trees (objects `trees` and `trees_grown`).
     #[serde(default)]
     pub tree_bytes: u64,
@@ -735,5 +856,10 @@ pub struct TileStats {
 
 /// For serde: leave a zero count out.
 fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
+/// For serde: leave a zero byte count out.
+fn is_zero_u64(n: &u64) -> bool {
     *n == 0
 }

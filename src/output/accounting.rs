@@ -78,6 +78,11 @@ pub fn ledgers(data: &Dataset) -> Vec<Ledger> {
                     .iter()
                     .map(|g| (g.record, g.id.as_str()))
                     .collect(),
+                "water" => data
+                    .water
+                    .iter()
+                    .map(|g| (g.record, g.id.as_str()))
+                    .collect(),
                 "links" => data
                     .links
                     .iter()

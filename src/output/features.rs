@@ -44,6 +44,7 @@ const KINDS: &[(&str, &str)] = &[
     ("gate_", "gate"),
     ("garden_", "garden"),
     ("stone_", "stone"),
+    ("hall_", "hall"),
 ];
 
 /// The lookup from names to lots and houses, built once per build.
@@ -89,9 +90,10 @@ impl<'a> Directory<'a> {
             .iter()
             .find_map(|(prefix, kind)| name.strip_prefix(prefix).map(|r| (*kind, r)))
             .unwrap_or((name, ""));
-        // The id inside the name: gates end in `_<edge>`, stones in `_<group>_<role>_<k>`.
+        // The id inside the name: gates end in `_<edge>`, halls in `_<template>`, stones in
+        // `_<group>_<role>_<k>`.
         let id = match kind {
-            "gate" => drop_words(rest, 1),
+            "gate" | "hall" => drop_words(rest, 1),
             "stone" => drop_words(rest, 3),
             _ => rest,
         };
@@ -166,5 +168,9 @@ mod tests {
         assert_eq!(f("trees_grown").lot, "");
         assert_eq!(f("people").kind, "people");
         assert_eq!(f("kura_9").source, "lots.shp");
+        assert_eq!(f("hall_4_2_goju-no-to").kind, "hall");
+        assert_eq!(f("hall_4_2_goju-no-to").lot, "4_2");
+        assert_eq!(f("ground").kind, "ground");
+        assert_eq!(f("streets").source, "");
     }
 }

@@ -185,6 +185,10 @@ pub struct Report {
     /// The rock gardens of temple lots, one entry per lot (placed or skipped, with why).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub gardens: Vec<crate::model::GardenStat>,
+    /// The halls of estates and temples, one entry per hall a lot's use asked for (placed
+    /// with its plot, or not with why).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub halls: Vec<crate::model::HallStat>,
     /// Trees of a species: by species and how each was drawn, and bytes of tree geometry per
     /// tile (absent when no tree has a species).
     #[serde(skip_serializing_if = "TreesReport::is_empty")]
@@ -295,6 +299,12 @@ pub struct TileReport {
     pub glb_bytes: u64,
     /// Of the OBJ's, bytes of its trees.
     pub tree_bytes: u64,
+    /// Of the OBJ's, bytes of its ground (objects `ground` and `streets`).
+    #[serde(default)]
+    pub ground_bytes: u64,
+    /// Its halls, per template.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub halls: std::collections::BTreeMap<String, usize>,
 }
 
 /// The part of the report that comes from reading and analysis, the same for every tile.
@@ -333,6 +343,9 @@ pub struct InputSummary {
     /// Every lot that could have had a rock garden: placed or skipped with why.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub gardens: Vec<crate::model::GardenStat>,
+    /// Every hall a lot's use asked for: placed or not with why.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub halls: Vec<crate::model::HallStat>,
 }
 
 /// manifest.json, written last: what the build is (tool, parameters, input, frame) and
@@ -497,6 +510,8 @@ pub fn assemble_report(m: &Manifest) -> Report {
             obj_bytes: t.obj.as_ref().map_or(0, |f| f.bytes),
             glb_bytes: t.glb.as_ref().map_or(0, |f| f.bytes),
             tree_bytes: s.tree_bytes,
+            ground_bytes: s.ground_bytes,
+            halls: s.halls.clone(),
         });
         for (species, lods) in &s.trees_by_species {
             add(r.trees.by_species.entry(species.clone()).or_default(), lods);
@@ -525,6 +540,7 @@ pub fn assemble_report(m: &Manifest) -> Report {
     r.accounting = super::accounting::close(&i.ledgers, &r.skipped, &mut r.warnings);
     r.crowds = Crowds::of(&i.crowds);
     r.gardens = i.gardens.clone();
+    r.halls = i.halls.clone();
     for s in &r.skipped {
         *r.skipped_by_reason
             .entry(reason_class(&s.reason))

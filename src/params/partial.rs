@@ -26,6 +26,8 @@ pub struct Params {
     trees: Option<super::billboards::partial::Trees>,
     crowd: Option<super::crowd::partial::Crowd>,
     garden: Option<super::garden::partial::Garden>,
+    halls: Option<super::halls::partial::Halls>,
+    ground: Option<super::halls::partial::Ground>,
     output: Option<super::output::partial::Output>,
     origin_lonlat: Option<[f64; 3]>,
     type_mix: Option<BTreeMap<String, f64>>,
@@ -61,6 +63,7 @@ struct Layers {
     people: Option<super::billboards::partial::PointsLayer>,
     trees: Option<super::billboards::partial::PointsLayer>,
     gardens: Option<FencesLayer>,
+    water: Option<FencesLayer>,
     links: Option<LinksLayer>,
     dem: Option<DemLayer>,
 }
