@@ -101,3 +101,17 @@ for i in $(seq 1 "$RUNS"); do
   end=$(date +%s.%N)
   printf 'no gardens run %d: %.2f s\n' "$i" "$(echo "$end - $start" | bc -l)"
 done
+
+echo "== ground and halls (30,052 lots, ground and halls off against the default runs above)"
+printf '[ground]\nenabled = false\n[halls]\nenabled = false\n' > "$work/bare.toml"
+for i in $(seq 1 "$RUNS"); do
+  start=$(date +%s.%N)
+  $bin build "$work/town-30052" --out "$work/out-bare" --params "$work/bare.toml" --quiet --force
+  end=$(date +%s.%N)
+  printf 'no ground, no halls run %d: %.2f s\n' "$i" "$(echo "$end - $start" | bc -l)"
+done
+python3 -c "
+import json, collections; r = json.load(open('$work/out-30052/report.json')); t = r['tiles']
+g = [x['ground_bytes'] for x in t]
+print('ground bytes per tile (OBJ): mean', round(sum(g) / len(g)), 'max', max(g), '| of the tiles', round(100 * sum(g) / sum(x['obj_bytes'] for x in t), 2), '%')
+print('halls:', dict(collections.Counter((h['template'], 'placed' if h['placed'] else 'skipped') for h in r.get('halls', []))))"

@@ -32,7 +32,7 @@ fn kyoto_small_builds_and_every_tile_rereads_cleanly() {
     assert_eq!(report["counts"]["tiles"], tiles.len());
     assert!(tiles.len() >= 2, "the fixture spans several tiles");
     let mut names = BTreeSet::new();
-    let (mut kura, mut fences, mut garden) = (0, 0, 0);
+    let (mut kura, mut fences, mut garden, mut halls) = (0, 0, 0, 0);
     for tile in tiles {
         let obj = out.path().join(tile["obj"]["path"].as_str().unwrap());
         for o in load_tile(&obj, origin) {
@@ -57,6 +57,7 @@ fn kyoto_small_builds_and_every_tile_rereads_cleanly() {
             kura += is_kura as usize;
             fences += (kind == "fence") as usize;
             garden += (kind == "garden" || kind == "stone") as usize;
+            halls += (kind == "hall") as usize;
             let (lot_use, _, poly) = lots.get(id).unwrap_or_else(|| panic!("no lot {id}"));
             match kind {
                 "machiya" | "kura" => assert_eq!(lot_use, "machiya"),
@@ -97,7 +98,11 @@ fn kyoto_small_builds_and_every_tile_rereads_cleanly() {
         "the temple lot's rock garden: its bed and 15 stones"
     );
     assert_eq!(
-        names.len() - kura - fences - garden,
+        halls, 4,
+        "the samurai lot's omoya, the temple's hondo, sanmon and pagoda"
+    );
+    assert_eq!(
+        names.len() - kura - fences - garden - halls,
         machiya_lots,
         "one machiya_* object per machiya lot"
     );

@@ -5,6 +5,7 @@
 //! tiles of a town put together are one continuous ground. Generation does the cutting, tile
 //! by tile (`generate::ground`).
 
+use geo::algorithm::buffer::{BufferStyle, LineCap, LineJoin};
 use geo::{BoundingRect, Buffer, Centroid};
 use geo_types::Polygon;
 use rayon::prelude::*;
@@ -17,6 +18,10 @@ use crate::params::Params;
 
 /// The most tiles one lot may add (a lot larger than this many tiles is damaged data).
 const MAX_TILES_A_LOT: i64 = 400;
+/// The angle each straight piece of a street's round end or bend turns, radians: about six
+/// pieces a half circle, within 10 cm of the circle on a 6 m street (geo's default, 0.2,
+/// gave a Chino tile 480 KB of ground).
+const ROUND_STEP: f64 = 0.5;
 /// How far around a tile the lots its height is interpolated from are gathered, metres.
 const HEIGHT_REACH: f64 = 200.0;
 
@@ -88,7 +93,12 @@ pub fn plan_ground(data: &Dataset, plan: &mut Plan, params: &Params) {
     } else {
         data.streets
             .par_iter()
-            .flat_map_iter(|s| s.line.buffer(s.width / 2.0).0)
+            .flat_map_iter(|s| {
+                let style = BufferStyle::new(s.width / 2.0)
+                    .line_cap(LineCap::Round(ROUND_STEP))
+                    .line_join(LineJoin::Round(ROUND_STEP));
+                s.line.buffer_with_style(style).0
+            })
             .collect()
     };
     let street_index = index(streets.iter());

@@ -36,6 +36,8 @@ pub const SKIPPED: [u8; 3] = [220, 90, 80];
 pub const OTHER_USE: [u8; 3] = [200, 215, 190];
 /// The frontage Fig.4 chose for each house.
 pub const FRONTAGE: [u8; 3] = [200, 30, 30];
+/// Halls of estates and temples: a temple's lacquer red.
+pub const HALL: [u8; 3] = [178, 58, 42];
 /// Kura built.
 pub const KURA: [u8; 3] = [70, 70, 78];
 /// Walls.
@@ -171,6 +173,7 @@ pub fn draw_plan(
     draw_lots_and_houses(&mut pm, view, data, plan, &colours);
     let refused_any = kura.is_some_and(|avoid| draw_kura(&mut pm, view, plan, avoid));
     let any_fence = draw_fences(&mut pm, view, plan);
+    let any_hall = draw_halls(&mut pm, view, plan);
     let any_billboard = draw_billboards(&mut pm, view, plan);
     draw_lines_on_top(&mut pm, view, data, plan);
     draw_tile_grid(&mut pm, view, plan, tile_grid);
@@ -185,6 +188,7 @@ pub fn draw_plan(
         !data.footprints.is_empty(),
         kura_rows,
         any_fence,
+        any_hall,
         any_billboard,
     );
     encode_png(&pm)
@@ -288,6 +292,26 @@ fn draw_kura(pm: &mut Pixmap, view: &View, plan: &Plan, avoid: bool) -> bool {
         }
     }
     refused_any
+}
+
+/// The halls' plots, filled (whether there was any).
+fn draw_halls(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
+    let mut any = false;
+    for h in plan.halls.values().flatten() {
+        let ring = h.outline();
+        let Some(path) = line_path(view, &[ring[0], ring[1], ring[2], ring[3], ring[0]]) else {
+            continue;
+        };
+        pm.fill_path(
+            &path,
+            &paint(HALL, 255),
+            FillRule::EvenOdd,
+            Transform::identity(),
+            None,
+        );
+        any = true;
+    }
+    any
 }
 
 /// Walls and gates (section 4.3): a dark line along each wall segment, a red bar per gate;
@@ -462,6 +486,7 @@ fn draw_legend(
     footprints: bool,
     kura_rows: usize,
     fences: bool,
+    halls: bool,
     billboards: bool,
 ) {
     let mut rows: Vec<(String, [u8; 3])> = colours.iter().map(|(t, c)| (t.clone(), *c)).collect();
@@ -480,6 +505,9 @@ fn draw_legend(
     if fences {
         rows.push(("wall".into(), FENCE));
         rows.push(("gate".into(), GATE));
+    }
+    if halls {
+        rows.push(("hall".into(), HALL));
     }
     if billboards {
         rows.push(("tree".into(), TREE));
