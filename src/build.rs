@@ -453,30 +453,23 @@ fn write_city(
                 }
                 write_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
                 progress.inc(1);
-                // The bytes the trees' objects take in the OBJ, exactly.
-                let is_tree = |m: &Mesh| m.name == "trees" || m.name == "trees_grown";
-                meshes.stats.tree_bytes = match &mesh_bytes {
-                    Some(sizes) => meshes
-                        .meshes
-                        .iter()
-                        .zip(sizes)
-                        .filter(|(m, _)| is_tree(m))
-                        .map(|(_, &n)| n as u64)
-                        .sum(),
-                    None => output::obj_bytes(meshes.meshes.iter().filter(|m| is_tree(m))) as u64,
+                // The bytes the trees' and the ground's objects take in the OBJ, exactly (the
+                // OBJ writer's count when it wrote one).
+                let bytes_of = |names: [&str; 2]| -> u64 {
+                    let of = |m: &Mesh| names.contains(&m.name.as_str());
+                    match &mesh_bytes {
+                        Some(sizes) => meshes
+                            .meshes
+                            .iter()
+                            .zip(sizes)
+                            .filter(|(m, _)| of(m))
+                            .map(|(_, &n)| n as u64)
+                            .sum(),
+                        None => output::obj_bytes(meshes.meshes.iter().filter(|m| of(m))) as u64,
+                    }
                 };
-                // And the ground's (the OBJ writer's count when it wrote one).
-                let is_ground = |m: &Mesh| m.name == "ground" || m.name == "streets";
-                meshes.stats.ground_bytes = match &mesh_bytes {
-                    Some(sizes) => meshes
-                        .meshes
-                        .iter()
-                        .zip(sizes)
-                        .filter(|(m, _)| is_ground(m))
-                        .map(|(_, &n)| n as u64)
-                        .sum(),
-                    None => output::obj_bytes(meshes.meshes.iter().filter(|m| is_ground(m))) as u64,
-                };
+                meshes.stats.tree_bytes = bytes_of(["trees", "trees_grown"]);
+                meshes.stats.ground_bytes = bytes_of(["ground", "streets"]);
                 entry.stats = meshes.stats;
                 Ok(entry)
             })

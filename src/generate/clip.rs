@@ -164,6 +164,12 @@ fn clip_boolean(poly: &LocalPoly, lo: f64, hi: f64) -> Vec<LocalPoly> {
         },
     )
     .to_polygon();
+    local_polys(geo_poly.intersection(&band))
+}
+
+/// The polygons of a boolean operation's result in the frame's ring convention (exterior
+/// counter-clockwise, holes clockwise), without slivers.
+pub fn local_polys(mp: geo_types::MultiPolygon<f64>) -> Vec<LocalPoly> {
     let ring_of = |ls: &LineString<f64>, ccw: bool| {
         let mut r: LocalRing = crate::geom::ring::open(ls)
             .iter()
@@ -175,10 +181,7 @@ fn clip_boolean(poly: &LocalPoly, lo: f64, hi: f64) -> Vec<LocalPoly> {
         let r = dedup(r);
         (r.len() >= 3 && area(&r).abs() > 1e-9).then_some(r)
     };
-    geo_poly
-        .intersection(&band)
-        .0
-        .into_iter()
+    mp.0.into_iter()
         .filter_map(|p| {
             let exterior = ring_of(p.exterior(), true)?;
             let holes = p

@@ -12,7 +12,7 @@
 use geo::BooleanOps;
 use geo_types::{Coord, LineString, Polygon};
 
-use super::clip::{area, dedup, is_convex, LocalPoly, LocalRing};
+use super::clip::{area, dedup, is_convex, local_polys, LocalPoly, LocalRing};
 
 /// A plane over the site's (u, v): `h = a + b u + c v`.
 pub type Plane = [f64; 3];
@@ -197,30 +197,7 @@ fn clip_boolean(poly: &LocalPoly, n: [f64; 2], c: f64) -> Vec<LocalPoly> {
         to_ls(&poly.exterior),
         poly.holes.iter().map(to_ls).collect(),
     );
-    let ring_of = |ls: &LineString<f64>, ccw: bool| {
-        let mut r: LocalRing = crate::geom::ring::open(ls)
-            .iter()
-            .map(|c| [c.x, c.y])
-            .collect();
-        if (area(&r) > 0.0) != ccw {
-            r.reverse();
-        }
-        let r = dedup(r);
-        (r.len() >= 3 && area(&r).abs() > 1e-9).then_some(r)
-    };
-    gp.intersection(&half)
-        .0
-        .into_iter()
-        .filter_map(|p| {
-            let exterior = ring_of(p.exterior(), true)?;
-            let holes = p
-                .interiors()
-                .iter()
-                .filter_map(|h| ring_of(h, false))
-                .collect();
-            Some(LocalPoly { exterior, holes })
-        })
-        .collect()
+    local_polys(gp.intersection(&half))
 }
 
 /// Inserts into every ring edge the vertices of the other regions that lie on it (within

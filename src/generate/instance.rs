@@ -193,15 +193,7 @@ fn prism(cx: &PartCx, p: &Prism, frame: Frame, mesh: &mut Mesh) -> Result<(), St
         return Ok(());
     }
     check_heights(cx, p, &pieces)?;
-    let front_v = if p.v0.is_some() {
-        v0
-    } else {
-        pieces
-            .iter()
-            .flat_map(|x| &x.exterior)
-            .map(|q| q[1])
-            .fold(f64::INFINITY, f64::min)
-    };
+    let front_v = front_line(p, v0, &pieces);
     let dress = dress_of(cx, p, front_v)?;
     let (g, slope) = (cx.site.ground, cx.site.slope);
     let top = |q: [f64; 2]| g + slope * q[0] + cx.at(&p.top, q);
@@ -218,6 +210,18 @@ fn prism(cx: &PartCx, p: &Prism, frame: Frame, mesh: &mut Mesh) -> Result<(), St
         g,
     );
     Ok(())
+}
+
+/// The part's front line: its `v0`, else the front of its pieces.
+fn front_line(p: &Prism, v0: f64, pieces: &[LocalPoly]) -> f64 {
+    if p.v0.is_some() {
+        return v0;
+    }
+    pieces
+        .iter()
+        .flat_map(|x| &x.exterior)
+        .map(|q| q[1])
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// How a part's walls and faces are dressed: its materials, and the facade on its front line
@@ -283,15 +287,7 @@ fn roof_prism(
             ));
         }
     }
-    let front_v = if p.v0.is_some() {
-        v0
-    } else {
-        pieces
-            .iter()
-            .flat_map(|x| &x.exterior)
-            .map(|q| q[1])
-            .fold(f64::INFINITY, f64::min)
-    };
+    let front_v = front_line(p, v0, pieces);
     let dress = dress_of(cx, p, front_v)?;
     // An edge two regions share (run both ways) is inside the roof: no wall there.
     let key = |q: [f64; 2]| ((q[0] * 1e4).round() as i64, (q[1] * 1e4).round() as i64);

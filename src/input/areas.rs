@@ -20,16 +20,13 @@ pub(super) fn read_garden_areas(
     target: &Option<Crs>,
     data: &mut Dataset,
 ) -> Result<(), InputError> {
-    let mut areas = Vec::new();
-    read_areas(
+    data.gardens = read_areas(
         &params.layers.gardens.id_field,
         "the garden's outline",
         o,
         target,
-        &mut areas,
         data,
     )?;
-    data.gardens = areas;
     Ok(())
 }
 
@@ -40,16 +37,13 @@ pub(super) fn read_water(
     target: &Option<Crs>,
     data: &mut Dataset,
 ) -> Result<(), InputError> {
-    let mut areas = Vec::new();
-    read_areas(
+    data.water = read_areas(
         &params.layers.water.id_field,
         "the water's outline",
         o,
         target,
-        &mut areas,
         data,
     )?;
-    data.water = areas;
     Ok(())
 }
 
@@ -59,9 +53,9 @@ fn read_areas(
     what: &str,
     o: &Opened,
     target: &Option<Crs>,
-    out: &mut Vec<GardenArea>,
     data: &mut Dataset,
-) -> Result<(), InputError> {
+) -> Result<Vec<GardenArea>, InputError> {
+    let mut out = Vec::new();
     let id_field = resolve_field(id_field, &o.layer.fields, o.layer.text_encoding);
     let mut seen = HashSet::new();
     for f in &o.layer.features {
@@ -94,5 +88,5 @@ fn read_areas(
             });
         }
     }
-    Ok(())
+    Ok(out)
 }
