@@ -332,7 +332,7 @@ fn a_lot_too_small_for_its_halls_is_reported_with_why_and_a_use_without_halls_st
     )
     .unwrap();
     let out = dir.path().join("out");
-    build_ok(
+    let run = common::build_cmd(
         &fixture("kyoto-small"),
         &out,
         &[
@@ -342,6 +342,15 @@ fn a_lot_too_small_for_its_halls_is_reported_with_why_and_a_use_without_halls_st
             "--params",
             params.to_str().unwrap(),
         ],
+    )
+    .output()
+    .unwrap();
+    assert!(run.status.success());
+    // The summary counts the halls and those without room.
+    let said = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        said.contains("; 1 without room, see report.json halls"),
+        "{said}"
     );
     let report = read_json(&out.join("report.json"));
     let halls = report["halls"].as_array().unwrap();

@@ -166,6 +166,7 @@ pub fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<(
         );
     }
     print_billboards(r)?;
+    print_halls(r)?;
     say!(
         "  tiles      {:>7}  ({} written now, {:.1} MB)",
         c.tiles,
@@ -202,6 +203,34 @@ pub fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<(
     {
         say!("  in a browser: edo-city serve {}", opts.out.display());
     }
+    Ok(())
+}
+
+/// Halls: how many of each template were placed, and how many found no room (report.json's
+/// `halls` says which and why).
+fn print_halls(r: &edo_city::output::report::Report) -> std::io::Result<()> {
+    if r.halls.is_empty() {
+        return Ok(());
+    }
+    let mut placed: std::collections::BTreeMap<&str, usize> = Default::default();
+    for h in r.halls.iter().filter(|h| h.placed) {
+        *placed.entry(h.template.as_str()).or_default() += 1;
+    }
+    let without = r.halls.iter().filter(|h| !h.placed).count();
+    say!(
+        "  halls      {:>7}  ({}{})",
+        placed.values().sum::<usize>(),
+        placed
+            .iter()
+            .map(|(t, n)| format!("{t} {n}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        if without > 0 {
+            format!("; {without} without room, see report.json halls")
+        } else {
+            String::new()
+        }
+    );
     Ok(())
 }
 
