@@ -111,5 +111,11 @@ fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
     let out: serde_json::Value = serde_json::from_str(last).unwrap();
     assert_eq!(out["clicked"]["lot"], lot, "{text}");
     assert_eq!(out["clicked"]["kind"], "machiya");
+    // Walking stands the eye 1.6 m over the tiles' ground.
+    let (g, eye) = (
+        out["walk"]["ground"].as_f64().unwrap(),
+        out["walk"]["eye"].as_f64().unwrap(),
+    );
+    assert!((eye - g - 1.6).abs() < 0.05, "{text}");
     assert_eq!(out["hypotheses"], serde_json::json!(["edo", "other-seed"]));
 }

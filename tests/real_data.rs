@@ -40,6 +40,10 @@ fn example(name: &str) -> String {
 fn build_example(set: &str, name: &str, out: &Path) -> Option<serde_json::Value> {
     let dir = real(set)?;
     let r = build_ok(&dir, out, &["--quiet", "--params", &example(name)]);
+    // Every tile has its ground, real parcels and roads included.
+    for t in r["tiles"].as_array().unwrap() {
+        assert!(t["ground_bytes"].as_u64().unwrap() > 0, "{set}: {t}");
+    }
     // Every record of every layer is built or listed as skipped.
     for a in r["accounting"].as_array().unwrap() {
         assert_eq!(a["unaccounted"], 0, "{set}: {a}");

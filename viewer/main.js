@@ -29,6 +29,7 @@ const api = (window.edoCity = {
   camera: () => ({ position: camera.position.toArray(), target: controls.target.toArray() }),
   screenOf: (east, north, up) => screenOf(east, north, up),
   sample: () => sample(),
+  groundAt: (x, z) => groundAt({ x, z }),
   setSplit: (on) => setSplit(on),
 });
 
@@ -83,14 +84,23 @@ function city(k) {
   tiles.group.matrixAutoUpdate = false;
   tiles.group.matrix.copy(placement);
   tiles.group.matrixWorldNeedsUpdate = true;
-  const c = { tiles, models: new Set(), links: null, loaded: false };
+  const c = { tiles, models: new Set(), grounds: new Map(), links: null, loaded: false };
   tiles.addEventListener('load-model', ({ scene: model, tile }) => {
     // Each node of a tile is one object kind (machiya, kura, fence, people, ...): its
     // glTF extras, which three.js puts in userData.kind.
     applyToggles(model);
     c.models.add(tile);
+    // The tile's ground and streets, which walking stands on.
+    const under = [];
+    model.traverse((o) => {
+      if (o.userData.kind === 'ground' || o.userData.kind === 'streets') {
+        o.traverse((m) => { if (m.isMesh) under.push(m); });
+      }
+    });
+    c.grounds.set(tile, under);
     if (k === api.current) api.tiles = c.models.size;
   });
+  tiles.addEventListener('dispose-model', ({ tile }) => c.grounds.delete(tile));
   tiles.addEventListener('load-error', ({ url, error }) => {
     api.errors.push(`${url}: ${error}`);
     console.error('tile failed to load', url, error);
@@ -265,8 +275,19 @@ function render() {
   renderer.setScissorTest(false);
 }
 
-// Walking: eye height above the city's zero, W/S or arrows forward and back, A/D turn.
+// Walking: eye height above the ground (the tiles' ground and streets, else the city's
+// zero), W/S or arrows forward and back, A/D turn.
 const keys = new Set();
+const down = new THREE.Raycaster();
+/** The ground's height under (x, z) in the viewer's frame, or null off the loaded ground. */
+function groundAt(position) {
+  const c = cities[api.current];
+  const meshes = c ? [...c.grounds.values()].flat() : [];
+  if (!meshes.length) return null;
+  down.set(new THREE.Vector3(position.x, 10000, position.z), new THREE.Vector3(0, -1, 0));
+  const hit = down.intersectObjects(meshes, false)[0];
+  return hit ? hit.point.y : null;
+}
 function walkStep(dt) {
   if (!walking) return;
   const dir = new THREE.Vector3();
@@ -278,7 +299,7 @@ function walkStep(dt) {
   if (keys.has('s') || keys.has('arrowdown')) camera.position.addScaledVector(dir, -speed);
   const turn = (keys.has('a') || keys.has('arrowleft') ? 1 : 0) - (keys.has('d') || keys.has('arrowright') ? 1 : 0);
   if (turn) camera.rotateOnWorldAxis(new THREE.Vector3(0, 1, 0), turn * 1.5 * dt);
-  camera.position.y = EYE;
+  camera.position.y = (groundAt(camera.position) ?? 0) + EYE;
 }
 
 function toggleWalk() {
@@ -286,8 +307,9 @@ function toggleWalk() {
   controls.enabled = !walking;
   if (walking) {
     const t = controls.target.clone();
-    camera.position.set(t.x, EYE, t.z + 20);
-    camera.lookAt(t.x, EYE, t.z);
+    camera.position.set(t.x, 0, t.z + 20);
+    camera.position.y = (groundAt(camera.position) ?? 0) + EYE;
+    camera.lookAt(t.x, camera.position.y, t.z);
   } else {
     controls.target.set(camera.position.x, 0, camera.position.z - 40);
     camera.position.y = 120;

@@ -119,6 +119,19 @@ try {
   out.street = street;
   if (street.white < street.pixels * 0.01) fail(`too few plaster-white pixels: ${street.white}`);
 
+  // The ground is under the camera's target, and walking (K) stands the eye on it.
+  const target = (await cam()).target;
+  const ground = await page.evaluate((t) => window.edoCity.groundAt(t[0], t[2]), target);
+  if (typeof ground !== 'number') fail(`no ground under the camera's target ${JSON.stringify(target)}`);
+  await page.keyboard.press('k');
+  await page.waitForTimeout(300);
+  const eye = (await cam()).position;
+  const under = await page.evaluate((p) => window.edoCity.groundAt(p[0], p[2]), eye);
+  if (typeof under !== 'number' || Math.abs(eye[1] - under - 1.6) > 0.05) fail(`walking: eye at ${eye[1]} over ground ${under}`);
+  out.walk = { ground: under, eye: eye[1] };
+  await page.keyboard.press('k');
+  await page.waitForTimeout(300);
+
   // A link marker: clicking it names its page (the test does not follow it: no network).
   const links = await page.evaluate(async () => {
     const h = window.edoCity.hypotheses[0];
