@@ -383,3 +383,64 @@ fn a_hall_use_naming_no_hall_template_stops_the_build() {
     assert!(err.contains("hondo"), "{err}");
     assert!(!out.exists());
 }
+
+#[test]
+fn a_temples_garden_faces_its_main_hall_and_keeps_clear_of_every_hall() {
+    let dir = tempfile::tempdir().unwrap();
+    common::synth(dir.path(), 3000, 4);
+    let params = edo_city::params::Params::default();
+    let data = edo_city::input::read_dataset(dir.path(), &params).expect("reads");
+    let catalog = edo_city::templates::Catalog::load(None).unwrap();
+    let plan = edo_city::analyse::analyse(&data, &params, &catalog, "lots.shp", &|_| {});
+    let halls: Vec<_> = plan.halls.values().flatten().collect();
+    let mut faced = 0;
+    for g in plan.gardens.values().flatten() {
+        let ring = g.outline();
+        // No corner or side midpoint of the garden lies in a hall's plot.
+        for h in &halls {
+            let plot = geo_types::Polygon::new(
+                h.outline().into_iter().chain([h.outline()[0]]).collect(),
+                vec![],
+            );
+            for k in 0..4 {
+                let (a, b) = (ring[k], ring[(k + 1) % 4]);
+                for p in [
+                    a,
+                    geo_types::Coord {
+                        x: (a.x + b.x) / 2.0,
+                        y: (a.y + b.y) / 2.0,
+                    },
+                ] {
+                    assert!(
+                        !plot.contains(&geo::Point(p)),
+                        "garden {} in hall {}",
+                        g.lot,
+                        h.template
+                    );
+                }
+            }
+        }
+        let Some(hondo) = halls
+            .iter()
+            .find(|h| h.lot == g.lot && h.template == "hondo")
+        else {
+            continue;
+        };
+        // The viewing side (ring[0] -> ring[1]) is nearer the hall than the far side.
+        let p = hondo.outline();
+        let c = geo_types::Coord {
+            x: (p[0].x + p[2].x) / 2.0,
+            y: (p[0].y + p[2].y) / 2.0,
+        };
+        let mid = |a: geo_types::Coord<f64>, b: geo_types::Coord<f64>| {
+            ((a.x + b.x) / 2.0 - c.x).hypot((a.y + b.y) / 2.0 - c.y)
+        };
+        assert!(
+            mid(ring[0], ring[1]) < mid(ring[2], ring[3]),
+            "garden {}",
+            g.lot
+        );
+        faced += 1;
+    }
+    assert!(faced > 0, "some temple has both a hondo and a garden");
+}

@@ -7,7 +7,10 @@
 //! The polygons of the gardens layer (`layers.gardens`) get a garden each, whatever their
 //! lot's use, in the same way inside their own outline (keyed `area-<id>`, viewpoint the gate
 //! of the lot holding the polygon's centre); a lot holding one gets no second garden.
-//! Runs before the billboards, which keep out of the gardens.
+//! Where a lot has its main hall (the first its use lists in `halls.uses`, planned before the
+//! gardens), the garden faces the hall instead of the gate: a temple's garden is seen from its
+//! hall's veranda, as Ryoanji's from its hojo. Runs before the billboards, which keep out of
+//! the gardens.
 
 use std::collections::{HashMap, HashSet};
 
@@ -52,8 +55,27 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: 
     }
     // No garden is planned yet: the plan's houses, kura, fences and gates.
     let obstacles = Obstacles::of_plan(plan, catalog, params);
-    // A lot's first gate is its viewpoint.
+    // A lot's viewpoint: the middle of its first hall (a temple's main hall, whose veranda
+    // a garden is seen from, as Ryoanji's from its hojo), else its first gate.
     let mut gates: HashMap<&str, Coord<f64>> = HashMap::new();
+    // The main hall is the first its lot's use lists, when it was placed.
+    let mut main: HashMap<&str, &str> = HashMap::new();
+    for r in &plan.hall_reports {
+        main.entry(r.lot.as_str())
+            .or_insert(if r.placed { r.template.as_str() } else { "" });
+    }
+    let main_halls = plan
+        .halls
+        .values()
+        .flatten()
+        .filter(|h| main.get(h.lot.as_str()) == Some(&h.template.as_str()));
+    for h in main_halls {
+        let ring = h.outline();
+        gates.entry(h.lot.as_str()).or_insert(Coord {
+            x: (ring[0].x + ring[2].x) / 2.0,
+            y: (ring[0].y + ring[2].y) / 2.0,
+        });
+    }
     for f in plan.fences.values().flatten() {
         if f.kind == FenceKind::Gate {
             gates.entry(f.id.as_str()).or_insert(Coord {
