@@ -24,6 +24,8 @@ use crate::templates::{Catalog, Kind, Template};
 const SHRINK: f64 = 0.9;
 /// The widest lot searched, metres: a larger one is damaged data.
 const MAX_LOT: f64 = 5000.0;
+/// The most positions tried across a lot, each way, for one plot size.
+const MAX_STEPS: f64 = 150.0;
 
 /// Plans the halls of every lot into `plan.halls` and reports each in `plan.hall_reports`.
 pub fn plan_halls(
@@ -299,7 +301,11 @@ fn find(
         // Sample the plot every 2 m or less: with the clearance, nothing between samples
         // can be missed but a wall thinner than the gap, and walls count half a metre more.
         let (nx, ny) = ((w / 2.0).ceil() as usize + 1, (d / 2.0).ceil() as usize + 1);
-        let step = (w.min(d) / 6.0).max(0.5);
+        // A sixth of the plot, and never more than 150 steps across the lot: a precinct a
+        // kilometre wide is searched in seconds, not minutes.
+        let step = (w.min(d) / 6.0)
+            .max(0.5)
+            .max((u1 - u0).max(v1 - v0) / MAX_STEPS);
         // Across: centred on the gate's axis (u = 0) first, then alternately either side.
         let mut us: Vec<f64> = Vec::new();
         let (lo, hi) = (u0, u1 - w);
