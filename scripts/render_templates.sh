@@ -27,7 +27,7 @@ render tree 1 1 -8,4,15 0,3.4,0
 render person 1 1 -1.5,1.5,3 0,0.8,0
 # Halls on the plots they ask for (u east, v north: the gate side faces the camera).
 render hondo 24 18 -12,14,16 12,4,-9
-render sanmon 14 8 -7,9,11 7,4.5,-4
+render sanmon 14 8 -13,13,19 7,5,-4
 render goju-no-to 13 13 -32,18,44 6.5,14,-6.5
 render omoya 22 18 -18,16,22 11,3,-9
 render shinden 38 28 -18,24,26 19,3,-14
