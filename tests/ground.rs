@@ -427,11 +427,7 @@ fn a_temples_garden_faces_its_main_hall_and_keeps_clear_of_every_hall() {
             continue;
         };
         // The viewing side (ring[0] -> ring[1]) is nearer the hall than the far side.
-        let p = hondo.outline();
-        let c = geo_types::Coord {
-            x: (p[0].x + p[2].x) / 2.0,
-            y: (p[0].y + p[2].y) / 2.0,
-        };
+        let c = hondo.centre();
         let mid = |a: geo_types::Coord<f64>, b: geo_types::Coord<f64>| {
             ((a.x + b.x) / 2.0 - c.x).hypot((a.y + b.y) / 2.0 - c.y)
         };

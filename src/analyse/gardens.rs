@@ -70,11 +70,7 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: 
         .flatten()
         .filter(|h| main.get(h.lot.as_str()) == Some(&h.template.as_str()));
     for h in main_halls {
-        let ring = h.outline();
-        gates.entry(h.lot.as_str()).or_insert(Coord {
-            x: (ring[0].x + ring[2].x) / 2.0,
-            y: (ring[0].y + ring[2].y) / 2.0,
-        });
+        gates.entry(h.lot.as_str()).or_insert(h.centre());
     }
     for f in plan.fences.values().flatten() {
         if f.kind == FenceKind::Gate {

@@ -129,7 +129,7 @@ fn place_lot(
             params.halls.clearance,
         ) {
             Some((corner, size)) => {
-                let hall = PlannedHall {
+                let mut hall = PlannedHall {
                     lot: lot.id.clone(),
                     record: lot.record,
                     template: t.name.clone(),
@@ -140,15 +140,8 @@ fn place_lot(
                     district: lot.district.clone(),
                     tile: String::new(),
                 };
+                hall.tile = tile_id(hall.centre(), params.tile_size, params.tile_origin);
                 let ring = hall.outline();
-                let centre = Coord {
-                    x: (ring[0].x + ring[2].x) / 2.0,
-                    y: (ring[0].y + ring[2].y) / 2.0,
-                };
-                let hall = PlannedHall {
-                    tile: tile_id(centre, params.tile_size, params.tile_origin),
-                    ..hall
-                };
                 placed.push(Polygon::new(
                     ring.iter().chain(&ring[..1]).copied().collect(),
                     vec![],

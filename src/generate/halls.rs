@@ -1,8 +1,6 @@
 //! Hall meshes: a hall template built on the plot analysis found for it, its `v = 0` side
 //! facing the lot's gate.
 
-use geo_types::Coord;
-
 use super::clip::LocalPoly;
 use super::instance::{instantiate, Local, Site};
 use super::mesh::{Frame, Mesh};
@@ -53,13 +51,4 @@ pub fn build(
     let mut mesh = Mesh::new(h.object_name());
     instantiate(t, &slots, &site, frame, &mut mesh)?;
     Ok(mesh.finish())
-}
-
-/// The point of a hall's plot at local `(u, v)`, for tests and the plan image.
-pub fn plot_point(h: &PlannedHall, p: [f64; 2]) -> Coord<f64> {
-    let v = h.v();
-    Coord {
-        x: h.corner.x + p[0] * h.u.x + p[1] * v.x,
-        y: h.corner.y + p[0] * h.u.y + p[1] * v.y,
-    }
 }

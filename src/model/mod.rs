@@ -659,6 +659,16 @@ impl PlannedHall {
         }
     }
 
+    /// The middle of the plot on the map.
+    pub fn centre(&self) -> Coord<f64> {
+        let v = self.v();
+        let [w, d] = self.size;
+        Coord {
+            x: self.corner.x + (w * self.u.x + d * v.x) / 2.0,
+            y: self.corner.y + (w * self.u.y + d * v.y) / 2.0,
+        }
+    }
+
     /// The plot on the map, counter-clockwise.
     pub fn outline(&self) -> Vec<Coord<f64>> {
         let v = self.v();
