@@ -362,8 +362,12 @@ fn write_city(
     for dir in [&opts.out, &tiles_dir, &opts.out.join(output::TEXTURE_DIR)] {
         output::atomic::remove_leftover_temporaries(dir);
     }
-    let textures = output::write_textures(&opts.out, texture_set)
+    let mut textures = output::write_textures(&opts.out, texture_set)
         .map_err(|e| write_err(&opts.out.join(output::TEXTURE_DIR), e))?;
+    textures.extend(
+        output::write_model_textures(&opts.out, &plan.model_textures)
+            .map_err(|e| write_err(&opts.out.join(output::TEXTURE_DIR), e))?,
+    );
     let species = output::species::write_species(&opts.out, &plan, catalog, params)
         .map_err(|e| write_err(&opts.out.join("species"), e))?;
 
@@ -421,6 +425,7 @@ fn write_city(
                     centre,
                     meshes: &meshes.meshes,
                     features: &features,
+                    palette: output::palette::Palette::new(&plan.palette),
                 };
                 let mut entry = report::ManifestTile {
                     id: id.clone(),
@@ -780,6 +785,12 @@ fn input_summary(
     s.crowds = plan.crowds.clone();
     s.gardens = plan.garden_reports.clone();
     s.halls = plan.hall_reports.clone();
+    // Placed landmarks come from the manifest's tiles (what was written); the rest is the
+    // whole city's.
+    s.landmarks = crate::model::LandmarkReport {
+        placed: Vec::new(),
+        ..plan.landmark_report.clone()
+    };
     // A skip that names only its feature gets its record, so the ledger closes after the
     // manifest's round trip too (`--tiles`, `merge`).
     for skip in s.skipped.iter_mut().filter(|k| k.record.is_none()) {

@@ -14,12 +14,14 @@ mod billboards;
 mod crowd;
 mod garden;
 mod halls;
+mod landmarks;
 pub mod output;
 mod partial;
 pub use billboards::{PeopleParams, PointsLayer, TreesParams};
 pub use crowd::CrowdParams;
 pub use garden::GardenParams;
 pub use halls::{GroundParams, HallParams};
+pub use landmarks::{LandmarkParams, LandmarksLayer, MAX_OFFSET, MAX_SIZE, MIN_SIZE};
 pub use output::OutputParams;
 
 /// The default parameter file, shipped inside the binary.
@@ -99,6 +101,8 @@ pub struct Params {
     pub halls: HallParams,
     /// The ground of every tile: streets, lot and estate ground, water.
     pub ground: GroundParams,
+    /// Landmarks placed from their own models (`layers.landmarks`).
+    pub landmarks: LandmarkParams,
     /// The output formats.
     pub output: OutputParams,
     /// Where the output origin stands on the globe, `[longitude, latitude, height]`: for the
@@ -247,6 +251,8 @@ pub struct Layers {
     pub links: LinksLayer,
     /// Water (rivers, ponds): polygons drawn as a water surface in the ground.
     pub water: IdLayer,
+    /// Landmarks: points or polygons naming a model each.
+    pub landmarks: LandmarksLayer,
     /// The terrain grid.
     pub dem: DemLayer,
 }
@@ -764,6 +770,7 @@ impl Params {
         self.garden.validate().map_err(bad)?;
         self.halls.validate().map_err(bad)?;
         self.ground.validate().map_err(bad)?;
+        self.landmarks.validate().map_err(bad)?;
         self.output.validate().map_err(bad)?;
         if let Some(o) = &self.origin_lonlat {
             output::check_origin_lonlat(o).map_err(bad)?;

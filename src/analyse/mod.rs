@@ -10,6 +10,7 @@ pub mod ground;
 pub mod halls;
 pub mod house;
 pub mod kura;
+pub mod landmarks;
 pub mod obstacles;
 pub mod room;
 pub mod street;
@@ -131,6 +132,9 @@ pub fn analyse(
                 plan.fences.entry(f.tile.clone()).or_default().push(f);
             }
         }
+    }
+    if params.landmarks.enabled {
+        landmarks::plan_landmarks(data, &mut plan, params, crate::materials::MATERIALS.len());
     }
     let t = std::time::Instant::now();
     halls::plan_halls(data, &mut plan, &edges, catalog, params);

@@ -79,8 +79,8 @@ impl Obstacles {
         }
     }
 
-    /// Everything `plan` builds so far: houses, kura, fences and gates, halls and rock
-    /// gardens.
+    /// Everything `plan` builds so far: houses, kura, fences and gates, halls, rock gardens
+    /// and the landmarks' footprints.
     pub fn of_plan(plan: &crate::model::Plan, catalog: &Catalog, params: &Params) -> Obstacles {
         Obstacles::new(
             plan.houses.values().flatten(),
@@ -93,7 +93,14 @@ impl Obstacles {
                 .values()
                 .flatten()
                 .map(|h| h.outline())
-                .chain(plan.gardens.values().flatten().map(|g| g.outline())),
+                .chain(plan.gardens.values().flatten().map(|g| g.outline()))
+                .chain(
+                    plan.landmarks
+                        .values()
+                        .flatten()
+                        .map(|l| crate::geom::ring::open(l.footprint.exterior()).to_vec())
+                        .filter(|r| r.len() >= 3),
+                ),
         )
     }
 

@@ -12,6 +12,7 @@ pub mod ground;
 pub mod halls;
 pub mod instance;
 pub mod kura;
+pub mod landmarks;
 pub mod machiya;
 pub mod mesh;
 pub mod planted;
@@ -63,6 +64,8 @@ pub struct TilePlan<'a> {
     pub gardens: &'a [crate::model::PlannedGarden],
     /// The tile's halls.
     pub halls: &'a [crate::model::PlannedHall],
+    /// The tile's landmarks.
+    pub landmarks: &'a [crate::model::PlannedLandmark],
     /// What the tile's ground is cut from, when `[ground]` is on.
     pub surface: Option<&'a crate::model::PlannedGround>,
     /// The DEM, the tile's id and its bounds, when the terrain is to be written.
@@ -78,6 +81,7 @@ impl<'a> TilePlan<'a> {
             billboards: plan.billboards.get(id).map_or(&[][..], Vec::as_slice),
             gardens: plan.gardens.get(id).map_or(&[][..], Vec::as_slice),
             halls: plan.halls.get(id).map_or(&[][..], Vec::as_slice),
+            landmarks: plan.landmarks.get(id).map_or(&[][..], Vec::as_slice),
             surface: plan.grounds.get(id),
             ground: None,
         }
@@ -90,8 +94,8 @@ fn template_random(seed: u64, layer: &str, id: &str) -> f64 {
     crate::rng::feature_rng(seed, &format!("{layer}/template"), id).random::<f64>()
 }
 
-/// Every model of one tile: houses with their kura, fences and gates, people, trees and the
-/// terrain, in that order.
+/// Every model of one tile: houses with their kura, landmarks, halls, fences and gates,
+/// people, trees, gardens and the ground, in that order.
 pub fn generate_tile(
     tile: &TilePlan,
     catalog: &Catalog,
@@ -176,6 +180,18 @@ pub fn generate_tile(
             }
             Err(reason) => out.stats.skipped.push(skip(format!("its kura: {reason}"))),
         }
+    }
+    for l in tile.landmarks {
+        out.meshes.push(landmarks::mesh(l, frame));
+        out.stats
+            .landmarks
+            .push(crate::model::landmark::PlacedLandmark {
+                id: l.id.clone(),
+                model: l.model.file.clone(),
+                tile: l.tile.clone(),
+                bounds: l.bounds.map(|v| (v * 1000.0).round() / 1000.0),
+                triangles: l.model.triangles.len(),
+            });
     }
     build_halls(tile.halls, catalog, params, frame, files, &mut out);
     build_fences(tile.fences, catalog, params, frame, files, &mut out);

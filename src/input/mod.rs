@@ -8,6 +8,7 @@
 
 /// Coordinate reference systems (in [`crate::geom::crs`]: the tileset uses them too).
 pub use crate::geom::crs;
+pub use landmarks::models_dir;
 pub mod dem;
 pub mod fields;
 pub mod geometry;
@@ -18,8 +19,10 @@ pub mod table;
 pub mod widths;
 
 mod areas;
+mod landmarks;
 mod lines;
 mod links;
+pub mod models;
 mod polygons;
 mod target;
 
@@ -200,6 +203,7 @@ struct Layers {
     gardens: Option<Opened>,
     water: Option<Opened>,
     links: Option<Opened>,
+    landmarks: Option<Opened>,
 }
 
 impl Layers {
@@ -243,6 +247,16 @@ impl Layers {
                 true => None,
                 false => role("links", &l.links.file, &l.links.encoding, &d.links.file)?,
             },
+            // So is a table of landmarks.
+            landmarks: match params.landmarks.enabled && !is_table(&l.landmarks.file) {
+                true => role(
+                    "landmarks",
+                    &l.landmarks.file,
+                    &l.landmarks.encoding,
+                    &d.landmarks.file,
+                )?,
+                false => None,
+            },
         })
     }
 
@@ -261,6 +275,7 @@ impl Layers {
             &self.gardens,
             &self.water,
             &self.links,
+            &self.landmarks,
         ]
         .into_iter()
         .flatten()
@@ -281,6 +296,7 @@ impl Layers {
             &mut self.gardens,
             &mut self.water,
             &mut self.links,
+            &mut self.landmarks,
         ]
         .into_iter()
         .flatten()
@@ -438,6 +454,19 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         }
         links::read_link_table(&l.links, &path, &mut data)?;
     }
+    if let Some(o) = &layers.landmarks {
+        landmarks::read_landmark_shapes(dir, params, o, &target, &mut data)?;
+    } else if params.landmarks.enabled && is_table(&l.landmarks.file) {
+        let path = dir.join(&l.landmarks.file);
+        if !path.exists() {
+            return Err(InputError::Missing(format!(
+                "no landmarks table: {} does not exist (set `layers.landmarks.file` to the right \
+                 path, or to \"\")",
+                path.display()
+            )));
+        }
+        landmarks::read_landmark_table(dir, params, &path, &mut data)?;
+    }
     data.dem = read_dem(dir, params, &target, &dl.dem.file, &mut data.warnings)?;
     for o in layers.all() {
         data.warnings.extend(o.winding_warning());
@@ -456,9 +485,10 @@ fn links_file(dir: &Path, params: &Params, d: &crate::params::Layers) -> String 
     file.clone()
 }
 
-/// Whether a layer file is a table (CSV) rather than a shapefile.
+/// Whether a layer file is a table (CSV, or an XLSX workbook) rather than a shapefile.
 fn is_table(file: &str) -> bool {
-    file.to_lowercase().ends_with(".csv")
+    let f = file.to_lowercase();
+    f.ends_with(".csv") || f.ends_with(".xlsx")
 }
 
 /// The skip entry for a record of `o` whose shape is null (no geometry, only attributes).

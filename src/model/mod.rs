@@ -6,6 +6,7 @@
 
 pub mod crowd;
 pub mod dem;
+pub mod landmark;
 pub mod tile;
 pub mod warning;
 
@@ -254,6 +255,10 @@ pub struct Dataset {
     pub water: Vec<GardenArea>,
     /// The links layer's points.
     pub links: Vec<Link>,
+    /// The landmarks layer's records whose model was read.
+    pub landmarks: Vec<LandmarkRecord>,
+    /// The landmarks' models, each read once, by the name the records give.
+    pub models: BTreeMap<String, std::sync::Arc<Model>>,
     /// Street centrelines with their widths.
     pub streets: Vec<Street>,
     /// Building footprints, each built to its own height.
@@ -330,6 +335,7 @@ impl Frontage {
 
 /// A tile id `<col>_<row>` on the fixed grid.
 pub use crowd::{CrowdStat, MeanLambdas};
+pub use landmark::{LandmarkRecord, LandmarkReport, Model, PlannedLandmark};
 pub use tile::TileId;
 pub use warning::{Warning, WarningClass};
 
@@ -617,6 +623,15 @@ pub struct Plan {
     pub hall_reports: Vec<HallStat>,
     /// The ground of every tile to write (`[ground]`): the surfaces it is cut from.
     pub grounds: BTreeMap<TileId, PlannedGround>,
+    /// The landmarks, per tile (the tile of their point).
+    pub landmarks: BTreeMap<TileId, Vec<PlannedLandmark>>,
+    /// The materials the landmarks' models bring, in palette order (library ids from
+    /// `materials::MATERIALS.len()` on).
+    pub palette: Vec<landmark::PaletteEntry>,
+    /// Their textures: prefixed file name and bytes.
+    pub model_textures: Vec<(String, std::sync::Arc<Vec<u8>>)>,
+    /// What became of the landmarks layer.
+    pub landmark_report: LandmarkReport,
 }
 
 /// A hall (a template of kind `hall`: a temple's main hall, gate or pagoda, a samurai's main
@@ -848,6 +863,9 @@ pub struct TileStats {
     /// Halls built in the tile, per template.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub halls: BTreeMap<String, usize>,
+    /// Landmarks written in the tile, with their boxes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub landmarks: Vec<landmark::PlacedLandmark>,
     /// Bytes of the tile's OBJ taken by its ground (objects `ground` and `streets`).
     #[serde(default, skip_serializing_if = "is_zero_u64")]
     pub ground_bytes: u64,

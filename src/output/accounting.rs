@@ -83,6 +83,11 @@ pub fn ledgers(data: &Dataset) -> Vec<Ledger> {
                     .iter()
                     .map(|g| (g.record, g.id.as_str()))
                     .collect(),
+                "landmarks" => data
+                    .landmarks
+                    .iter()
+                    .map(|g| (g.record, g.id.as_str()))
+                    .collect(),
                 "links" => data
                     .links
                     .iter()

@@ -45,6 +45,7 @@ const KINDS: &[(&str, &str)] = &[
     ("garden_", "garden"),
     ("stone_", "stone"),
     ("hall_", "hall"),
+    ("landmark_", "landmark"),
 ];
 
 /// The lookup from names to lots and houses, built once per build.
@@ -103,6 +104,11 @@ impl<'a> Directory<'a> {
             lot: id.to_string(),
             ..Feature::default()
         };
+        if kind == "landmark" {
+            // Its own layer's id: no lot, type or use of ours.
+            f.source = l.landmarks.file.clone();
+            return f;
+        }
         let drawn = id.strip_prefix("area-");
         f.source = match (name.split('_').next().unwrap_or(""), drawn) {
             ("people", _) if self.given[0] => l.people.file.clone(),
@@ -170,6 +176,8 @@ mod tests {
         assert_eq!(f("kura_9").source, "lots.shp");
         assert_eq!(f("hall_4_2_goju-no-to").kind, "hall");
         assert_eq!(f("hall_4_2_goju-no-to").lot, "4_2");
+        assert_eq!(f("landmark_nijo-keep").kind, "landmark");
+        assert_eq!(f("landmark_nijo-keep").lot, "nijo-keep");
         assert_eq!(f("ground").kind, "ground");
         assert_eq!(f("streets").source, "");
     }

@@ -12,6 +12,7 @@ pub mod gltf;
 pub mod links;
 pub mod lock;
 pub mod obj;
+pub mod palette;
 pub mod plan;
 pub mod render;
 pub mod report;
@@ -121,12 +122,27 @@ pub fn mask_png(png: &[u8]) -> Result<Vec<u8>, image::ImageError> {
 
 /// Writes the texture library to `<out>/tiles/textures/` ([`TEXTURE_DIR`]).
 pub fn write_textures(out: &Path, library: &[Texture]) -> std::io::Result<Vec<ManifestFile>> {
+    write_texture_files(out, library.iter().map(|(n, b)| (*n, &b[..])))
+}
+
+/// Writes the textures the landmarks' models brought (prefixed names, see
+/// [`crate::model::Plan::model_textures`]) beside the library.
+pub fn write_model_textures(
+    out: &Path,
+    textures: &[(String, std::sync::Arc<Vec<u8>>)],
+) -> std::io::Result<Vec<ManifestFile>> {
+    write_texture_files(out, textures.iter().map(|(n, b)| (n.as_str(), &b[..])))
+}
+
+/// Writes each (file name, bytes) into `<out>/tiles/textures/`.
+fn write_texture_files<'a>(
+    out: &Path,
+    files: impl Iterator<Item = (&'a str, &'a [u8])>,
+) -> std::io::Result<Vec<ManifestFile>> {
     let dir = out.join(TEXTURE_DIR);
     std::fs::create_dir_all(&dir)?;
-    library
-        .iter()
+    files
         .map(|(name, bytes)| {
-            let bytes: &[u8] = bytes;
             atomic::write_atomic(&dir.join(name), bytes)?;
             Ok(ManifestFile {
                 path: format!("{TEXTURE_DIR}/{name}"),

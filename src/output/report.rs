@@ -189,6 +189,10 @@ pub struct Report {
     /// with its plot, or not with why).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub halls: Vec<crate::model::HallStat>,
+    /// The landmarks: placed (with tile and box), displaced features, and skipped records
+    /// with why.
+    #[serde(skip_serializing_if = "landmarks_empty")]
+    pub landmarks: crate::model::LandmarkReport,
     /// Trees of a species: by species and how each was drawn, and bytes of tree geometry per
     /// tile (absent when no tree has a species).
     #[serde(skip_serializing_if = "TreesReport::is_empty")]
@@ -346,6 +350,15 @@ pub struct InputSummary {
     /// Every hall a lot's use asked for: placed or not with why.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub halls: Vec<crate::model::HallStat>,
+    /// What became of the landmarks layer (its `placed` is left empty here: the tiles list
+    /// what they hold).
+    #[serde(default, skip_serializing_if = "landmarks_empty")]
+    pub landmarks: crate::model::LandmarkReport,
+}
+
+/// Whether a build had no landmarks at all (the report then leaves the key out).
+fn landmarks_empty(l: &crate::model::LandmarkReport) -> bool {
+    l.placed.is_empty() && l.displaced.is_empty() && l.skipped.is_empty()
 }
 
 /// manifest.json, written last: what the build is (tool, parameters, input, frame) and
@@ -541,6 +554,14 @@ pub fn assemble_report(m: &Manifest) -> Report {
     r.crowds = Crowds::of(&i.crowds);
     r.gardens = i.gardens.clone();
     r.halls = i.halls.clone();
+    r.landmarks = crate::model::LandmarkReport {
+        placed: m
+            .tiles
+            .iter()
+            .flat_map(|t| t.stats.landmarks.iter().cloned())
+            .collect(),
+        ..i.landmarks.clone()
+    };
     for s in &r.skipped {
         *r.skipped_by_reason
             .entry(reason_class(&s.reason))

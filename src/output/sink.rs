@@ -22,6 +22,8 @@ pub struct TileContent<'a> {
     pub meshes: &'a [Mesh],
     /// One description per mesh.
     pub features: &'a [Feature],
+    /// What the meshes' material ids name (the library, then the landmarks' materials).
+    pub palette: super::palette::Palette<'a>,
 }
 
 /// What a sink wrote for one tile.

@@ -28,6 +28,7 @@ pub struct Params {
     garden: Option<super::garden::partial::Garden>,
     halls: Option<super::halls::partial::Halls>,
     ground: Option<super::halls::partial::Ground>,
+    landmarks: Option<super::landmarks::partial::Landmarks>,
     output: Option<super::output::partial::Output>,
     origin_lonlat: Option<[f64; 3]>,
     type_mix: Option<BTreeMap<String, f64>>,
@@ -65,6 +66,7 @@ struct Layers {
     gardens: Option<FencesLayer>,
     water: Option<FencesLayer>,
     links: Option<LinksLayer>,
+    landmarks: Option<super::landmarks::partial::LandmarksLayer>,
     dem: Option<DemLayer>,
 }
 #[derive(Deserialize)]

@@ -19,8 +19,8 @@ use std::collections::HashMap;
 use serde_json::{json, Value};
 
 use crate::generate::mesh::Mesh;
-use crate::materials::MATERIALS;
 use crate::output::features::Feature;
+use crate::output::palette::{mime_type, Palette};
 use buffer::Buffer;
 
 /// One primitive being assembled: interleaving is left to the accessors (one view each).
@@ -97,7 +97,13 @@ fn linear(c: f32) -> f32 {
 
 /// The GLB bytes of one tile. `shift` (millimetres, output frame) is the tile centre the
 /// positions are taken around; `features` has one entry per mesh.
-pub fn tile_glb(tile: &str, meshes: &[Mesh], features: &[Feature], shift: [i64; 3]) -> Vec<u8> {
+pub fn tile_glb(
+    tile: &str,
+    meshes: &[Mesh],
+    features: &[Feature],
+    shift: [i64; 3],
+    palette: Palette,
+) -> Vec<u8> {
     // Node per kind, in order of first appearance; primitive per material, by material id.
     let mut kinds: Vec<(&str, std::collections::BTreeMap<u16, Primitive>)> = Vec::new();
     for (i, (mesh, f)) in meshes.iter().zip(features).enumerate() {
@@ -158,7 +164,7 @@ pub fn tile_glb(tile: &str, meshes: &[Mesh], features: &[Feature], shift: [i64; 
         nodes.push(json!({"name": kind, "mesh": meshes_json.len(), "extras": {"kind": kind}}));
         meshes_json.push(json!({"name": kind, "primitives": primitives}));
     }
-    let (materials, images, textures) = materials(&used);
+    let (materials, images, textures) = materials(&used, palette);
     let mut doc = json!({
         "asset": {
             "version": "2.0",
@@ -191,14 +197,15 @@ pub fn tile_glb(tile: &str, meshes: &[Mesh], features: &[Feature], shift: [i64; 
 
 /// The materials `used` (library ids, in first-use order) as glTF materials, with the
 /// images and textures the textured ones need.
-fn materials(used: &[u16]) -> (Vec<Value>, Vec<Value>, Vec<Value>) {
+fn materials(used: &[u16], palette: Palette) -> (Vec<Value>, Vec<Value>, Vec<Value>) {
     let (mut out, mut images, mut textures) = (Vec::new(), Vec::new(), Vec::new());
     for &id in used {
-        let m = &MATERIALS[id as usize];
+        let m = palette.get(id);
         let mut pbr = json!({"metallicFactor": 0.0, "roughnessFactor": 0.9});
         match m.texture {
             Some(file) => {
-                images.push(json!({"uri": format!("textures/{file}"), "mimeType": "image/png"}));
+                images
+                    .push(json!({"uri": format!("textures/{file}"), "mimeType": mime_type(file)}));
                 textures.push(json!({"sampler": 0, "source": images.len() - 1}));
                 pbr["baseColorTexture"] = json!({"index": textures.len() - 1});
             }
@@ -231,7 +238,13 @@ impl crate::output::sink::Sink for GlbSink {
         out: &std::path::Path,
         tile: &crate::output::sink::TileContent,
     ) -> std::io::Result<crate::output::sink::TileFiles> {
-        let bytes = tile_glb(tile.id, tile.meshes, tile.features, tile.centre);
+        let bytes = tile_glb(
+            tile.id,
+            tile.meshes,
+            tile.features,
+            tile.centre,
+            tile.palette,
+        );
         let path = format!("tiles/{}.glb", tile.id);
         crate::output::atomic::write_atomic(&out.join(&path), &bytes)?;
         Ok(crate::output::sink::TileFiles {

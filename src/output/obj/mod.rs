@@ -10,11 +10,11 @@ pub mod mtl;
 use std::io::Write;
 use std::path::Path;
 
+use super::palette::Palette;
 use super::report::ManifestFile;
 use super::sink::{Sink, TileContent, TileFiles};
 use super::{atomic, sha256_hex};
 use crate::generate::mesh::Mesh;
-use crate::materials::MATERIALS;
 
 /// The OBJ format: `tiles/<id>.obj` and its `tiles/<id>.mtl`.
 pub struct ObjSink {
@@ -33,12 +33,18 @@ impl Sink for ObjSink {
         let mut obj = Vec::with_capacity(tile.meshes.len() * 4096);
         let sizes = if self.by_kind {
             let kinds: Vec<&str> = tile.features.iter().map(|f| f.kind.as_str()).collect();
-            write_tile_by_kind(&mut obj, id, tile.origin, tile.meshes, &kinds);
+            write_tile_by_kind(&mut obj, id, tile.origin, tile.meshes, &kinds, tile.palette);
             None
         } else {
-            Some(write_tile(&mut obj, id, tile.origin, tile.meshes))
+            Some(write_tile_in(
+                &mut obj,
+                id,
+                tile.origin,
+                tile.meshes,
+                tile.palette,
+            ))
         };
-        let mtl = mtl::mtl_text().into_bytes();
+        let mtl = mtl::tile_mtl_text(tile.meshes, tile.palette).into_bytes();
         let dir = out.join("tiles");
         atomic::write_atomic(&dir.join(format!("{id}.obj")), &obj)?;
         atomic::write_atomic(&dir.join(format!("{id}.mtl")), &mtl)?;
@@ -127,11 +133,11 @@ fn face(buf: &mut Vec<u8>, f: &crate::generate::mesh::Face, v_base: u64, vt_base
 }
 
 /// Appends `usemtl` when the material changes.
-fn use_material(buf: &mut Vec<u8>, current: &mut Option<u16>, material: u16) {
+fn use_material(buf: &mut Vec<u8>, current: &mut Option<u16>, material: u16, palette: Palette) {
     if *current != Some(material) {
         *current = Some(material);
         buf.extend_from_slice(b"usemtl ");
-        buf.extend_from_slice(MATERIALS[material as usize].name.as_bytes());
+        buf.extend_from_slice(palette.get(material).name.as_bytes());
         buf.push(b'\n');
     }
 }
@@ -143,6 +149,17 @@ pub fn write_tile<'a>(
     tile: &str,
     origin: [f64; 2],
     meshes: impl IntoIterator<Item = &'a Mesh>,
+) -> Vec<usize> {
+    write_tile_in(buf, tile, origin, meshes, Palette::LIBRARY)
+}
+
+/// The same, with material ids looked up in `palette`.
+pub fn write_tile_in<'a>(
+    buf: &mut Vec<u8>,
+    tile: &str,
+    origin: [f64; 2],
+    meshes: impl IntoIterator<Item = &'a Mesh>,
+    palette: Palette,
 ) -> Vec<usize> {
     header(buf, tile, origin);
     let (mut v_base, mut vt_base) = (1u64, 1u64);
@@ -158,7 +175,7 @@ pub fn write_tile<'a>(
         let mut current = None;
         for i in order {
             let f = &mesh.faces[i];
-            use_material(buf, &mut current, f.material);
+            use_material(buf, &mut current, f.material, palette);
             face(buf, f, v_base, vt_base);
         }
         v_base += mesh.positions.len() as u64;
@@ -178,6 +195,7 @@ pub fn write_tile_by_kind(
     origin: [f64; 2],
     meshes: &[Mesh],
     kinds: &[&str],
+    palette: Palette,
 ) {
     header(buf, tile, origin);
     let mut order: Vec<&str> = Vec::new();
@@ -210,7 +228,7 @@ pub fn write_tile_by_kind(
         let mut current = None;
         for (material, i, k) in faces {
             let &(_, vb, tb) = bases.iter().find(|b| b.0 == i).expect("a base per mesh");
-            use_material(buf, &mut current, material);
+            use_material(buf, &mut current, material, palette);
             face(buf, &meshes[i].faces[k], vb, tb);
         }
     }

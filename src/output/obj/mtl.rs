@@ -9,12 +9,53 @@
 
 use std::fmt::Write;
 
+use crate::generate::mesh::Mesh;
 use crate::materials::MATERIALS;
+use crate::output::palette::Palette;
 
 /// MTL text listing every material, for a tile in `tiles/`: textures are referenced as
 /// `textures/<file>` (the library is in `tiles/textures/`, no `..`).
 pub fn mtl_text() -> String {
     mtl_text_at("textures/")
+}
+
+/// A tile's MTL text: the library, then the landmark materials its meshes use (a tile
+/// without a landmark has the library's text alone).
+pub fn tile_mtl_text(meshes: &[Mesh], palette: Palette) -> String {
+    let mut s = mtl_text();
+    let mut extra: Vec<u16> = meshes
+        .iter()
+        .flat_map(|m| m.faces.iter().map(|f| f.material))
+        .filter(|&id| Palette::is_extra(id))
+        .collect();
+    extra.sort_unstable();
+    extra.dedup();
+    for id in extra {
+        let m = palette.get(id);
+        let _ = writeln!(s, "\nnewmtl {}", m.name);
+        match m.texture {
+            Some(t) => {
+                let _ = writeln!(
+                    s,
+                    "# untextured colour: {:.3} {:.3} {:.3}",
+                    m.kd[0], m.kd[1], m.kd[2]
+                );
+                let _ = writeln!(
+                    s,
+                    "Ka 1.000 1.000 1.000\nKd 1.000 1.000 1.000\nKs 0.000 0.000 0.000\nd 1.0\n\
+                     illum 1\nmap_Kd textures/{t}"
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "Ka {0:.3} {1:.3} {2:.3}\nKd {0:.3} {1:.3} {2:.3}\nKs 0.000 0.000 0.000\nd 1.0\nillum 1",
+                    m.kd[0], m.kd[1], m.kd[2]
+                );
+            }
+        }
+    }
+    s
 }
 
 /// MTL text with textures referenced as `<prefix><file>`.
