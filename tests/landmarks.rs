@@ -71,9 +71,13 @@ fn the_pagoda_lands_whole_in_its_tile_and_displaces_the_house_under_it() {
     // The house of lot 1 is not built: displaced and skipped with why.
     let displaced = l["displaced"].as_array().unwrap();
     assert!(
-        displaced
-            .iter()
-            .any(|d| d["kind"] == "machiya" && d["id"] == "1" && d["landmark"] == "pagoda"),
+        displaced.iter().any(|d| d["kind"] == "machiya"
+            && d["id"] == "1"
+            && d["landmark"] == "pagoda"
+            && d["reason"]
+                .as_str()
+                .unwrap()
+                .contains("overlaps the landmark's footprint")),
         "{displaced:?}"
     );
     let skipped = report["skipped"].as_array().unwrap();
@@ -152,6 +156,18 @@ fn the_pagoda_lands_whole_in_its_tile_and_displaces_the_house_under_it() {
             );
         }
     }
+    // The plan shows its footprint in the landmark colour (a plan without landmarks has
+    // none of it).
+    let landmark_pixels = |png: &Path| {
+        let img = image::open(png).unwrap().to_rgb8();
+        img.pixels()
+            .filter(|p| p.0 == edo_city::output::plan::LANDMARK)
+            .count()
+    };
+    assert!(landmark_pixels(&out.join("plan.png")) > 20);
+    let plain = tmp.path().join("plain");
+    build_ok(&fixture("kyoto-small"), &plain, &["--quiet"]);
+    assert_eq!(landmark_pixels(&plain.join("plan.png")), 0);
 }
 
 #[test]

@@ -68,10 +68,15 @@ fn chino_parcels_with_widths_from_split_lines() {
     let Some(r) = build_example("chino_plateau_devpermit", "chino", out.path()) else {
         return;
     };
-    // 217 parcels in, every one a town lot with a house: none is too shallow or degenerate.
+    // 217 parcels in, every one a town lot with a house (none is too shallow or degenerate)
+    // but for the 9 where one of the 45 landmarks stands.
     assert_eq!(r["counts"]["lots"], 217);
-    assert_eq!(r["counts"]["machiya"], 217);
-    assert_eq!(r["counts"]["skipped"], 0, "{}", r["skipped"]);
+    assert_eq!(r["counts"]["machiya"], 208);
+    assert_eq!(r["counts"]["skipped"], 9, "{}", r["skipped"]);
+    for s in r["skipped"].as_array().unwrap() {
+        let reason = s["reason"].as_str().unwrap();
+        assert!(reason.starts_with("displaced by landmark "), "{s}");
+    }
     assert!(
         r["crs"].as_str().unwrap().contains("+lon_0=138.5"),
         "zone VIII kept"
@@ -235,6 +240,65 @@ fn swellendam_erven_and_buildings_from_two_utm_zones() {
 }
 
 #[test]
+fn chino_public_buildings_stand_as_landmarks() {
+    let out = tempfile::tempdir().unwrap();
+    let Some(r) = build_example("chino_plateau_devpermit", "chino", out.path()) else {
+        return;
+    };
+    // 45 points in WGS84, each kind mapped to a model: all placed, in zone VIII metres
+    // beside the parcels, whole in the tile named in the manifest.
+    let l = &r["landmarks"];
+    let placed = l["placed"].as_array().unwrap();
+    assert_eq!(placed.len(), 45, "{}", l["skipped"]);
+    assert_eq!(l["skipped"].as_array().unwrap().len(), 0);
+    assert_eq!(l["displaced"].as_array().unwrap().len(), 9);
+    let a = r["accounting"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["role"] == "landmarks")
+        .expect("the landmarks layer is in the ledger");
+    assert_eq!(a["read"], 45);
+    let names: Vec<&str> = placed.iter().map(|p| p["id"].as_str().unwrap()).collect();
+    assert!(names.contains(&"茅野駅"), "{names:?}");
+    let manifest = read_json(&out.path().join("manifest.json"));
+    for p in placed {
+        let b: Vec<f64> = p["bounds"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        // Zone VIII (origin 138.5 E, 36 N): Chino lies 20-40 km west, within 10 km of 36 N.
+        assert!((-40_000.0..-15_000.0).contains(&b[0]), "{p}");
+        assert!((-10_000.0..10_000.0).contains(&b[1]), "{p}");
+        assert!(b[5] - b[2] > 3.0 && b[5] - b[2] < 60.0, "{p}");
+        // Its tile (the tile of its anchor) holds the middle of its box; tile bounds are
+        // stated from the manifest's origin.
+        let tile = p["tile"].as_str().unwrap();
+        let t = manifest["tiles"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|t| t["id"] == tile)
+            .unwrap_or_else(|| panic!("{tile} not in the manifest"));
+        let tb: Vec<f64> = t["bounds"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let o = &manifest["origin"];
+        let cx = (b[0] + b[3]) / 2.0 - o[0].as_f64().unwrap();
+        let cy = (b[1] + b[4]) / 2.0 - o[1].as_f64().unwrap();
+        assert!(
+            tb[0] <= cx && cx <= tb[3] && tb[1] <= cy && cy <= tb[4],
+            "{p} in {t}"
+        );
+    }
+}
+
+#[test]
 fn init_guesses_build_every_real_set() {
     for (set, built_min) in [
         ("chino_plateau_devpermit", 217),
@@ -275,9 +339,10 @@ fn chino_parcels_take_the_town_area_holding_them() {
         return;
     };
     let by_district = r["counts"]["by_district"].as_object().unwrap();
-    // f_district has 10 town areas (町丁); every parcel lies in one of them.
+    // f_district has 10 town areas (町丁); every house lies in one of them (the 217 parcels'
+    // houses less the 9 where a landmark stands).
     assert_eq!(by_district.len(), 10, "{by_district:?}");
     assert!(by_district.contains_key("ちの上原"));
     let total: u64 = by_district.values().map(|v| v.as_u64().unwrap()).sum();
-    assert_eq!(total, 217);
+    assert_eq!(total, 208);
 }

@@ -330,6 +330,7 @@ fn displace(p: &PlannedLandmark, data: &Dataset, plan: &mut Plan, out: &mut Vec<
                     landmark: p.id.clone(),
                     kind: kind.into(),
                     id: h.id.clone(),
+                    reason: "the house's outline overlaps the landmark's footprint".into(),
                 });
                 plan.skipped.push(Skipped {
                     layer: role.into(),
@@ -350,6 +351,9 @@ fn displace(p: &PlannedLandmark, data: &Dataset, plan: &mut Plan, out: &mut Vec<
                         landmark: p.id.clone(),
                         kind: "kura".into(),
                         id: h.id.clone(),
+                        reason: "the kura's plot overlaps the landmark's footprint; the \
+                                 house is built without it"
+                            .into(),
                     });
                     h.kura = KuraDecision::NoRoom;
                 }
@@ -377,6 +381,10 @@ fn displace(p: &PlannedLandmark, data: &Dataset, plan: &mut Plan, out: &mut Vec<
                     landmark: p.id.clone(),
                     kind: kind.into(),
                     id: f.id.clone(),
+                    reason: format!(
+                        "the lot's {kind} crosses the landmark's footprint; the {kind} \
+                         segments it crosses are left out"
+                    ),
                 });
             }
             false

@@ -167,6 +167,7 @@ pub fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<(
     }
     print_billboards(r)?;
     print_halls(r)?;
+    print_landmarks(r)?;
     say!(
         "  tiles      {:>7}  ({} written now, {:.1} MB)",
         c.tiles,
@@ -230,6 +231,30 @@ fn print_halls(r: &edo_city::output::report::Report) -> std::io::Result<()> {
         } else {
             String::new()
         }
+    );
+    Ok(())
+}
+
+/// Landmarks: how many placed from which model, what they displaced, how many were skipped.
+fn print_landmarks(r: &edo_city::output::report::Report) -> std::io::Result<()> {
+    let l = &r.landmarks;
+    if l.placed.is_empty() && l.skipped.is_empty() {
+        return Ok(());
+    }
+    let mut by_model: std::collections::BTreeMap<&str, usize> = Default::default();
+    for p in &l.placed {
+        *by_model.entry(p.model.as_str()).or_default() += 1;
+    }
+    say!(
+        "  landmarks  {:>7}  ({}); {} generated features displaced, {} landmarks skipped",
+        l.placed.len(),
+        by_model
+            .iter()
+            .map(|(m, n)| format!("{m} {n}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        l.displaced.len(),
+        l.skipped.len()
     );
     Ok(())
 }

@@ -174,6 +174,8 @@ pub struct Displaced {
     pub kind: String,
     /// Its id (the lot's or fence line's).
     pub id: String,
+    /// Why: what of it overlapped the landmark's footprint, and what was kept.
+    pub reason: String,
 }
 
 /// A placed landmark in the report.

@@ -50,6 +50,10 @@ pub const KURA_REFUSED: [u8; 3] = [235, 120, 30];
 pub const TREE: [u8; 3] = [40, 130, 50];
 /// People.
 pub const PERSON: [u8; 3] = [30, 40, 120];
+/// A landmark's footprint (placed from its own model).
+pub const LANDMARK: [u8; 3] = [110, 50, 160];
+/// A lot whose house a landmark displaced.
+pub const LANDMARK_LOT: [u8; 3] = [214, 200, 232];
 
 /// What the image shows and how metres map to pixels.
 #[derive(Debug, Clone, Copy)]
@@ -174,6 +178,7 @@ pub fn draw_plan(
     let refused_any = kura.is_some_and(|avoid| draw_kura(&mut pm, view, plan, avoid));
     let any_fence = draw_fences(&mut pm, view, plan);
     let any_hall = draw_halls(&mut pm, view, plan);
+    let any_landmark = draw_landmarks(&mut pm, view, plan);
     let any_billboard = draw_billboards(&mut pm, view, plan);
     draw_lines_on_top(&mut pm, view, data, plan);
     draw_tile_grid(&mut pm, view, plan, tile_grid);
@@ -182,15 +187,15 @@ pub fn draw_plan(
         Some(_) => 1 + usize::from(refused_any),
         None => 0,
     };
-    draw_legend(
-        &mut pm,
-        &colours,
-        !data.footprints.is_empty(),
+    let shown = Shown {
+        footprints: !data.footprints.is_empty(),
         kura_rows,
-        any_fence,
-        any_hall,
-        any_billboard,
-    );
+        fences: any_fence,
+        halls: any_hall,
+        landmarks: any_landmark,
+        billboards: any_billboard,
+    };
+    draw_legend(&mut pm, &colours, &shown);
     encode_png(&pm)
 }
 
@@ -221,7 +226,7 @@ fn draw_streets(pm: &mut Pixmap, view: &View, data: &Dataset) {
     }
 }
 
-/// Lots without a house (other uses, skipped ones), then every house by its type's colour.
+/// Lots without a house (other uses, given to a landmark, skipped ones), then every house by its type's colour.
 fn draw_lots_and_houses(
     pm: &mut Pixmap,
     view: &View,
@@ -231,6 +236,10 @@ fn draw_lots_and_houses(
 ) {
     let id = Transform::identity();
     let skipped: HashSet<&str> = plan.skipped.iter().map(|s| s.id.as_str()).collect();
+    let displaced: HashSet<&str> = (plan.landmark_report.displaced.iter())
+        .filter(|d| d.kind == "machiya")
+        .map(|d| d.id.as_str())
+        .collect();
     let planned: HashSet<&str> = plan
         .houses
         .values()
@@ -243,7 +252,9 @@ fn draw_lots_and_houses(
             continue;
         }
         if let Some(path) = polygon_path(view, &lot.outline) {
-            let fill = if skipped.contains(lot.id.as_str()) {
+            let fill = if displaced.contains(lot.id.as_str()) {
+                LANDMARK_LOT
+            } else if skipped.contains(lot.id.as_str()) {
                 SKIPPED
             } else {
                 OTHER_USE
@@ -309,6 +320,21 @@ fn draw_halls(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
             Transform::identity(),
             None,
         );
+        any = true;
+    }
+    any
+}
+
+/// The landmarks' footprints, filled and outlined (whether there was any).
+fn draw_landmarks(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
+    let mut any = false;
+    for l in plan.landmarks.values().flatten() {
+        let Some(path) = polygon_path(view, &l.footprint) else {
+            continue;
+        };
+        let id = Transform::identity();
+        pm.fill_path(&path, &paint(LANDMARK, 255), FillRule::EvenOdd, id, None);
+        pm.stroke_path(&path, &paint([40, 20, 60], 255), &thin(), id, None);
         any = true;
     }
     any
@@ -480,17 +506,20 @@ fn draw_scale_bar(pm: &mut Pixmap, view: &View) {
     draw_text(pm, x, y - 20.0, &format!("{metres} m"), 2, [30, 30, 30]);
 }
 
-fn draw_legend(
-    pm: &mut Pixmap,
-    colours: &BTreeMap<String, [u8; 3]>,
+/// Which rows the legend has (only what the plan shows).
+struct Shown {
     footprints: bool,
+    /// 0 (kura off), 1 (kura) or 2 (kura and refused kura).
     kura_rows: usize,
     fences: bool,
     halls: bool,
+    landmarks: bool,
     billboards: bool,
-) {
+}
+
+fn draw_legend(pm: &mut Pixmap, colours: &BTreeMap<String, [u8; 3]>, shown: &Shown) {
     let mut rows: Vec<(String, [u8; 3])> = colours.iter().map(|(t, c)| (t.clone(), *c)).collect();
-    if footprints {
+    if shown.footprints {
         rows.push(("footprint".into(), FOOTPRINT));
     }
     for (name, colour) in [
@@ -498,18 +527,22 @@ fn draw_legend(
         ("kura refused (plots collide)", KURA_REFUSED),
     ]
     .into_iter()
-    .take(kura_rows)
+    .take(shown.kura_rows)
     {
         rows.push((name.into(), colour));
     }
-    if fences {
+    if shown.fences {
         rows.push(("wall".into(), FENCE));
         rows.push(("gate".into(), GATE));
     }
-    if halls {
+    if shown.halls {
         rows.push(("hall".into(), HALL));
     }
-    if billboards {
+    if shown.landmarks {
+        rows.push(("landmark".into(), LANDMARK));
+        rows.push(("lot of a landmark".into(), LANDMARK_LOT));
+    }
+    if shown.billboards {
         rows.push(("tree".into(), TREE));
         rows.push(("person".into(), PERSON));
     }
