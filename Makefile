@@ -2,7 +2,7 @@
 
 CARGO ?= cargo
 
-.PHONY: run test test-future lint bench real textures fixtures clean pictures bad-input viewer-deps
+.PHONY: run test test-cluster test-future lint bench real textures fixtures clean pictures bad-input viewer-deps
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
@@ -45,6 +45,12 @@ real:
 ## Whole-Kyoto scale: 30,052 synthetic lots, three builds, per-stage timings.
 bench:
 	bash scripts/bench.sh
+
+## The cluster path on a real Slurm: a throw-away single-node cluster (installs Debian's
+## slurm-wlm and munge when missing; needs root), the sbatch array of deploy/slurm/ and its
+## merge, checked byte for byte against a full build; every daemon stopped after.
+test-cluster:
+	bash scripts/test-cluster.sh
 
 ## Redraw the texture library (the PNGs are committed).
 textures:

@@ -298,7 +298,12 @@ fn run(
     // run at a time in the directory, and never a second hypothesis in it.
     let existed = opts.out.exists();
     std::fs::create_dir_all(&opts.out).map_err(|e| write_err(&opts.out, e))?;
-    let lock = output::lock::OutLock::acquire(&opts.out).map_err(|e| {
+    // Shards of one city write disjoint tiles: they share the directory.
+    let lock = match opts.selection {
+        Selection::Shard { .. } => output::lock::OutLock::acquire_shared(&opts.out),
+        _ => output::lock::OutLock::acquire(&opts.out),
+    };
+    let lock = lock.map_err(|e| {
         if !existed {
             let _ = std::fs::remove_dir(&opts.out);
         }
@@ -358,9 +363,13 @@ fn write_city(
     };
     let tiles_dir = opts.out.join("tiles");
     std::fs::create_dir_all(&tiles_dir).map_err(|e| write_err(&tiles_dir, e))?;
-    // A run killed before its renames leaves temporaries; they are never valid output.
-    for dir in [&opts.out, &tiles_dir, &opts.out.join(output::TEXTURE_DIR)] {
-        output::atomic::remove_leftover_temporaries(dir);
+    // A run killed before its renames leaves temporaries; they are never valid output. Shards
+    // leave them (the shards beside them are writing theirs); a full build or merge sweeps.
+    let alone = !matches!(opts.selection, Selection::Shard { .. });
+    if alone {
+        for dir in [&opts.out, &tiles_dir, &opts.out.join(output::TEXTURE_DIR)] {
+            output::atomic::remove_leftover_temporaries(dir);
+        }
     }
     let mut textures = output::write_textures(&opts.out, texture_set)
         .map_err(|e| write_err(&opts.out.join(output::TEXTURE_DIR), e))?;
@@ -368,7 +377,7 @@ fn write_city(
         output::write_model_textures(&opts.out, &plan.model_textures)
             .map_err(|e| write_err(&opts.out.join(output::TEXTURE_DIR), e))?,
     );
-    let species = output::species::write_species(&opts.out, &plan, catalog, params)
+    let species = output::species::write_species(&opts.out, &plan, catalog, params, alone)
         .map_err(|e| write_err(&opts.out.join("species"), e))?;
 
     let files = layer_files(&opts.input, params);

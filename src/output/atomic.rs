@@ -37,7 +37,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", run_token()));
     let result = (|| {
         let mut f = fs::File::create(&tmp)?;
         match disk_room(bytes.len()) {
@@ -57,8 +57,24 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
-/// Removes temporary files a killed run left in `dir` (names `.<file>.tmp-<pid>`, as
-/// [`write_atomic`] makes them). Other files are never touched.
+/// This process's part of a temporary name: its pid and a random number drawn once, so the
+/// shards of a cluster writing the same texture into a shared directory never share a
+/// temporary, even on two nodes where their pids are equal. (Names only: nothing written
+/// depends on it.)
+fn run_token() -> &'static str {
+    use std::hash::{BuildHasher, Hasher};
+    use std::sync::OnceLock;
+    static TOKEN: OnceLock<String> = OnceLock::new();
+    TOKEN.get_or_init(|| {
+        let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+        h.write_u32(std::process::id());
+        format!("{}-{}", std::process::id(), h.finish() % 1_000_000_000)
+    })
+}
+
+/// Removes temporary files a killed run left in `dir` (names `.<file>.tmp-<pid>[-<n>]`, as
+/// [`write_atomic`] makes them). Other files are never touched. Only a run that holds its
+/// directory alone may call it: a shard would take the temporaries of the shards beside it.
 pub fn remove_leftover_temporaries(dir: &Path) {
     let Ok(entries) = fs::read_dir(dir) else {
         return;
@@ -66,9 +82,9 @@ pub fn remove_leftover_temporaries(dir: &Path) {
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
         let ours = name.starts_with('.')
-            && name
-                .rsplit_once(".tmp-")
-                .is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+            && name.rsplit_once(".tmp-").is_some_and(|(_, pid)| {
+                !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit() || b == b'-')
+            });
         if ours {
             let _ = fs::remove_file(e.path());
         }
@@ -93,6 +109,7 @@ mod tests {
     fn leftovers_of_a_killed_run_are_swept_and_nothing_else() {
         let dir = tempfile::tempdir().unwrap();
         fs::write(dir.path().join(".a.obj.tmp-123"), b"half").unwrap();
+        fs::write(dir.path().join(".b.obj.tmp-123-456789"), b"half").unwrap();
         fs::write(dir.path().join("a.obj"), b"whole").unwrap();
         fs::write(dir.path().join(".notes.tmp-x"), b"user's").unwrap();
         remove_leftover_temporaries(dir.path());

@@ -17,12 +17,14 @@ use crate::params::Params;
 use crate::templates::Catalog;
 
 /// Writes the species directory (or removes an earlier build's when no tree has a species);
-/// returns its files for the manifest.
+/// returns its files for the manifest. `alone`: whether this run holds the directory alone
+/// (not a shard beside others), so it may sweep a killed run's temporaries.
 pub fn write_species(
     out: &Path,
     plan: &Plan,
     catalog: &Catalog,
     params: &Params,
+    alone: bool,
 ) -> std::io::Result<Vec<ManifestFile>> {
     let dir = out.join("species");
     let trees: Vec<_> = plan
@@ -38,7 +40,9 @@ pub fn write_species(
         return Ok(Vec::new());
     }
     std::fs::create_dir_all(&dir)?;
-    atomic::remove_leftover_temporaries(&dir);
+    if alone {
+        atomic::remove_leftover_temporaries(&dir);
+    }
     let mut files = Vec::new();
     let mut put = |name: String, bytes: &[u8]| -> std::io::Result<()> {
         atomic::write_atomic(&dir.join(&name), bytes)?;
