@@ -115,3 +115,44 @@ import json, collections; r = json.load(open('$work/out-30052/report.json')); t 
 g = [x['ground_bytes'] for x in t]
 print('ground bytes per tile (OBJ): mean', round(sum(g) / len(g)), 'max', max(g), '| of the tiles', round(100 * sum(g) / sum(x['obj_bytes'] for x in t), 2), '%')
 print('halls:', dict(collections.Counter((h['template'], 'placed' if h['placed'] else 'skipped') for h in r.get('halls', []))))"
+
+echo "== against the box-extrusion script (30,052 lots; scripts/box_extrude.py, pyshp; 5 runs of each, alternating)"
+python3 -c 'import shapefile' 2>/dev/null || python3 -m pip install --quiet pyshp 2>/dev/null \
+  || python3 -m pip install --quiet --break-system-packages pyshp
+cargo build --release --quiet --example raw_write
+printf '[trees]\nstyle = "lsystem"\n[people]\nmotion = "boids"\n' > "$work/all.toml"
+: > "$work/ab.txt"
+for i in $(seq 1 5); do
+  for what in script default all; do
+    rm -rf "$work/ab-$what"
+    start=$(date +%s.%N)
+    case $what in
+      script) python3 scripts/box_extrude.py "$work/town-30052/lots.shp" "$work/box.obj" ;;
+      default) $bin build "$work/town-30052" --out "$work/ab-$what" --quiet --format obj ;;
+      all) $bin build "$work/town-30052" --out "$work/ab-$what" --quiet --format obj,glb --params "$work/all.toml" ;;
+    esac
+    end=$(date +%s.%N)
+    case $what in
+      script) bytes=$(stat -c %s "$work/box.obj") ;;
+      *) bytes=$(du -sb --apparent-size "$work/ab-$what/tiles" | cut -f1) ;;
+    esac
+    raw=$(${CARGO_TARGET_DIR:-target}/release/examples/raw_write "$bytes" "$work/raw.obj")
+    rm -f "$work/raw.obj"
+    echo "$what $(echo "$end - $start" | bc -l) $bytes $raw" >> "$work/ab.txt"
+  done
+done
+python3 - "$work/ab.txt" <<'PY'
+import statistics, sys
+rows = [l.split() for l in open(sys.argv[1])]
+by = {}
+for what, wall, size, raw in rows:
+    by.setdefault(what, []).append((float(wall), int(size), float(raw)))
+med = {w: statistics.median(r[0] for r in v) for w, v in by.items()}
+for w, v in by.items():
+    walls = sorted(r[0] for r in v)
+    raw = statistics.median(r[2] for r in v)
+    print(f"{w:8s} median {med[w]:.2f} s ({walls[0]:.2f}-{walls[-1]:.2f}), {v[0][1] / 1e6:.1f} MB, "
+          f"raw write of those bytes {raw:.2f} s -> {med[w] / raw:.1f}x the raw write")
+print(f"default (OBJ) / script: {med['default'] / med['script']:.2f}; "
+      f"every feature, OBJ+GLB / script: {med['all'] / med['script']:.2f}")
+PY
