@@ -22,7 +22,12 @@ pub fn ridge(l: &Layout, s: &Settings) -> Vec<[f64; 3]> {
             dist[j * nx + i] = l
                 .stones
                 .iter()
-                .map(|st| ((x - st.x).hypot(y - st.y) - st.size / 2.0).max(0.0))
+                .map(|st| {
+                    // sqrt of the sum, not hypot: hypot guards against overflow that metres
+                    // never reach, and it was an eighth of a build's time here.
+                    let (dx, dy) = (x - st.x, y - st.y);
+                    ((dx * dx + dy * dy).sqrt() - st.size / 2.0).max(0.0)
+                })
                 .fold(f64::INFINITY, f64::min);
         }
     }
