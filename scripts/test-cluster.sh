@@ -13,8 +13,10 @@ LOTS=${EDO_CITY_CLUSTER_LOTS:-3000}
 TIMEOUT=${EDO_CITY_CLUSTER_TIMEOUT:-600}
 
 if [ -z "${EDO_CITY_CLUSTER_BIN:-}" ]; then
-  cargo build --release --quiet
-  export EDO_CITY_CLUSTER_BIN=$ROOT/target/release/edo-city
+  # The debug binary `make test` has just built: a release build would add minutes to CI
+  # for a town that takes seconds either way.
+  cargo build --quiet
+  export EDO_CITY_CLUSTER_BIN=$ROOT/target/debug/edo-city
 fi
 BIN=$EDO_CITY_CLUSTER_BIN
 # slurmd runs the jobs as root here (SlurmUser=root): go on through sudo when not root.
