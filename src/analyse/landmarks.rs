@@ -11,7 +11,9 @@ use std::sync::Arc;
 use geo::{ConvexHull, Distance, Euclidean, Intersects};
 use geo_types::{Coord, MultiPoint, Point, Polygon};
 
-use crate::model::landmark::{z_up, Displaced, PaletteEntry, PlacedLandmark, SkippedLandmark};
+use crate::model::landmark::{
+    z_up, Displaced, LandmarkReport, PaletteEntry, PlacedLandmark, SkippedLandmark,
+};
 use crate::model::{Dataset, KuraDecision, LandmarkRecord, Model, Plan, PlannedLandmark, Skipped};
 use crate::params::{Params, MAX_OFFSET, MAX_SIZE, MIN_SIZE};
 
@@ -42,20 +44,7 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
         };
         match place(r, model, data, params) {
             Ok(p) => placed.push(p),
-            Err(reason) => {
-                report.skipped.push(SkippedLandmark {
-                    id: r.id.clone(),
-                    record: r.record,
-                    reason: reason.clone(),
-                });
-                plan.skipped.push(Skipped {
-                    layer: "landmarks".into(),
-                    file: file.clone(),
-                    id: r.id.clone(),
-                    record: Some(r.record),
-                    reason,
-                });
-            }
+            Err(reason) => skip(&mut report, plan, &file, (&r.id, r.record), reason),
         }
     }
     let (palette, textures, bases) = palette(&placed, library);
@@ -66,18 +55,7 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
                  {MAX_MATERIAL_IDS}; merge materials in {}",
                 p.model.file
             );
-            report.skipped.push(SkippedLandmark {
-                id: p.id.clone(),
-                record: p.record,
-                reason: reason.clone(),
-            });
-            plan.skipped.push(Skipped {
-                layer: "landmarks".into(),
-                file: file.clone(),
-                id: p.id.clone(),
-                record: Some(p.record),
-                reason,
-            });
+            skip(&mut report, plan, &file, (&p.id, p.record), reason);
             continue;
         };
         p.material_base = base;
@@ -97,6 +75,29 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
     plan.palette = palette;
     plan.model_textures = textures;
     plan.landmark_report = report;
+}
+
+/// A landmark not placed: in the report's `landmarks.skipped` and the build's skipped list
+/// (so the ledger counts it).
+fn skip(
+    report: &mut LandmarkReport,
+    plan: &mut Plan,
+    file: &str,
+    (id, record): (&str, usize),
+    reason: String,
+) {
+    report.skipped.push(SkippedLandmark {
+        id: id.to_string(),
+        record,
+        reason: reason.clone(),
+    });
+    plan.skipped.push(Skipped {
+        layer: "landmarks".into(),
+        file: file.to_string(),
+        id: id.to_string(),
+        record: Some(record),
+        reason,
+    });
 }
 
 /// A record's model set on its point, or why it cannot be.

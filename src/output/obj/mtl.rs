@@ -11,7 +11,7 @@ use std::fmt::Write;
 
 use crate::generate::mesh::Mesh;
 use crate::materials::MATERIALS;
-use crate::output::palette::Palette;
+use crate::output::palette::{Entry, Palette};
 
 /// MTL text listing every material, for a tile in `tiles/`: textures are referenced as
 /// `textures/<file>` (the library is in `tiles/textures/`, no `..`).
@@ -31,29 +31,7 @@ pub fn tile_mtl_text(meshes: &[Mesh], palette: Palette) -> String {
     extra.sort_unstable();
     extra.dedup();
     for id in extra {
-        let m = palette.get(id);
-        let _ = writeln!(s, "\nnewmtl {}", m.name);
-        match m.texture {
-            Some(t) => {
-                let _ = writeln!(
-                    s,
-                    "# untextured colour: {:.3} {:.3} {:.3}",
-                    m.kd[0], m.kd[1], m.kd[2]
-                );
-                let _ = writeln!(
-                    s,
-                    "Ka 1.000 1.000 1.000\nKd 1.000 1.000 1.000\nKs 0.000 0.000 0.000\nd 1.0\n\
-                     illum 1\nmap_Kd textures/{t}"
-                );
-            }
-            None => {
-                let _ = writeln!(
-                    s,
-                    "Ka {0:.3} {1:.3} {2:.3}\nKd {0:.3} {1:.3} {2:.3}\nKs 0.000 0.000 0.000\nd 1.0\nillum 1",
-                    m.kd[0], m.kd[1], m.kd[2]
-                );
-            }
-        }
+        write_material(&mut s, &palette.get(id), "textures/");
     }
     s
 }
@@ -64,32 +42,39 @@ pub fn mtl_text_at(prefix: &str) -> String {
         "# edo-city {} materials; textures in {prefix}\n",
         env!("CARGO_PKG_VERSION")
     );
-    for m in MATERIALS {
-        let _ = writeln!(s, "\nnewmtl {}", m.name);
-        match m.texture {
-            Some(t) => {
-                let _ = writeln!(
-                    s,
-                    "# untextured colour: {:.3} {:.3} {:.3}",
-                    m.kd[0], m.kd[1], m.kd[2]
-                );
-                s.push_str("Ka 1.000 1.000 1.000\nKd 1.000 1.000 1.000\n");
-                let _ = writeln!(
-                    s,
-                    "Ks 0.000 0.000 0.000\nd 1.0\nillum 1\nmap_Kd {prefix}{t}"
-                );
-                if let (true, Some(mask)) = (m.alpha, m.mask) {
-                    let _ = writeln!(s, "map_d {prefix}{mask}");
-                }
-            }
-            None => {
-                let _ = writeln!(
-                    s,
-                    "Ka {0:.3} {1:.3} {2:.3}\nKd {0:.3} {1:.3} {2:.3}\nKs 0.000 0.000 0.000\nd 1.0\nillum 1",
-                    m.kd[0], m.kd[1], m.kd[2]
-                );
-            }
-        }
+    let library = Palette::LIBRARY;
+    for id in 0..MATERIALS.len() {
+        write_material(&mut s, &library.get(id as u16), prefix);
     }
     s
+}
+
+/// One `newmtl` block: a textured material white with its texture (and its alpha mask when
+/// it is cut out), an untextured one its colour.
+fn write_material(s: &mut String, m: &Entry, prefix: &str) {
+    let _ = writeln!(s, "\nnewmtl {}", m.name);
+    match m.texture {
+        Some(t) => {
+            let _ = writeln!(
+                s,
+                "# untextured colour: {:.3} {:.3} {:.3}",
+                m.kd[0], m.kd[1], m.kd[2]
+            );
+            s.push_str("Ka 1.000 1.000 1.000\nKd 1.000 1.000 1.000\n");
+            let _ = writeln!(
+                s,
+                "Ks 0.000 0.000 0.000\nd 1.0\nillum 1\nmap_Kd {prefix}{t}"
+            );
+            if let (true, Some(mask)) = (m.alpha, m.mask) {
+                let _ = writeln!(s, "map_d {prefix}{mask}");
+            }
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "Ka {0:.3} {1:.3} {2:.3}\nKd {0:.3} {1:.3} {2:.3}\nKs 0.000 0.000 0.000\nd 1.0\nillum 1",
+                m.kd[0], m.kd[1], m.kd[2]
+            );
+        }
+    }
 }
