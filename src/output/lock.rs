@@ -6,9 +6,9 @@
 //! an exclusive lock on `<out>/.edo-city.lock` and holds it until it returns; a second run
 //! refuses at once, naming the holder's process. Shards (`build --shard I/N`) write disjoint
 //! tiles and their own manifests, so they run together on a cluster's shared directory: each
-//! takes the lock shared, which keeps out a full build and `merge` while any shard runs. The lock is the operating system's (`flock`
-//! on Linux, through std's `File::lock`): it ends with the process, so a run killed by
-//! SIGKILL never blocks the next one. The holder removes the file before it lets go; a run
+//! takes the lock shared, which keeps out a full build and `merge` while any shard runs.
+//! The lock is the operating system's (`flock` on Linux, through std's `File::lock`): it ends
+//! with the process, so a run killed by SIGKILL never blocks the next one. The holder removes the file before it lets go; a run
 //! that locked a file which was removed meanwhile opens it again, so two runs never hold two
 //! different files of the same name.
 
