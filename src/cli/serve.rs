@@ -1,6 +1,6 @@
 //! `edo-city serve <out> [<more outs>]`: the web viewer and one or more builds of the same
-//! place (hypotheses, eras) on 127.0.0.1, with the right MIME types, by `tiny_http` (a small,
-//! synchronous, well-kept server: a static file server needs no async runtime).
+//! place (hypotheses, eras) on 127.0.0.1, with the right MIME types (the HTTP side in
+//! `serve/http.rs`: a thread per connection on `std::net`; it says why not a server crate).
 //!
 //! Routes: `/` the viewer page; `/viewer/<file>` its scripts; `/node_modules/<pkg>/...` the
 //! npm packages it imports (three.js, 3d-tiles-renderer), from `viewer/node_modules`;
@@ -11,6 +11,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+
+mod http;
 
 /// The flags of `edo-city serve`.
 #[derive(Args)]
@@ -174,13 +176,13 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
             "links": b.dir.join("links.json").is_file(),
         }))
         .collect::<Vec<_>>()))?;
-    let server = tiny_http::Server::http(("127.0.0.1", args.port))
-        .map_err(|e| anyhow::anyhow!("cannot listen on 127.0.0.1:{}: {e}", args.port))?;
-    let port = server
-        .server_addr()
-        .to_ip()
-        .map(|a| a.port())
-        .unwrap_or(args.port);
+    let listener = std::net::TcpListener::bind(("127.0.0.1", args.port)).with_context(|| {
+        format!(
+            "cannot listen on 127.0.0.1:{} (another server there? try --port 0)",
+            args.port
+        )
+    })?;
+    let port = listener.local_addr().map_or(args.port, |a| a.port());
     let url = format!("http://127.0.0.1:{port}/");
     // Printed once, ignoring a closed stdout: the server goes on whoever reads it.
     let mut text = format!("serving {} build(s) at {url}\n", builds.len());
@@ -197,52 +199,29 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
     if args.open {
         let _ = std::process::Command::new("xdg-open").arg(&url).spawn();
     }
-    let server = std::sync::Arc::new(server);
-    let shared = std::sync::Arc::new((viewer, builds, list));
-    let workers: Vec<_> = (0..4)
-        .map(|_| {
-            let (server, shared) = (server.clone(), shared.clone());
-            std::thread::spawn(move || {
-                for req in server.incoming_requests() {
-                    let (viewer, builds, list) = &*shared;
-                    answer(req, viewer, builds, list);
-                }
-            })
-        })
-        .collect();
-    for w in workers {
-        let _ = w.join();
-    }
+    let handler: http::Handler =
+        std::sync::Arc::new(move |req: &http::Request| answer(&req.url, &viewer, &builds, &list));
+    http::serve(listener, handler);
     Ok(())
 }
 
-/// Answers one request: a file, the hypotheses list, or 404.
-fn answer(req: tiny_http::Request, viewer: &Path, builds: &[Hypothesis], list: &[u8]) {
-    let header = |k: &str, v: &str| tiny_http::Header::from_bytes(k, v).expect("valid header");
-    if req.method() != &tiny_http::Method::Get && req.method() != &tiny_http::Method::Head {
-        let _ = req.respond(tiny_http::Response::empty(405));
-        return;
+/// The answer to a GET of `url`: a file, the hypotheses list, or 404.
+fn answer(url: &str, viewer: &Path, builds: &[Hypothesis], list: &[u8]) -> http::Response {
+    let no_cache = ("Cache-Control", "no-cache".to_string());
+    if url.split('?').next() == Some("/hypotheses.json") {
+        return http::Response {
+            status: 200,
+            headers: vec![("Content-Type", "application/json".into()), no_cache],
+            body: http::Body::Bytes(list.to_vec()),
+        };
     }
-    if req.url().split('?').next() == Some("/hypotheses.json") {
-        let r = tiny_http::Response::from_data(list.to_vec())
-            .with_header(header("Content-Type", "application/json"))
-            .with_header(header("Cache-Control", "no-cache"));
-        let _ = req.respond(r);
-        return;
-    }
-    match route(req.url(), viewer, builds).and_then(|p| Some((std::fs::File::open(&p).ok()?, p))) {
-        Some((file, path)) => {
-            let r = tiny_http::Response::from_file(file)
-                .with_header(header("Content-Type", mime(&path)))
-                .with_header(header("Cache-Control", "no-cache"));
-            let _ = req.respond(r);
-        }
-        None => {
-            let r = tiny_http::Response::from_string(format!("not found: {}", req.url()))
-                .with_status_code(404)
-                .with_header(header("Content-Type", "text/plain; charset=utf-8"));
-            let _ = req.respond(r);
-        }
+    match route(url, viewer, builds).and_then(|p| Some((std::fs::File::open(&p).ok()?, p))) {
+        Some((file, path)) => http::Response {
+            status: 200,
+            headers: vec![("Content-Type", mime(&path).into()), no_cache],
+            body: http::Body::File(file),
+        },
+        None => http::Response::text(404, format!("not found: {url}")),
     }
 }
 
