@@ -19,7 +19,7 @@ test: viewer-deps
 viewer-deps:
 	bash scripts/viewer-deps.sh
 
-## The suite again under faketime a year ahead and on a leap day (needs faketime:
+## The suite again under faketime on the first leap day a year or more ahead (needs faketime:
 ## scripts/ci-deps.sh installs it); CI runs it after `make test`.
 test-future:
 	bash scripts/test-future.sh
