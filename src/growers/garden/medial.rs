@@ -15,20 +15,20 @@ pub fn ridge(l: &Layout, s: &Settings) -> Vec<[f64; 3]> {
     let nx = ((s.width / s.cell).ceil() as usize).clamp(4, 400);
     let ny = ((s.depth / s.cell).ceil() as usize).clamp(4, 400);
     let (dx, dy) = (s.width / nx as f64, s.depth / ny as f64);
-    let mut dist = vec![0.0f64; nx * ny];
-    for j in 0..ny {
-        for i in 0..nx {
-            let (x, y) = ((i as f64 + 0.5) * dx, (j as f64 + 0.5) * dy);
-            dist[j * nx + i] = l
-                .stones
-                .iter()
-                .map(|st| {
-                    // sqrt of the sum, not hypot: hypot guards against overflow that metres
-                    // never reach, and it was an eighth of a build's time here.
-                    let (dx, dy) = (x - st.x, y - st.y);
-                    ((dx * dx + dy * dy).sqrt() - st.size / 2.0).max(0.0)
-                })
-                .fold(f64::INFINITY, f64::min);
+    // Stone by stone over whole rows (the min of the same values in the same order as cell by
+    // cell, so the same bits), which the compiler vectorises; the sqrt of the sum, not hypot:
+    // hypot guards against overflow that metres never reach, and it was an eighth of a build.
+    let xs: Vec<f64> = (0..nx).map(|i| (i as f64 + 0.5) * dx).collect();
+    let mut dist = vec![f64::INFINITY; nx * ny];
+    for st in &l.stones {
+        let half = st.size / 2.0;
+        for (j, row) in dist.chunks_exact_mut(nx).enumerate() {
+            let ddy = (j as f64 + 0.5) * dy - st.y;
+            let ddy2 = ddy * ddy;
+            for (d, &x) in row.iter_mut().zip(&xs) {
+                let ddx = x - st.x;
+                *d = d.min(((ddx * ddx + ddy2).sqrt() - half).max(0.0));
+            }
         }
     }
     let at = |i: usize, j: usize| dist[j * nx + i];
