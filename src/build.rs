@@ -123,8 +123,11 @@ pub struct Timings {
     pub analyse: Duration,
     /// Of `analyse`: kura placement, the R-tree of provisional plots and its queries.
     pub kura: Duration,
-    /// Of `analyse`: people and trees (obstacle R-tree, Poisson draws, thinning).
+    /// Of `analyse`: halls, gardens, people and trees, ground (obstacle R-trees, the
+    /// gardens' GA, Poisson draws, thinning).
     pub billboards: Duration,
+    /// Of `billboards`, step by step.
+    pub steps: Vec<(&'static str, Duration)>,
     /// Generating and writing the selected tiles (wall time).
     pub generate_and_write: Duration,
     /// Drawing plan.png.
@@ -294,6 +297,7 @@ fn run(
     timings.analyse = analysed;
     timings.kura = plan.kura_time;
     timings.billboards = plan.billboards_time;
+    timings.steps = plan.step_times.clone();
     // After reading (a mistyped input is reported as that), before writing anything: one
     // run at a time in the directory, and never a second hypothesis in it.
     let existed = opts.out.exists();

@@ -153,14 +153,19 @@ struct Candidate {
 
 /// Plans the people and trees of the whole city into `plan.billboards`: from the point
 /// layers when the data has them, else generated.
-pub fn plan_billboards(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: &Params) {
+pub fn plan_billboards(
+    data: &Dataset,
+    plan: &mut Plan,
+    obstacles: &Obstacles,
+    catalog: &Catalog,
+    params: &Params,
+) {
     let people = &params.people;
     let trees = &params.trees;
     if !people.enabled && !trees.enabled {
         return;
     }
     let near = Surroundings::new(data);
-    let obstacles = Obstacles::of_plan(plan, catalog, params);
     let mut all = Vec::new();
     for kind in [BillboardKind::Person, BillboardKind::Tree] {
         let k = Kind::of(kind, params);
@@ -655,7 +660,9 @@ fn keep_spaced(points: Vec<PlannedBillboard>, spacing: f64) -> Vec<PlannedBillbo
             (c.y / spacing).floor() as i64,
         )
     };
-    let mut grid: HashMap<(i64, i64), Vec<Coord<f64>>> = HashMap::new();
+    // Looked up, never iterated: the hasher changes no result (foldhash: SipHash showed up).
+    let mut grid: HashMap<(i64, i64), Vec<Coord<f64>>, foldhash::fast::FixedState> =
+        HashMap::default();
     let mut kept = Vec::new();
     for b in points {
         let (i, j) = cell(b.at);

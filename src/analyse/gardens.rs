@@ -25,7 +25,6 @@ use crate::model::{
     tile::tile_id, Dataset, FenceKind, GardenArea, GardenStat, Lot, Plan, PlannedGarden, Skipped,
 };
 use crate::params::Params;
-use crate::templates::Catalog;
 
 /// Where one garden is to go: a lot of `garden.uses`, or a polygon of the gardens layer.
 struct Site<'a> {
@@ -48,13 +47,11 @@ struct Site<'a> {
 
 /// Plans every garden into `plan.gardens` and reports each lot in `plan.garden_reports`;
 /// a gardens-layer polygon that gets none is also in `plan.skipped`, with the reason.
-pub fn plan_gardens(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: &Params) {
+pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, params: &Params) {
     let g = &params.garden;
     if !g.enabled {
         return;
     }
-    // No garden is planned yet: the plan's houses, kura, fences and gates.
-    let obstacles = Obstacles::of_plan(plan, catalog, params);
     // A lot's viewpoint: the middle of its first hall (a temple's main hall, whose veranda
     // a garden is seen from, as Ryoanji's from its hojo), else its first gate.
     let mut gates: HashMap<&str, Coord<f64>> = HashMap::new();

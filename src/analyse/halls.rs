@@ -32,6 +32,7 @@ pub fn plan_halls(
     data: &Dataset,
     plan: &mut Plan,
     edges: &StreetEdges,
+    obstacles: &Obstacles,
     catalog: &Catalog,
     params: &Params,
 ) {
@@ -39,7 +40,6 @@ pub fn plan_halls(
     if !h.enabled || h.uses.values().all(Vec::is_empty) {
         return;
     }
-    let obstacles = Obstacles::of_plan(plan, catalog, params);
     // A lot's first gate (its wall segment) faces the hall.
     let mut gates: HashMap<&str, (Coord<f64>, Coord<f64>)> = HashMap::new();
     for f in plan.fences.values().flatten() {

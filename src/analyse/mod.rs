@@ -137,11 +137,32 @@ pub fn analyse(
         landmarks::plan_landmarks(data, &mut plan, params, crate::materials::MATERIALS.len());
     }
     let t = std::time::Instant::now();
-    halls::plan_halls(data, &mut plan, &edges, catalog, params);
-    gardens::plan_gardens(data, &mut plan, catalog, params);
-    billboards::plan_billboards(data, &mut plan, catalog, params);
-    trees::plant(data, &mut plan, catalog, params);
-    ground::plan_ground(data, &mut plan, params);
+    let step = |name: &'static str, plan: &mut Plan, f: &dyn Fn(&mut Plan)| {
+        let t = std::time::Instant::now();
+        f(plan);
+        plan.step_times.push((name, t.elapsed()));
+    };
+    // What people, trees, gardens and halls keep out of: built once (houses, kura, fences,
+    // landmarks), then each step's halls and gardens added for the steps after it.
+    let mut obstacles = obstacles::Obstacles::of_plan(&plan, catalog, params);
+    plan.step_times.push(("obstacles", t.elapsed()));
+    step("halls", &mut plan, &|p| {
+        halls::plan_halls(data, p, &edges, &obstacles, catalog, params)
+    });
+    obstacles.add_areas(plan.halls.values().flatten().map(|h| h.outline()));
+    step("gardens", &mut plan, &|p| {
+        gardens::plan_gardens(data, p, &obstacles, params)
+    });
+    obstacles.add_areas(plan.gardens.values().flatten().map(|g| g.outline()));
+    step("people and billboard trees", &mut plan, &|p| {
+        billboards::plan_billboards(data, p, &obstacles, catalog, params)
+    });
+    step("grown trees", &mut plan, &|p| {
+        trees::plant(data, p, &obstacles, catalog, params)
+    });
+    step("ground", &mut plan, &|p| {
+        ground::plan_ground(data, p, params)
+    });
     plan.billboards_time = t.elapsed();
     if off_dem > 0 {
         if let Some(dem) = &data.dem {

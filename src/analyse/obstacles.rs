@@ -8,6 +8,7 @@
 
 use geo::{Contains, Distance, Euclidean};
 use geo_types::{Coord, Point, Polygon};
+use rayon::prelude::*;
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
@@ -47,29 +48,32 @@ impl Obstacles {
         catalog: &Catalog,
         params: &Params,
     ) -> Obstacles {
-        let mut items = Vec::new();
-        for m in houses {
-            let f = frame_of(m);
-            let depth = local_ring(m, f).iter().map(|p| p[1]).fold(0.0, f64::max);
-            items.push(Obstacle::House {
-                outline: m.outline.clone(),
-                a: f.a,
-                v: f.v,
-                v_max: house_end(m, depth, catalog, params),
-            });
-            if let Some(r) = m.kura.to_build(params.kura.collision) {
-                let q = f.quad(r);
-                items.push(Obstacle::Rect(Polygon::new(
-                    q.iter().chain(&q[..1]).copied().collect(),
-                    vec![],
-                )));
-            }
-        }
+        Obstacles::build(houses, fences, std::iter::empty(), catalog, params)
+    }
+
+    /// Houses (in parallel: a city has hundreds of thousands), fences and areas, then one
+    /// bulk load.
+    fn build<'a>(
+        houses: impl Iterator<Item = &'a PlannedHouse>,
+        fences: impl Iterator<Item = &'a PlannedFence>,
+        areas: impl Iterator<Item = Vec<Coord<f64>>>,
+        catalog: &Catalog,
+        params: &Params,
+    ) -> Obstacles {
+        let houses: Vec<&PlannedHouse> = houses.collect();
+        let mut items: Vec<Obstacle> = houses
+            .par_iter()
+            .map(|m| house_obstacles(m, catalog, params))
+            .collect::<Vec<_>>()
+            .into_iter()
+            .flatten()
+            .collect();
         for s in fences {
             items.push(Obstacle::Wall([s.a.x, s.a.y], [s.b.x, s.b.y]));
         }
+        items.extend(areas.map(area));
         let boxes = items
-            .iter()
+            .par_iter()
             .enumerate()
             .filter_map(|(i, o)| Some(GeomWithData::new(envelope(o)?, i)))
             .collect();
@@ -82,13 +86,9 @@ impl Obstacles {
     /// Everything `plan` builds so far: houses, kura, fences and gates, halls, rock gardens
     /// and the landmarks' footprints.
     pub fn of_plan(plan: &crate::model::Plan, catalog: &Catalog, params: &Params) -> Obstacles {
-        Obstacles::new(
+        Obstacles::build(
             plan.houses.values().flatten(),
             plan.fences.values().flatten(),
-            catalog,
-            params,
-        )
-        .with_areas(
             plan.halls
                 .values()
                 .flatten()
@@ -101,29 +101,22 @@ impl Obstacles {
                         .map(|l| crate::geom::ring::open(l.footprint.exterior()).to_vec())
                         .filter(|r| r.len() >= 3),
                 ),
+            catalog,
+            params,
         )
     }
 
-    /// The same with more rectangles (halls' plots, rock gardens) as obstacles too: gardens,
-    /// trees and people keep out.
-    pub fn with_areas(mut self, areas: impl Iterator<Item = Vec<Coord<f64>>>) -> Obstacles {
-        let mut added = false;
-        for mut ring in areas {
-            ring.push(ring[0]);
-            self.items
-                .push(Obstacle::Rect(Polygon::new(ring.into(), vec![])));
-            added = true;
+    /// More rectangles (halls' plots, rock gardens) as obstacles too, so the steps after them
+    /// keep out; inserted into the tree ([`Obstacles::hit`] asks only whether any obstacle is
+    /// hit, so the tree's shape never changes an answer).
+    pub fn add_areas(&mut self, areas: impl Iterator<Item = Vec<Coord<f64>>>) {
+        for ring in areas {
+            let o = area(ring);
+            if let Some(e) = envelope(&o) {
+                self.tree.insert(GeomWithData::new(e, self.items.len()));
+            }
+            self.items.push(o);
         }
-        if added {
-            let boxes = self
-                .items
-                .iter()
-                .enumerate()
-                .filter_map(|(i, o)| Some(GeomWithData::new(envelope(o)?, i)))
-                .collect();
-            self.tree = RTree::bulk_load(boxes);
-        }
-        self
     }
 
     /// Whether `p` lies in an obstacle or within `clearance` of one.
@@ -134,6 +127,34 @@ impl Obstacles {
             .locate_in_envelope_intersecting(&query)
             .any(|g| hits(&self.items[g.data], p, clearance.max(0.0)))
     }
+}
+
+/// A house's obstacles: its built band, and its kura when one is built.
+fn house_obstacles(m: &PlannedHouse, catalog: &Catalog, params: &Params) -> Vec<Obstacle> {
+    let f = frame_of(m);
+    let depth = local_ring(m, f).iter().map(|p| p[1]).fold(0.0, f64::max);
+    let mut out = vec![Obstacle::House {
+        outline: m.outline.clone(),
+        a: f.a,
+        v: f.v,
+        v_max: house_end(m, depth, catalog, params),
+    }];
+    if let Some(r) = m.kura.to_build(params.kura.collision) {
+        let q = f.quad(r);
+        out.push(Obstacle::Rect(Polygon::new(
+            q.iter().chain(&q[..1]).copied().collect(),
+            vec![],
+        )));
+    }
+    out
+}
+
+/// An open ring as a closed rectangle-like obstacle.
+fn area(mut ring: Vec<Coord<f64>>) -> Obstacle {
+    if let Some(&first) = ring.first() {
+        ring.push(first);
+    }
+    Obstacle::Rect(Polygon::new(ring.into(), vec![]))
 }
 
 fn envelope(o: &Obstacle) -> Option<Rectangle<[f64; 2]>> {

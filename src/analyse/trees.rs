@@ -30,12 +30,17 @@ use crate::templates::{Catalog, Species};
 pub const MIN_HEIGHT: f64 = 1.5;
 
 /// Gives every tree of the plan its species, height and crown (see the module's doc).
-pub fn plant(data: &Dataset, plan: &mut Plan, catalog: &Catalog, params: &Params) {
+pub fn plant(
+    data: &Dataset,
+    plan: &mut Plan,
+    obstacles: &Obstacles,
+    catalog: &Catalog,
+    params: &Params,
+) {
     if !params.trees.enabled || plan.billboards.is_empty() {
         return;
     }
     let lots = LotIndex::new(data);
-    let obstacles = Obstacles::of_plan(plan, catalog, params);
     let mut crowns = Crowns::default();
     let given: HashMap<&str, bool> = data
         .trees

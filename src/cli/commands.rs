@@ -69,6 +69,13 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
             t.plan.as_secs_f64(),
             t.total.as_secs_f64()
         );
+        // "people and trees" above is every step after the fences; here each of them.
+        let steps: Vec<String> = t
+            .steps
+            .iter()
+            .map(|(name, d)| format!("{name} {:.3} s", d.as_secs_f64()))
+            .collect();
+        eprintln!("timings of the steps after fences: {}", steps.join(", "));
     }
     Ok(())
 }

@@ -603,8 +603,10 @@ pub struct Plan {
     pub warnings: Vec<Warning>,
     /// Time spent placing kura and testing their provisional plots (for `--timings`).
     pub kura_time: std::time::Duration,
-    /// Time spent placing people and trees.
+    /// Time spent placing halls, gardens, people and trees and the ground.
     pub billboards_time: std::time::Duration,
+    /// Of `billboards_time`, each step by name (for `--timings`).
+    pub step_times: Vec<(&'static str, std::time::Duration)>,
     /// Fence segments and gates per tile, in input order (each of these tiles is in
     /// `tiles`).
     pub fences: BTreeMap<TileId, Vec<PlannedFence>>,
