@@ -25,7 +25,8 @@ pub struct BuildArgs {
     /// No progress bars and no summary.
     #[arg(short, long)]
     pub quiet: bool,
-    /// Print the time of each stage.
+    /// Print the time of each stage, then of each step after the fences (obstacles, halls,
+    /// gardens, people and trees, ground).
     #[arg(long)]
     pub timings: bool,
     /// Do not draw <out>/plan.png (lots by type, streets, each house's frontage, tiles).
