@@ -179,7 +179,7 @@ pub fn plan_billboards(
         // Given points are all kept; generated ones are thinned to the minimum spacing.
         let spacing = if given.is_some() { 0.0 } else { k.min_spacing };
         let candidates = match given {
-            Some(points) => from_points(points, &k, &near, &obstacles, params, plan),
+            Some(points) => from_points(points, &k, &near, obstacles, params, plan),
             None => {
                 let mut sources = match kind {
                     BillboardKind::Person => street_sources(data, &near, params),
@@ -201,7 +201,7 @@ pub fn plan_billboards(
                                 .reduce(f64::min),
                             &k,
                             &near,
-                            &obstacles,
+                            obstacles,
                             params,
                         )
                     })

@@ -119,7 +119,7 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, para
     }
     let results: Vec<(GardenStat, Option<PlannedGarden>)> = sites
         .par_iter()
-        .map(|site| design(site, &obstacles, params))
+        .map(|site| design(site, obstacles, params))
         .collect();
     for ((stat, garden), site) in results.into_iter().zip(&sites) {
         if let (false, Some((id, record))) = (stat.placed, &site.area) {

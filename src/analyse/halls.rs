@@ -57,7 +57,7 @@ pub fn plan_halls(
         .par_iter()
         .map(|(lot, names)| {
             let gate = gates.get(lot.id.as_str()).copied();
-            let mut halls = place_lot(lot, names, gate, edges, &obstacles, catalog, params);
+            let mut halls = place_lot(lot, names, gate, edges, obstacles, catalog, params);
             if let Some(dem) = &data.dem {
                 // On the DEM, a hall's flat base is the lowest ground under its plot, as a
                 // house's is under its lot: never floating.

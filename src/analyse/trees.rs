@@ -143,7 +143,7 @@ pub fn plant(
                     boundary_distance(b.at, &data.lots[l].outline)
                 });
                 let room = (edge - params.trees.clearance).min(obstacle_room(
-                    &obstacles,
+                    obstacles,
                     b.at,
                     crown,
                     params.trees.clearance,
