@@ -83,9 +83,11 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, para
         .find(|l| l.role == "gardens")
         .map(|l| l.file.clone())
         .unwrap_or_default();
+    // The first lot (input order) holding the area's centre, found through the lots' boxes.
+    let index = (!data.gardens.is_empty()).then(|| super::lot_index::LotIndex::new(data));
     let holder = |area: &GardenArea| -> Option<&Lot> {
         let c = area.outline.centroid()?;
-        data.lots.iter().find(|l| l.outline.contains(&c))
+        Some(&data.lots[index.as_ref()?.containing(c.0)?])
     };
     let mut sites: Vec<Site> = Vec::new();
     let mut drawn: HashSet<&str> = HashSet::new();

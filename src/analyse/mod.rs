@@ -11,6 +11,7 @@ pub mod halls;
 pub mod house;
 pub mod kura;
 pub mod landmarks;
+pub mod lot_index;
 pub mod obstacles;
 pub mod room;
 pub mod street;

@@ -11,11 +11,8 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use geo::{BoundingRect, Contains};
-use geo_types::{Coord, Point};
+use geo_types::Coord;
 use rand::RngExt;
-use rstar::primitives::{GeomWithData, Rectangle};
-use rstar::{RTree, AABB};
 
 use super::obstacles::{boundary_distance, Obstacles};
 use crate::model::{
@@ -40,7 +37,7 @@ pub fn plant(
     if !params.trees.enabled || plan.billboards.is_empty() {
         return;
     }
-    let lots = LotIndex::new(data);
+    let lots = super::lot_index::LotIndex::new(data);
     let mut crowns = Crowns::default();
     let given: HashMap<&str, bool> = data
         .trees
@@ -287,42 +284,5 @@ impl Crowns {
                 Ok(r / h)
             })
             .clone()
-    }
-}
-
-/// The lots by their bounding boxes, for finding the lot a tree stands in.
-struct LotIndex<'a> {
-    data: &'a Dataset,
-    tree: RTree<GeomWithData<Rectangle<[f64; 2]>, usize>>,
-}
-
-impl<'a> LotIndex<'a> {
-    fn new(data: &'a Dataset) -> LotIndex<'a> {
-        let boxes = data
-            .lots
-            .iter()
-            .enumerate()
-            .filter_map(|(i, l)| {
-                let r = l.outline.bounding_rect()?;
-                Some(GeomWithData::new(
-                    Rectangle::from_corners([r.min().x, r.min().y], [r.max().x, r.max().y]),
-                    i,
-                ))
-            })
-            .collect();
-        LotIndex {
-            data,
-            tree: RTree::bulk_load(boxes),
-        }
-    }
-
-    /// The first lot (in input order) whose outline holds `p`.
-    fn containing(&self, p: Coord<f64>) -> Option<usize> {
-        let q = AABB::from_point([p.x, p.y]);
-        self.tree
-            .locate_in_envelope_intersecting(&q)
-            .map(|g| g.data)
-            .filter(|&i| self.data.lots[i].outline.contains(&Point(p)))
-            .min()
     }
 }
