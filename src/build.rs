@@ -93,6 +93,14 @@ pub enum Selection {
     },
 }
 
+impl Selection {
+    /// Whether this run is one shard of several writing into one directory at once: it shares
+    /// the output lock and leaves the others' temporaries alone.
+    pub fn is_shard(&self) -> bool {
+        matches!(self, Selection::Shard { .. })
+    }
+}
+
 /// What to build, already validated by the CLI.
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
@@ -303,9 +311,9 @@ fn run(
     let existed = opts.out.exists();
     std::fs::create_dir_all(&opts.out).map_err(|e| write_err(&opts.out, e))?;
     // Shards of one city write disjoint tiles: they share the directory.
-    let lock = match opts.selection {
-        Selection::Shard { .. } => output::lock::OutLock::acquire_shared(&opts.out),
-        _ => output::lock::OutLock::acquire(&opts.out),
+    let lock = match opts.selection.is_shard() {
+        true => output::lock::OutLock::acquire_shared(&opts.out),
+        false => output::lock::OutLock::acquire(&opts.out),
     };
     let lock = lock.map_err(|e| {
         if !existed {
@@ -369,7 +377,7 @@ fn write_city(
     std::fs::create_dir_all(&tiles_dir).map_err(|e| write_err(&tiles_dir, e))?;
     // A run killed before its renames leaves temporaries; they are never valid output. Shards
     // leave them (the shards beside them are writing theirs); a full build or merge sweeps.
-    let alone = !matches!(opts.selection, Selection::Shard { .. });
+    let alone = !opts.selection.is_shard();
     if alone {
         for dir in [&opts.out, &tiles_dir, &opts.out.join(output::TEXTURE_DIR)] {
             output::atomic::remove_leftover_temporaries(dir);
