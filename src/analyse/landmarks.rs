@@ -11,6 +11,7 @@ use std::sync::Arc;
 use geo::{ConvexHull, Distance, Euclidean, Intersects};
 use geo_types::{Coord, MultiPoint, Point, Polygon};
 
+use super::lot_index::LotIndex;
 use crate::model::landmark::{
     z_up, Displaced, LandmarkReport, PaletteEntry, PlacedLandmark, SkippedLandmark,
 };
@@ -37,12 +38,14 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
             reason: s.reason.clone(),
         });
     }
+    // The lots' R-tree, built when the first landmark needs the lot it stands in.
+    let lots = std::cell::OnceCell::new();
     let mut placed = Vec::new();
     for r in &data.landmarks {
         let Some(model) = data.models.get(&r.model) else {
             continue;
         };
-        match place(r, model, data, params) {
+        match place(r, model, data, &lots, params) {
             Ok(p) => placed.push(p),
             Err(reason) => skip(&mut report, plan, &file, (&r.id, r.record), reason),
         }
@@ -101,10 +104,11 @@ fn skip(
 }
 
 /// A record's model set on its point, or why it cannot be.
-fn place(
+fn place<'a>(
     r: &LandmarkRecord,
     model: &Arc<Model>,
-    data: &Dataset,
+    data: &'a Dataset,
+    lots: &std::cell::OnceCell<LotIndex<'a>>,
     params: &Params,
 ) -> Result<PlannedLandmark, String> {
     let lp = &params.landmarks;
@@ -131,7 +135,7 @@ fn place(
         "origin" => [0.0; 3],
         _ => [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, lo[2]],
     };
-    let z = ground(r, data, params)?;
+    let z = ground(r, data, lots, params)?;
     let mut p = PlannedLandmark {
         id: r.id.clone(),
         record: r.record,
@@ -198,7 +202,12 @@ fn model_box(model: &Model, z_is_up: bool) -> ([f64; 3], [f64; 3]) {
 }
 
 /// The elevation a landmark stands on, by `landmarks.ground`.
-fn ground(r: &LandmarkRecord, data: &Dataset, params: &Params) -> Result<f64, String> {
+fn ground<'a>(
+    r: &LandmarkRecord,
+    data: &'a Dataset,
+    lots: &std::cell::OnceCell<LotIndex<'a>>,
+    params: &Params,
+) -> Result<f64, String> {
     let l = &params.layers.landmarks;
     match params.landmarks.ground.as_str() {
         "given" => r.z.ok_or_else(|| {
@@ -216,27 +225,29 @@ fn ground(r: &LandmarkRecord, data: &Dataset, params: &Params) -> Result<f64, St
                     .into(),
             ),
         },
-        _ => Ok(lot_ground(r.at, data)),
+        _ => Ok(lot_ground(
+            r.at,
+            data,
+            lots.get_or_init(|| LotIndex::new(data)),
+        )),
     }
 }
 
-/// The ground of the lot holding `at`, else of the nearest lot, else 0 (or the DEM there).
-fn lot_ground(at: Coord<f64>, data: &Dataset) -> f64 {
-    use geo::Contains;
-    let p = Point::from(at);
-    if let Some(l) = data.lots.iter().find(|l| l.outline.contains(&p)) {
-        return l.ground;
+/// The ground of the lot holding `at`; else the DEM there when there is one, else the ground of
+/// the nearest lot, else 0.
+fn lot_ground(at: Coord<f64>, data: &Dataset, lots: &LotIndex) -> f64 {
+    if let Some(i) = lots.containing(at) {
+        return data.lots[i].ground;
     }
-    let nearest = data
-        .lots
+    if let Some(dem) = &data.dem {
+        return dem.sample(at).z;
+    }
+    let p = Point::from(at);
+    data.lots
         .iter()
         .map(|l| (Euclidean.distance(&p, &l.outline), l.ground))
-        .min_by(|a, b| a.0.total_cmp(&b.0));
-    match (nearest, &data.dem) {
-        (_, Some(dem)) => dem.sample(at).z,
-        (Some((_, z)), None) => z,
-        (None, None) => 0.0,
-    }
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(0.0, |(_, z)| z)
 }
 
 /// The palette of the models placed (in the order of their file names), their textures, and
