@@ -8,9 +8,9 @@
 //! tiles and their own manifests, so they run together on a cluster's shared directory: each
 //! takes the lock shared, which keeps out a full build and `merge` while any shard runs.
 //! The lock is the operating system's (`flock` on Linux, through std's `File::lock`): it ends
-//! with the process, so a run killed by SIGKILL never blocks the next one. The holder removes the file before it lets go; a run
-//! that locked a file which was removed meanwhile opens it again, so two runs never hold two
-//! different files of the same name.
+//! with the process, so a run killed by SIGKILL never blocks the next one. The holder removes
+//! the file before it lets go; a run that locked a file which was removed meanwhile opens it
+//! again, so two runs never hold two different files of the same name.
 
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Seek, SeekFrom, Write};

@@ -83,10 +83,9 @@ fn connection(
     stream.set_write_timeout(Some(IDLE))?;
     let _ = stream.set_nodelay(true);
     let mut reader = BufReader::new(stream.try_clone()?);
-    let response = match read_head(&mut reader)? {
+    let (response, head_only) = match read_head(&mut reader)? {
         Head::Request(req) if req.method == "GET" || req.method == "HEAD" => {
-            let head_only = req.method == "HEAD";
-            (handler(&req), head_only)
+            (handler(&req), req.method == "HEAD")
         }
         Head::Request(_) => (Response::text(405, "only GET and HEAD\n".into()), false),
         Head::TooLong => (Response::text(431, "request head too long\n".into()), false),
@@ -94,7 +93,7 @@ fn connection(
         Head::Closed => return Ok(()),
     };
     let mut out = io::BufWriter::new(&stream);
-    write_response(&mut out, response.0, response.1)?;
+    write_response(&mut out, response, head_only)?;
     out.flush()?;
     drop(out);
     stream.shutdown(Shutdown::Write)
