@@ -119,7 +119,9 @@ fn segment(a: Coord<f64>, b: Coord<f64>) -> Segment {
 
 /// A source of generated points: a street piece or a lot.
 struct Source<'a> {
-    id: String,
+    /// The lot's id, or the street piece's (made here); borrowed where it can be, since a
+    /// city has a source for nearly every lot.
+    id: std::borrow::Cow<'a, str>,
     /// The tiles its points may fall in, with the share of its area in each: its expected
     /// count is charged against their `max_points_per_tile` by these shares.
     tiles: Vec<(String, f64)>,
@@ -350,7 +352,7 @@ fn street_sources<'a>(data: &'a Dataset, near: &Surroundings<'a>, p: &Params) ->
                 let density =
                     p.district_density(district, |d| d.people_per_100m, p.people.per_100m);
                 out.push(Source {
-                    id: format!("{}/{}", super::crowds::stretch_id(&s.id, k), j + 1),
+                    id: format!("{}/{}", super::crowds::stretch_id(&s.id, k), j + 1).into(),
                     tiles: vec![(tile_id(mid, p.tile_size, p.tile_origin), 1.0)],
                     district,
                     expected: len / pieces as f64 / 100.0 * density,
@@ -386,7 +388,8 @@ fn lot_sources<'a>(
         let end = super::house::house_end(m, depth, catalog, p);
         built.insert(m.id.as_str(), if depth > 0.0 { end / depth } else { 1.0 });
     }
-    let mut out = Vec::new();
+    // Nearly every lot is a source: one allocation, not a doubling chain of copies.
+    let mut out = Vec::with_capacity(data.lots.len());
     for lot in &data.lots {
         let district = lot.district.as_deref();
         let (density, open) = if t.uses.iter().any(|u| u == lot.lot_use.name()) {
@@ -412,7 +415,7 @@ fn lot_sources<'a>(
             continue;
         }
         out.push(Source {
-            id: lot.id.clone(),
+            id: lot.id.as_str().into(),
             tiles: tiles_under(bb, c.0, p),
             district,
             expected: planted * density / 10_000.0,

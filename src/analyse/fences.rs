@@ -83,7 +83,7 @@ fn template_of(lot: &Lot, params: &Params) -> String {
 }
 
 /// A line's value of the attribute `field` (case ignored), trimmed.
-fn attr<'a>(attrs: &'a std::collections::BTreeMap<String, String>, field: &str) -> Option<&'a str> {
+fn attr<'a>(attrs: &'a crate::model::Attrs, field: &str) -> Option<&'a str> {
     attrs
         .iter()
         .find(|(k, _)| k.eq_ignore_ascii_case(field))
@@ -199,7 +199,7 @@ pub const MAX_WALL_HEIGHT: f64 = 100.0;
 /// number, not above 0, over [`MAX_WALL_HEIGHT`]) gives a warning naming the feature, and
 /// the template's own height stands.
 fn height_attr(
-    attrs: &std::collections::BTreeMap<String, String>,
+    attrs: &crate::model::Attrs,
     params: &Params,
     what: &str,
     warnings: &mut Vec<crate::model::Warning>,
@@ -230,7 +230,7 @@ fn height_attr(
 
 /// The gate of a walled outline or line, or a warning.
 fn gate_of(
-    attrs: &std::collections::BTreeMap<String, String>,
+    attrs: &crate::model::Attrs,
     pts: &[Coord<f64>],
     edges: &StreetEdges,
     params: &Params,

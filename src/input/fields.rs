@@ -58,7 +58,7 @@ pub struct AttributeRule {
 impl AttributeRule {
     /// The attribute's value for a feature: the field (trimmed), else the constant, then the
     /// value map applied. `None` when all are empty.
-    pub fn value(&self, attrs: &BTreeMap<String, String>) -> Option<String> {
+    pub fn value(&self, attrs: &crate::model::Attrs) -> Option<String> {
         let raw = self
             .field
             .as_ref()
@@ -81,11 +81,11 @@ mod tests {
             constant: Some("machiya".into()),
             values: [("1".to_string(), "buke".to_string())].into(),
         };
-        let mut attrs = BTreeMap::new();
+        let mut attrs = crate::model::Attrs::default();
         assert_eq!(rule.value(&attrs).as_deref(), Some("machiya"));
-        attrs.insert("youto".into(), " 1 ".into());
+        attrs.insert("youto".into(), " 1 ");
         assert_eq!(rule.value(&attrs).as_deref(), Some("buke"));
-        attrs.insert("youto".into(), "7".into());
+        attrs.insert("youto".into(), "7");
         assert_eq!(rule.value(&attrs).as_deref(), Some("7"));
     }
 

@@ -607,23 +607,24 @@ fn singular(layer: &str) -> &str {
 }
 
 /// Applies a table to the lots by id, table values winning; returns the match counts. A row
-/// with no lot is skipped and reported.
+/// with no lot is skipped and reported. `base_ids` holds each lot's record id.
 fn join(
     lots: &mut [Lot],
+    base_ids: &[String],
     mut table: table::Table,
     layer: &str,
     skipped: &mut Vec<Skipped>,
 ) -> TableJoin {
     let mut index: HashMap<String, Vec<usize>> = HashMap::new();
-    for (i, lot) in lots.iter().enumerate() {
+    for (i, (lot, base)) in lots.iter().zip(base_ids).enumerate() {
         // Parts of a multipart lot share their record's id; a row applies to all of them.
-        let base = lot.attrs.get("\u{0}base_id").cloned().unwrap_or_default();
         index.entry(base.clone()).or_default().push(i);
-        if lot.id != base {
+        if lot.id != *base {
             index.entry(lot.id.clone()).or_default().push(i);
         }
     }
     let mut matched_lots = vec![false; lots.len()];
+    let mut names = crate::model::FieldNames::default();
     let mut out = TableJoin {
         layer: layer.to_string(),
         file: table.file.clone(),
@@ -640,7 +641,7 @@ fn join(
                 for &i in targets {
                     matched_lots[i] = true;
                     for (k, v) in &values {
-                        lots[i].attrs.insert(k.clone(), v.clone());
+                        lots[i].attrs.insert(names.intern(k), v.as_str());
                     }
                 }
             }

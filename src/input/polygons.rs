@@ -49,6 +49,8 @@ pub(super) fn read_lots(
 
     let mut seen = HashSet::new();
     let mut lots = Vec::with_capacity(o.layer.features.len());
+    // Each lot's record id (a multipart record's parts share it), for the table join.
+    let mut base_ids = Vec::with_capacity(o.layer.features.len());
     // The features are used up here: their attributes move into the lots.
     let features = std::mem::take(&mut o.layer.features);
     let o = &*o;
@@ -70,12 +72,12 @@ pub(super) fn read_lots(
         let mut record_attrs = Some(f.attrs);
         for (part, (id, poly)) in parts.into_iter().enumerate() {
             // The last part takes the record's attributes; earlier parts get a copy.
-            let mut attrs = if part + 1 == count {
+            let attrs = if part + 1 == count {
                 record_attrs.take().unwrap_or_default()
             } else {
                 record_attrs.clone().unwrap_or_default()
             };
-            attrs.insert("\u{0}base_id".into(), base_id.clone());
+            base_ids.push(base_id.clone());
             lots.push(Lot {
                 id,
                 record: f.record,
@@ -92,7 +94,7 @@ pub(super) fn read_lots(
     if let Some(mut t) = table {
         data.warnings.append(&mut t.warnings);
         data.joins
-            .push(join(&mut lots, t, "lots", &mut data.skipped));
+            .push(join(&mut lots, &base_ids, t, "lots", &mut data.skipped));
     }
     let mut bad_ground = 0usize;
     for lot in &mut lots {
@@ -106,7 +108,6 @@ pub(super) fn read_lots(
                 _ => bad_ground += 1,
             }
         }
-        lot.attrs.remove("\u{0}base_id");
     }
     lots.retain(|lot| match ground_problem(lot.ground) {
         None => true,
@@ -281,7 +282,7 @@ pub(super) fn assign_districts(
             polygons_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "polygons"))?;
         o.count_winding(read.against_winding);
         let parts = read.polygons;
-        let id = f.attrs.get(&field).cloned().unwrap_or_default();
+        let id = f.attrs.get(&field).unwrap_or_default().to_string();
         let mut usable = false;
         for mut p in parts {
             if map_polygon(&mut p, &mut |c| to_target(o, target, c)).is_ok() && !id.is_empty() {
@@ -351,7 +352,7 @@ pub(super) fn record_polygons(
     o.count_winding(read.against_winding);
     let (polys, z) = (read.polygons, read.lowest_z);
     if matches!(f.shape, shapefile::Shape::NullShape) {
-        let id = f.attrs.get(id_field).cloned().unwrap_or_default();
+        let id = f.attrs.get(id_field).unwrap_or_default().to_string();
         skipped.push(Skipped {
             layer: o.role.into(),
             file: o.file.clone(),
@@ -367,7 +368,7 @@ pub(super) fn record_polygons(
         });
         return Ok(None);
     }
-    let id = f.attrs.get(id_field).cloned().unwrap_or_default();
+    let id = f.attrs.get(id_field).unwrap_or_default().to_string();
     if id.is_empty() {
         skipped.push(Skipped {
             layer: o.role.into(),

@@ -5,7 +5,6 @@
 //! its header: it decodes as UTF-8 into replacement characters without any error. We decode,
 //! then look for U+FFFD and warn, naming the file and the option that fixes it.
 
-use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -21,7 +20,7 @@ pub struct Feature {
     /// The shape as read.
     pub shape: Shape,
     /// Every DBF field as text, by field name.
-    pub attrs: BTreeMap<String, String>,
+    pub attrs: crate::model::Attrs,
 }
 
 /// A layer as read, before any interpretation.
@@ -130,7 +129,11 @@ const DAMAGED: &str = "the file is damaged or cut short (an interrupted copy or 
 /// A layer's attribute table, read.
 struct Table {
     dbf_path: PathBuf,
-    records: Vec<dbase::Record>,
+    /// Each record's fields as text, read one record at a time (a `dbase::Record` is a map
+    /// with its own copy of every field name: holding a million of them took gigabytes).
+    records: Vec<crate::model::Attrs>,
+    /// Text values that did not decode (they hold U+FFFD).
+    garbled: usize,
     fields: Vec<String>,
     encoding: Option<&'static encoding_rs::Encoding>,
     encoding_name: String,
@@ -216,13 +219,28 @@ fn read_table(path: &Path, forced: &str) -> Result<Table, InputError> {
             );
         }
     }
-    let records = dbf.read().map_err(|e| InputError::Layer {
-        file: dbf_path.display().to_string(),
-        message: format!("cannot read the DBF records ({e}); {DAMAGED}"),
-    })?;
+    let mut names = crate::model::FieldNames::default();
+    let mut garbled = 0usize;
+    let mut records = Vec::new();
+    for rec in dbf.iter_records() {
+        let rec = rec.map_err(|e| InputError::Layer {
+            file: dbf_path.display().to_string(),
+            message: format!("cannot read the DBF records ({e}); {DAMAGED}"),
+        })?;
+        let attrs = rec
+            .into_iter()
+            .map(|(name, value)| {
+                let text = field_text(&value);
+                garbled += usize::from(text.contains('\u{fffd}'));
+                (names.intern(&name), text.into_boxed_str())
+            })
+            .collect();
+        records.push(attrs);
+    }
     Ok(Table {
         dbf_path,
         records,
+        garbled,
         fields,
         encoding,
         encoding_name,
@@ -251,6 +269,7 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
     let Table {
         dbf_path,
         records,
+        garbled,
         fields,
         encoding,
         encoding_name,
@@ -281,22 +300,13 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
         });
     }
 
-    let mut garbled = 0usize;
     let mut features = Vec::with_capacity(shapes.len());
     let is_deleted: std::collections::HashSet<usize> = deleted.iter().copied().collect();
     let kept = shapes
         .into_iter()
         .enumerate()
         .filter(|(i, _)| !is_deleted.contains(i));
-    for ((record, shape), rec) in kept.zip(records) {
-        let mut attrs = BTreeMap::new();
-        for (name, value) in rec.into_iter() {
-            let text = field_text(&value);
-            if text.contains('\u{fffd}') {
-                garbled += 1;
-            }
-            attrs.insert(name, text);
-        }
+    for ((record, shape), attrs) in kept.zip(records) {
         features.push(Feature {
             record,
             shape,

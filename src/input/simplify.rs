@@ -97,7 +97,9 @@ fn reduce_ring(r: &LineString<f64>, tol: f64) -> LineString<f64> {
     // Back in the input's order from its first kept vertex, so that the same outline with
     // other floating-point noise (a reprojected copy) keeps the same vertex order.
     kept.sort_unstable();
-    let mut out: Vec<Coord<f64>> = kept.iter().map(|&i| pts[i]).collect();
+    // Sized for the closing vertex too: a pushed one would double a million outlines.
+    let mut out: Vec<Coord<f64>> = Vec::with_capacity(kept.len() + 1);
+    out.extend(kept.iter().map(|&i| pts[i]));
     out.push(out[0]);
     LineString(out)
 }

@@ -4,6 +4,7 @@
 //! here (and not inside a stage) lets the stages depend on the data, never on each other:
 //! `model` depends on nothing of ours.
 
+pub mod attrs;
 pub mod crowd;
 pub mod dem;
 pub mod landmark;
@@ -12,6 +13,7 @@ pub mod warning;
 
 use std::collections::BTreeMap;
 
+pub use attrs::{Attrs, FieldNames};
 use geo_types::{Coord, LineString, Polygon};
 use serde::{Deserialize, Serialize};
 
@@ -97,7 +99,7 @@ pub struct Lot {
     /// A tile id given in the data; wins over the computed one.
     pub tile: Option<String>,
     /// Every attribute of the feature (DBF fields, then table values on top).
-    pub attrs: BTreeMap<String, String>,
+    pub attrs: Attrs,
     /// Ground elevation, metres: the `ground` field, else the lowest Z of a PolygonZ, else 0.
     pub ground: f64,
 }
@@ -112,7 +114,7 @@ pub struct FenceLine {
     /// The line, in the output CRS; a closed one walls in its inside.
     pub line: LineString<f64>,
     /// Every attribute of the feature.
-    pub attrs: BTreeMap<String, String>,
+    pub attrs: Attrs,
 }
 
 /// A polygon of the optional gardens layer (`layers.gardens`): where a user has drawn a rock
