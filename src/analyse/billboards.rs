@@ -122,13 +122,36 @@ struct Source<'a> {
     /// The lot's id, or the street piece's (made here); borrowed where it can be, since a
     /// city has a source for nearly every lot.
     id: std::borrow::Cow<'a, str>,
-    /// The tiles its points may fall in, with the share of its area in each: its expected
-    /// count is charged against their `max_points_per_tile` by these shares.
-    tiles: Vec<(String, f64)>,
+    /// Where its points may fall: see [`Source::tiles`].
+    reach: Reach,
     district: Option<&'a str>,
     /// Expected points in the source.
     expected: f64,
     shape: SourceShape<'a>,
+}
+
+/// The ground a source's points fall on, for the tiles it is charged to.
+#[derive(Clone, Copy)]
+enum Reach {
+    /// A street piece: the tile of its middle.
+    Point(Coord<f64>),
+    /// A lot: every tile its bounding box overlaps (see [`tiles_under`]).
+    Box {
+        bb: geo_types::Rect<f64>,
+        centroid: Coord<f64>,
+    },
+}
+
+impl Source<'_> {
+    /// The tiles its points may fall in, with the share of its area in each: its expected
+    /// count is charged against their `max_points_per_tile` by these shares. Worked out when
+    /// asked, not held: at a million lots the held names took a hundred megabytes.
+    fn tiles(&self, p: &Params) -> Vec<(String, f64)> {
+        match self.reach {
+            Reach::Point(c) => vec![(tile_id(c, p.tile_size, p.tile_origin), 1.0)],
+            Reach::Box { bb, centroid } => tiles_under(bb, centroid, p),
+        }
+    }
 }
 
 enum SourceShape<'a> {
@@ -189,14 +212,14 @@ pub fn plan_billboards(
                 };
                 // Generated billboards dress the built city: a tile with no house, kura or
                 // fence gets none (streets often run on past the lots).
-                sources.retain(|s| s.tiles.iter().any(|t| plan.tiles.contains(&t.0)));
-                let scale = budget(&sources, &k, &mut plan.warnings);
+                sources.retain(|s| s.tiles(params).iter().any(|t| plan.tiles.contains(&t.0)));
+                let scale = budget(&sources, &k, params, &mut plan.warnings);
                 let drawn: Vec<Vec<Candidate>> = sources
                     .par_iter()
                     .map(|s| {
                         draw(
                             s,
-                            s.tiles
+                            s.tiles(params)
                                 .iter()
                                 .filter_map(|t| scale.get(&t.0))
                                 .copied()
@@ -208,7 +231,8 @@ pub fn plan_billboards(
                         )
                     })
                     .collect();
-                drawn.into_iter().flatten().collect()
+                drop(sources);
+                super::concat(drawn)
             }
         };
         let mut kept = thin(candidates, spacing);
@@ -353,7 +377,7 @@ fn street_sources<'a>(data: &'a Dataset, near: &Surroundings<'a>, p: &Params) ->
                     p.district_density(district, |d| d.people_per_100m, p.people.per_100m);
                 out.push(Source {
                     id: format!("{}/{}", super::crowds::stretch_id(&s.id, k), j + 1).into(),
-                    tiles: vec![(tile_id(mid, p.tile_size, p.tile_origin), 1.0)],
+                    reach: Reach::Point(mid),
                     district,
                     expected: len / pieces as f64 / 100.0 * density,
                     shape: SourceShape::Street {
@@ -416,7 +440,7 @@ fn lot_sources<'a>(
         }
         out.push(Source {
             id: lot.id.as_str().into(),
-            tiles: tiles_under(bb, c.0, p),
+            reach: Reach::Box { bb, centroid: c.0 },
             district,
             expected: planted * density / 10_000.0,
             shape: SourceShape::Lot {
@@ -461,12 +485,13 @@ fn tiles_under(bb: geo_types::Rect<f64>, centroid: Coord<f64>, p: &Params) -> Ve
 fn budget(
     sources: &[Source],
     k: &Kind,
+    p: &Params,
     warnings: &mut Vec<crate::model::Warning>,
 ) -> BTreeMap<String, f64> {
-    let mut expected: BTreeMap<&str, f64> = BTreeMap::new();
+    let mut expected: BTreeMap<String, f64> = BTreeMap::new();
     for s in sources {
-        for (tile, share) in &s.tiles {
-            *expected.entry(tile.as_str()).or_default() += s.expected * share;
+        for (tile, share) in s.tiles(p) {
+            *expected.entry(tile).or_default() += s.expected * share;
         }
     }
     let mut scale = BTreeMap::new();

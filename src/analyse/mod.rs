@@ -30,6 +30,17 @@ use crate::templates::Catalog;
 use frontage::{find_frontage, lot_depth, FrontageRule};
 use street::StreetEdges;
 
+/// The vectors one after another in one allocation of the exact size. Collecting a flatten
+/// grows by doubling, which at a million lots held three copies at the moment of the last
+/// growth.
+pub(crate) fn concat<T>(parts: Vec<Vec<T>>) -> Vec<T> {
+    let mut out = Vec::with_capacity(parts.iter().map(Vec::len).sum());
+    for p in parts {
+        out.extend(p);
+    }
+    out
+}
+
 /// Why a lot did not make it into the plan, or what it became.
 enum Outcome {
     Planned(Box<PlannedHouse>, Vec<crate::model::Warning>),
@@ -97,6 +108,17 @@ pub fn analyse(
         .iter()
         .filter(|o| matches!(o, Outcome::Planned(..)))
         .count();
+    // Each tile's houses in one allocation of the right size (pushed one by one, the tiles'
+    // vectors held up to twice the houses at a million lots).
+    let mut per_tile: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+    for o in outcomes.iter().chain(&fp_outcomes) {
+        if let Outcome::Planned(m, _) = o {
+            *per_tile.entry(m.tile.as_str()).or_default() += 1;
+        }
+    }
+    for (tile, n) in per_tile {
+        plan.houses.insert(tile.to_string(), Vec::with_capacity(n));
+    }
     for o in outcomes.into_iter().chain(fp_outcomes) {
         match o {
             Outcome::Planned(m, warnings) => {

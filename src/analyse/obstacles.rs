@@ -61,13 +61,11 @@ impl Obstacles {
         params: &Params,
     ) -> Obstacles {
         let houses: Vec<&PlannedHouse> = houses.collect();
-        let mut items: Vec<Obstacle> = houses
+        let per_house: Vec<Vec<Obstacle>> = houses
             .par_iter()
             .map(|m| house_obstacles(m, catalog, params))
-            .collect::<Vec<_>>()
-            .into_iter()
-            .flatten()
             .collect();
+        let mut items = super::concat(per_house);
         for s in fences {
             items.push(Obstacle::Wall([s.a.x, s.a.y], [s.b.x, s.b.y]));
         }
