@@ -26,6 +26,7 @@ use crate::output::{self, report};
 use crate::params::{Params, ParamsError};
 use crate::templates::{Catalog, Kind, TemplateError};
 
+pub mod cache;
 pub mod shards;
 
 /// Progress of the long stages; the CLI draws bars, tests pass [`NoProgress`].
@@ -159,6 +160,8 @@ pub struct BuildOutcome {
     pub bytes_written: u64,
     /// Tiles written by this run.
     pub tiles_written: usize,
+    /// Whether the analysis ran or came from the cache.
+    pub cache: cache::CacheUse,
 }
 
 /// Loads the machiya types and checks `type_mix` against them.
@@ -227,17 +230,26 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
 
 /// Reads and analyses the input: the part of a build every tile depends on. Returns the
 /// time each took.
+fn read_input(
+    input: &Path,
+    params: &Params,
+    progress: &dyn Progress,
+) -> Result<(Dataset, Duration), BuildError> {
+    let t = Instant::now();
+    progress.start("reading", 0);
+    let data = input::read_dataset(input, params)?;
+    progress.finish();
+    Ok((data, t.elapsed()))
+}
+
+/// Reads the input and analyses it (both timed).
 pub fn read_and_analyse(
     input: &Path,
     params: &Params,
     catalog: &Catalog,
     progress: &dyn Progress,
 ) -> Result<(Dataset, Plan, Duration, Duration), BuildError> {
-    let t = Instant::now();
-    progress.start("reading", 0);
-    let data = input::read_dataset(input, params)?;
-    progress.finish();
-    let read = t.elapsed();
+    let (data, read) = read_input(input, params, progress)?;
     let t = Instant::now();
     let lots_file = input.join(&params.layers.lots.file).display().to_string();
     let machiya_lots = data
@@ -300,7 +312,29 @@ fn run(
 ) -> Result<BuildOutcome, BuildError> {
     let params = &opts.params;
     let mut timings = Timings::default();
-    let (data, plan, read, analysed) = read_and_analyse(&opts.input, params, catalog, progress)?;
+    // A build caches its plan; `--tiles` of the same key reads it instead of analysing.
+    let cache_file = match opts.selection {
+        Selection::Shard { .. } => None,
+        _ => cache::file_for(&opts.out),
+    };
+    let key = cache_file.as_ref().map(|_| cache::key(opts));
+    let cached = match (&opts.selection, &cache_file, &key) {
+        (Selection::Tiles(_), Some(file), Some(key)) => cache::load(file, key),
+        _ => None,
+    };
+    let reused = cached.is_some();
+    let (data, plan, read, analysed) = match cached {
+        Some(plan) => {
+            let (data, read) = read_input(&opts.input, params, progress)?;
+            (data, plan, read, Duration::ZERO)
+        }
+        None => read_and_analyse(&opts.input, params, catalog, progress)?,
+    };
+    // Any whole analysis is worth keeping (a `--tiles` after an edit of the input, too).
+    let store = match (reused, &cache_file, &key) {
+        (false, Some(file), Some(key)) => Some((file, key)),
+        _ => None,
+    };
     timings.read = read;
     timings.analyse = analysed;
     timings.kura = plan.kura_time;
@@ -321,20 +355,37 @@ fn run(
         }
         BuildError::Config(e.to_string())
     })?;
-    let written = shards::check_out_dir(opts)
-        .and_then(|()| shards::refuse_empty(opts, &plan))
-        .and_then(|()| {
+    // The plan is cached while the tiles are written (it is the input's, whatever happens
+    // to the writing), once the directory is known to be this build's.
+    let checked = shards::check_out_dir(opts).and_then(|()| shards::refuse_empty(opts, &plan));
+    let written = checked.and_then(|()| {
+        std::thread::scope(|s| {
+            if let Some((file, key)) = store {
+                s.spawn(|| cache::store(file, key, &plan));
+            }
             write_city(
                 opts,
                 catalog,
                 texture_set,
                 progress,
-                data,
-                plan,
+                &data,
+                &plan,
                 timings,
                 t0,
             )
-        });
+        })
+    });
+    // Freeing the city's millions of small allocations takes tens of milliseconds that
+    // nobody waits for: a thread does it, and a CLI that exits first just ends it.
+    std::thread::spawn(move || drop((data, plan)));
+    let written = written.map(|o| BuildOutcome {
+        cache: match (reused, &cache_file) {
+            (true, _) => cache::CacheUse::Reused,
+            (false, Some(_)) => cache::CacheUse::Analysed,
+            (false, None) => cache::CacheUse::Off,
+        },
+        ..o
+    });
     drop(lock);
     if written.is_err() && !existed {
         // Leave no directory behind that the user did not have before (only empty ones go).
@@ -357,15 +408,15 @@ fn write_city(
     catalog: &Catalog,
     texture_set: &[output::Texture],
     progress: &dyn Progress,
-    data: Dataset,
-    plan: Plan,
+    data: &Dataset,
+    plan: &Plan,
     mut timings: Timings,
     t0: Instant,
 ) -> Result<BuildOutcome, BuildError> {
     let params = &opts.params;
 
     let t = Instant::now();
-    let selected = shards::select(&plan, &opts.selection)?;
+    let selected = shards::select(plan, &opts.selection)?;
     let previous = match &opts.selection {
         Selection::Tiles(_) => Some(shards::previous_manifest(
             &opts.out,
@@ -389,12 +440,12 @@ fn write_city(
         output::write_model_textures(&opts.out, &plan.model_textures)
             .map_err(|e| write_err(&opts.out.join(output::TEXTURE_DIR), e))?,
     );
-    let species = output::species::write_species(&opts.out, &plan, catalog, params, alone)
+    let species = output::species::write_species(&opts.out, plan, catalog, params, alone)
         .map_err(|e| write_err(&opts.out.join("species"), e))?;
 
     let files = layer_files(&opts.input, params);
     let sinks = output::sink::sinks(&params.output);
-    let directory = output::features::Directory::of(&data, &plan, params);
+    let directory = output::features::Directory::of(data, plan, params);
     let tiles: Vec<&String> = plan
         .tiles
         .iter()
@@ -411,8 +462,8 @@ fn write_city(
             .plan_image
             .then(|| {
                 let grid = (params.tile_size, params.tile_origin);
-                output::plan::View::fit(&data, None).and_then(|view| {
-                    output::plan::draw_plan(&data, &plan, &view, grid, kura_view(params))
+                output::plan::View::fit(data, None).and_then(|view| {
+                    output::plan::draw_plan(data, plan, &view, grid, kura_view(params))
                 })
             })
             .flatten();
@@ -424,8 +475,8 @@ fn write_city(
             .map(|&id| {
                 let t = Instant::now();
                 let tile = generate::TilePlan {
-                    ground: terrain_of(&data, params, id),
-                    ..generate::TilePlan::of(&plan, id)
+                    ground: terrain_of(data, params, id),
+                    ..generate::TilePlan::of(plan, id)
                 };
                 let mut meshes =
                     generate::generate_tile(&tile, catalog, params, plan.origin, &files);
@@ -543,7 +594,7 @@ fn write_city(
         crs_wkt: data.crs_wkt.clone(),
         tile_size: params.tile_size,
         params: params.clone(),
-        input: input_summary(&opts.input, opts.templates.as_deref(), &data, &plan),
+        input: input_summary(&opts.input, opts.templates.as_deref(), data, plan),
         tiles: manifest_tiles,
         formats: sinks.iter().map(|s| s.format().to_string()).collect(),
         files: Vec::new(),
@@ -551,7 +602,7 @@ fn write_city(
         species,
     };
     let mut manifest = manifest;
-    let links = output::links::write_links(&opts.out, &data, plan.origin)
+    let links = output::links::write_links(&opts.out, data, plan.origin)
         .map_err(|e| write_err(&opts.out.join("links.json"), e))?;
     manifest.files.extend(links);
     // A shard's tiles are only part of the city: `merge` writes the tileset.
@@ -571,15 +622,13 @@ fn write_city(
     // Drawn beside the tiles: its own time, not the wall time it added.
     timings.plan = plan_time + t.elapsed();
     let rep = shards::write_manifest_and_report(&opts.out, &manifest)?;
-    // Freeing the city's millions of small allocations takes tens of milliseconds that
-    // nobody waits for: a thread does it, and a CLI that exits first just ends it.
-    std::thread::spawn(move || drop((data, plan)));
     timings.total = t0.elapsed();
     Ok(BuildOutcome {
         report: rep,
         timings,
         bytes_written,
         tiles_written,
+        cache: cache::CacheUse::Off,
     })
 }
 

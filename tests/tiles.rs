@@ -158,3 +158,73 @@ fn a_mistyped_input_is_reported_as_such_even_into_an_existing_build() {
                 .and(predicate::str::contains("another build").not()),
         );
 }
+
+#[test]
+fn tiles_reuse_the_cached_analysis_only_for_the_same_input_and_parameters() {
+    let work = tempfile::tempdir().unwrap();
+    let (input, cache) = (work.path().join("in"), work.path().join("cache"));
+    copy_fixture("kyoto-small", &input);
+    let (full, out) = (work.path().join("full"), work.path().join("out"));
+    // Runs a build with the given cache setting; its summary.
+    let run = |out: &Path, extra: &[&str], cache: &Path| -> String {
+        let o = build_cmd(&input, out, extra)
+            .env("EDO_CITY_CACHE", cache)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let reused = |summary: &str| summary.contains("analysis   reused");
+    run(&full, &["--quiet"], Path::new("off"));
+    assert!(!reused(&run(&out, &[], &cache)));
+    let plans: Vec<_> = std::fs::read_dir(&cache).unwrap().collect();
+    assert_eq!(plans.len(), 1, "one cache file for the output directory");
+    assert_eq!(
+        all_files(&full).keys().collect::<Vec<_>>(),
+        all_files(&out).keys().collect::<Vec<_>>(),
+        "the cache is not in the output"
+    );
+    let id = read_json(&full.join("manifest.json"))["tiles"][0]["id"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let tile = out.join(format!("tiles/{id}.obj"));
+    let tiles = ["--tiles", id.as_str()];
+
+    std::fs::write(&tile, "damaged").unwrap();
+    assert!(reused(&run(&out, &tiles, &cache)), "same input: reused");
+    assert_same_tree(&full, &out);
+
+    // An edited input (its time changed) is analysed again, and that analysis cached.
+    let dbf = std::fs::File::options()
+        .write(true)
+        .open(input.join("lots.dbf"))
+        .unwrap();
+    dbf.set_modified(std::time::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000_000))
+        .unwrap();
+    std::fs::write(&tile, "damaged").unwrap();
+    assert!(
+        !reused(&run(&out, &tiles, &cache)),
+        "edited input: analysed"
+    );
+    assert_same_tree(&full, &out);
+    assert!(reused(&run(&out, &tiles, &cache)), "and cached again");
+
+    // A damaged cache file is never read: the analysis runs.
+    let plan = std::fs::read_dir(&cache)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let bytes = std::fs::read(&plan).unwrap();
+    std::fs::write(&plan, &bytes[..bytes.len() / 2]).unwrap();
+    std::fs::write(&tile, "damaged").unwrap();
+    assert!(!reused(&run(&out, &tiles, &cache)));
+    assert_same_tree(&full, &out);
+
+    // EDO_CITY_CACHE=off: no cache read or written.
+    std::fs::write(&tile, "damaged").unwrap();
+    assert!(!reused(&run(&out, &tiles, Path::new("off"))));
+    assert_same_tree(&full, &out);
+}

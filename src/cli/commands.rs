@@ -58,9 +58,13 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
     if timings {
         let t = &outcome.timings;
         eprintln!(
-            "timings: read {:.3} s, analyse {:.3} s (kura plots and R-tree {:.3} s, people and trees {:.3} s), generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, total {:.3} s",
+            "timings: read {:.3} s, analyse {:.3} s{} (kura plots and R-tree {:.3} s, people and trees {:.3} s), generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, total {:.3} s",
             t.read.as_secs_f64(),
             t.analyse.as_secs_f64(),
+            match outcome.cache {
+                edo_city::build::cache::CacheUse::Reused => " from the cache",
+                _ => "",
+            },
             t.kura.as_secs_f64(),
             t.billboards.as_secs_f64(),
             t.generate_and_write.as_secs_f64(),

@@ -199,6 +199,12 @@ pub fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<(
             r.warnings.len() - 10
         );
     }
+    if o.cache == edo_city::build::cache::CacheUse::Reused {
+        say!(
+            "  analysis   reused: this input, these parameters and this program were analysed \
+             by the last full build into this directory (EDO_CITY_CACHE=off analyses again)"
+        );
+    }
     say!("  in {:.2} s", o.timings.total.as_secs_f64());
     if opts.out.join("tileset.json").is_file() && opts.selection == edo_city::build::Selection::All
     {

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::TileId;
 
 /// A model as read from its file: triangles in the model's own frame and units.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Model {
     /// The file, as the user named it (relative to the models' directory).
     pub file: String,
@@ -30,7 +30,7 @@ pub struct Model {
 }
 
 /// One triangle of a model.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ModelTriangle {
     /// Position indices.
     pub positions: [u32; 3],
@@ -41,7 +41,7 @@ pub struct ModelTriangle {
 }
 
 /// A model's material as its file gives it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModelMaterial {
     /// Its name in the model's file.
     pub name: String,
@@ -54,7 +54,7 @@ pub struct ModelMaterial {
 
 /// A material a model brought, as the tiles name it: after the library's materials, its
 /// name prefixed `lm_<model>_` so it never clashes with ours.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PaletteEntry {
     /// The prefixed name.
     pub name: String,
@@ -86,7 +86,7 @@ pub struct LandmarkRecord {
 }
 
 /// A landmark analysis placed: its model, where and how, in the tile of its point.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlannedLandmark {
     /// The record's id.
     pub id: String,

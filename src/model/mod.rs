@@ -4,6 +4,7 @@
 //! here (and not inside a stage) lets the stages depend on the data, never on each other:
 //! `model` depends on nothing of ours.
 
+pub mod as_json;
 pub mod attrs;
 pub mod crowd;
 pub mod dem;
@@ -303,7 +304,7 @@ pub struct TableJoin {
 }
 
 /// The frontage (maguchi 間口): the lot edge facing the street, from Fig.4 of the paper.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Frontage {
     /// Start and end vertex; walking a -> b the lot lies on the left.
     pub a: Coord<f64>,
@@ -342,7 +343,7 @@ pub use tile::TileId;
 pub use warning::{Warning, WarningClass};
 
 /// What a planned house stands for.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum HouseSource {
     /// A lot-filling machiya on a town lot: its template decides its height.
     Lot,
@@ -370,7 +371,7 @@ impl PlannedHouse {
 
 /// A house after analysis (a machiya on its lot, or a building of a footprint layer):
 /// everything generation needs, nothing more.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PlannedHouse {
     /// The lot's or footprint's id.
     pub id: String,
@@ -399,7 +400,7 @@ pub struct PlannedHouse {
 }
 
 /// A wall segment or a gate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 pub enum FenceKind {
     /// A length of wall.
     Wall,
@@ -409,7 +410,7 @@ pub enum FenceKind {
 
 /// One fence segment or gate (section 4.3): the site of a fence or gate template, from `a` to
 /// `b` with the enclosed side on the left.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PlannedFence {
     /// The lot's (or fence line's) id.
     pub id: String,
@@ -447,7 +448,7 @@ pub struct PlannedFence {
 }
 
 /// A billboard: a person or a tree (section 4.4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 pub enum BillboardKind {
     /// A person: one quad facing along the street.
     Person,
@@ -466,7 +467,7 @@ impl BillboardKind {
 }
 
 /// One person or tree to build.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlannedBillboard {
     /// Person or tree.
     pub kind: BillboardKind,
@@ -493,7 +494,7 @@ pub struct PlannedBillboard {
 }
 
 /// A tree of a species (ki 木), as `analyse::trees` planted it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TreeForm {
     /// The species (a file of templates/trees/).
     pub species: String,
@@ -515,7 +516,7 @@ pub const MIN_SQUEEZE: f64 = 0.4;
 
 /// What section 4.2 decided for a machiya's kura (蔵). A rectangle is `[u0, v0, u1, v1]` in
 /// the machiya's frontage frame (u along the street, v into the lot).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub enum KuraDecision {
     /// Frontage narrower than `kura.min_frontage` or lot shallower than `kura.depth_ratio`
     /// times it (or a footprint building).
@@ -586,7 +587,7 @@ impl PlannedHouse {
 }
 
 /// The output of analysis: what to build, tile by tile.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct Plan {
     /// Dataset origin in projected metres: output coordinates are relative to it.
     pub origin: [f64; 2],
@@ -600,14 +601,19 @@ pub struct Plan {
     /// Footprints planned (they share the tiles with the machiya).
     pub footprints: usize,
     /// Features analysis left out, with their reasons.
+    #[serde(with = "as_json")]
     pub skipped: Vec<Skipped>,
     /// What analysis noticed.
+    #[serde(with = "as_json")]
     pub warnings: Vec<Warning>,
     /// Time spent placing kura and testing their provisional plots (for `--timings`).
+    #[serde(skip)]
     pub kura_time: std::time::Duration,
     /// Time spent placing halls, gardens, people and trees and the ground.
+    #[serde(skip)]
     pub billboards_time: std::time::Duration,
     /// Of `billboards_time`, each step by name (for `--timings`).
+    #[serde(skip)]
     pub step_times: Vec<(&'static str, std::time::Duration)>,
     /// Fence segments and gates per tile, in input order (each of these tiles is in
     /// `tiles`).
@@ -616,14 +622,17 @@ pub struct Plan {
     /// fixed order.
     pub billboards: BTreeMap<TileId, Vec<PlannedBillboard>>,
     /// The street crowds' order parameters, per street stretch (`people.motion = "boids"`).
+    #[serde(with = "as_json")]
     pub crowds: Vec<CrowdStat>,
     /// The rock gardens, per tile (the tile of their lot).
     pub gardens: BTreeMap<TileId, Vec<PlannedGarden>>,
     /// What became of every lot that could have had a garden.
+    #[serde(with = "as_json")]
     pub garden_reports: Vec<GardenStat>,
     /// The halls of estates and temples, per tile (the tile of their plot's centre).
     pub halls: BTreeMap<TileId, Vec<PlannedHall>>,
     /// What became of every hall a lot's use asked for.
+    #[serde(with = "as_json")]
     pub hall_reports: Vec<HallStat>,
     /// The ground of every tile to write (`[ground]`): the surfaces it is cut from.
     pub grounds: BTreeMap<TileId, PlannedGround>,
@@ -635,13 +644,14 @@ pub struct Plan {
     /// Their textures: prefixed file name and bytes.
     pub model_textures: Vec<(String, std::sync::Arc<Vec<u8>>)>,
     /// What became of the landmarks layer.
+    #[serde(with = "as_json")]
     pub landmark_report: LandmarkReport,
 }
 
 /// A hall (a template of kind `hall`: a temple's main hall, gate or pagoda, a samurai's main
 /// house, a court noble's residence) on the plot analysis found for it in an estate or
 /// temple lot, facing the lot's gate.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlannedHall {
     /// The lot's id.
     pub lot: String,
@@ -723,7 +733,7 @@ pub struct HallStat {
 
 /// What a tile's ground is cut from: the surfaces near the tile, unclipped, and how high the
 /// ground stands. Generation clips them to `bounds` (see `generate::ground`).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct PlannedGround {
     /// The tile's square, `[xmin, ymin, xmax, ymax]`.
     pub bounds: [f64; 4],
@@ -741,7 +751,7 @@ pub struct PlannedGround {
 
 /// The ground's height without a DEM: flat where every lot stands at one elevation, else
 /// interpolated from the lots' own elevations (inverse distance, the nearest few).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum GroundHeight {
     /// One elevation everywhere.
     Flat(f64),
@@ -756,7 +766,7 @@ impl Default for GroundHeight {
 }
 
 /// A dry rock garden (karesansui 枯山水) planned in a lot (seed 000).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlannedGarden {
     /// Its name in object names and its RNG key: the lot's id, or `area-<id>` for a polygon
     /// of the gardens layer.

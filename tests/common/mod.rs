@@ -17,8 +17,15 @@ pub fn fixture(name: &str) -> PathBuf {
         .join(name)
 }
 
+/// The binary, with its analysis cache in the build's temporary directory (not the home
+/// directory of whoever runs the tests).
 pub fn edo_city() -> Command {
-    Command::cargo_bin("edo-city").expect("binary built")
+    let mut c = Command::cargo_bin("edo-city").expect("binary built");
+    c.env(
+        "EDO_CITY_CACHE",
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join("edo-city-cache"),
+    );
+    c
 }
 
 /// Runs `edo-city build <input> --out <out> <extra...>` and asserts it succeeded.

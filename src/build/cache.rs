@@ -1,0 +1,250 @@
+//! The analysis cache: a full build keeps its [`Plan`] so that `--tiles` can skip the
+//! analysis.
+//!
+//! Regenerating one tile used to read and analyse the whole city (every frontage, kura, wall,
+//! hall, garden GA, person and tree), because a tile sees its neighbours. That analysis is a
+//! function of the input files, the parameters, the templates and the program, so a full
+//! build writes its plan to a cache file under a key of exactly those, and `--tiles` with the
+//! same key reads the plan back instead of analysing (the input is still read: the tiles'
+//! attributes, the DEM and the report come from it). Anything else (no cache, another key, a
+//! damaged or cut file) means the analysis runs as before: the cache can make a run faster,
+//! never different.
+//!
+//! The cache lives outside the output directory (which holds only the city, to be copied to
+//! a web server as it is): `$EDO_CITY_CACHE`, else `$XDG_CACHE_HOME/edo-city`, else
+//! `~/.cache/edo-city`; `EDO_CITY_CACHE=off` (or empty) turns it off. One file per output
+//! directory, the newest [`KEEP`] kept.
+
+use std::fs;
+use std::io::{BufReader, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+use std::time::UNIX_EPOCH;
+
+use sha2::{Digest, Sha256};
+
+use super::BuildOptions;
+use crate::model::Plan;
+
+/// The first bytes of a cache file; a new layout of the file gets a new number.
+const MAGIC: &[u8; 24] = b"edo-city analysis v1\n\0\0\0";
+/// Cache files kept (one per output directory, the most recently written).
+pub const KEEP: usize = 16;
+
+/// What a build did with the cache, for the summary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CacheUse {
+    /// No cache directory (turned off, or no home directory).
+    #[default]
+    Off,
+    /// `--tiles` found the plan of this input and these parameters and skipped the analysis.
+    Reused,
+    /// The analysis ran (nothing cached, or it was made from other input or parameters).
+    Analysed,
+}
+
+/// Where this output directory's cache file is, if caching is on.
+pub fn file_for(out: &Path) -> Option<PathBuf> {
+    let dir = match std::env::var_os("EDO_CITY_CACHE") {
+        Some(v) if v.is_empty() || v == "off" => return None,
+        Some(v) => PathBuf::from(v),
+        None => match std::env::var_os("XDG_CACHE_HOME").filter(|v| !v.is_empty()) {
+            Some(x) => PathBuf::from(x).join("edo-city"),
+            None => PathBuf::from(std::env::var_os("HOME")?).join(".cache/edo-city"),
+        },
+    };
+    let out = super::absolute(out);
+    let name = hex(&Sha256::digest(out.as_os_str().as_encoded_bytes())[..12]);
+    Some(dir.join(format!("{name}.plan")))
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The key of a build's analysis: the program (its size and time of writing), the
+/// parameters, and every file of the input, the templates and the textures (path, size,
+/// time of writing). Contents are not hashed: a million-lot input is gigabytes, and an edit
+/// changes a file's time.
+pub fn key(opts: &BuildOptions) -> [u8; 32] {
+    let mut h = Sha256::new();
+    h.update(env!("CARGO_PKG_VERSION").as_bytes());
+    if let Ok(exe) = std::env::current_exe() {
+        stamp(&mut h, &exe);
+    }
+    h.update(serde_json::to_vec(&opts.params).unwrap_or_default());
+    let skip = super::absolute(&opts.out);
+    let mut dirs = vec![opts.input.clone()];
+    dirs.extend(opts.templates.clone());
+    if !opts.params.textures.is_empty() {
+        dirs.push(PathBuf::from(&opts.params.textures));
+    }
+    for dir in dirs {
+        h.update(b"\0dir\0");
+        walk(&mut h, &dir, &skip, 0);
+    }
+    h.finalize().into()
+}
+
+/// A file's path, size and modification time into the key.
+fn stamp(h: &mut Sha256, path: &Path) {
+    h.update(path.as_os_str().as_encoded_bytes());
+    if let Ok(m) = fs::metadata(path) {
+        h.update(m.len().to_le_bytes());
+        let t = m
+            .modified()
+            .ok()
+            .and_then(|t| t.duration_since(UNIX_EPOCH).ok());
+        h.update(t.map_or(0, |t| t.as_nanos()).to_le_bytes());
+    }
+}
+
+/// Every file under `dir` in name order, but not the output directory (an `--out` inside the
+/// input would change the key with every build).
+fn walk(h: &mut Sha256, dir: &Path, skip: &Path, depth: usize) {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    paths.sort();
+    for p in paths {
+        if super::absolute(&p) == skip {
+            continue;
+        }
+        if p.is_dir() {
+            // Deep enough for models/ and tables/ folders; a link loop ends here.
+            if depth < 4 {
+                walk(h, &p, skip, depth + 1);
+            }
+        } else {
+            stamp(h, &p);
+        }
+    }
+}
+
+/// The plan cached for `out` under `key`, or `None` (no file, another key, damaged).
+pub fn load(file: &Path, key: &[u8; 32]) -> Option<Plan> {
+    let mut r = BufReader::new(fs::File::open(file).ok()?);
+    let mut head = [0u8; 24 + 32];
+    r.read_exact(&mut head).ok()?;
+    if &head[..24] != MAGIC || &head[24..] != key {
+        return None;
+    }
+    let mut body = Vec::new();
+    r.read_to_end(&mut body).ok()?;
+    postcard::from_bytes(&body).ok()
+}
+
+/// Writes `plan` for `out` under `key` (a temporary renamed into place, so a reader sees the
+/// old file or the new one), then forgets all but the newest [`KEEP`] files. Failing to
+/// cache never fails a build: the next `--tiles` analyses instead.
+pub fn store(file: &Path, key: &[u8; 32], plan: &Plan) {
+    let Some(dir) = file.parent() else {
+        return;
+    };
+    if fs::create_dir_all(dir).is_err() {
+        return;
+    }
+    let tmp = file.with_extension(format!("tmp-{}", std::process::id()));
+    let written = (|| -> std::io::Result<()> {
+        let mut w = BufWriter::new(fs::File::create(&tmp)?);
+        w.write_all(MAGIC)?;
+        w.write_all(key)?;
+        postcard::to_io(plan, &mut w).map_err(std::io::Error::other)?;
+        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        fs::rename(&tmp, file)
+    })();
+    if written.is_err() {
+        let _ = fs::remove_file(&tmp);
+        return;
+    }
+    evict(dir);
+}
+
+/// Removes all but the [`KEEP`] most recently written plans.
+fn evict(dir: &Path) {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    let mut plans: Vec<(std::time::SystemTime, PathBuf)> = entries
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "plan"))
+        .filter_map(|p| Some((fs::metadata(&p).ok()?.modified().ok()?, p)))
+        .collect();
+    if plans.len() <= KEEP {
+        return;
+    }
+    plans.sort();
+    for (_, p) in &plans[..plans.len() - KEEP] {
+        let _ = fs::remove_file(p);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_plan_comes_back_as_it_went_in() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("x.plan");
+        let mut plan = Plan {
+            origin: [0.1 + 0.2, f64::NAN],
+            ..Plan::default()
+        };
+        plan.tiles.insert("3_4".into());
+        plan.garden_reports.push(crate::model::GardenStat {
+            lot: "L1".into(),
+            area: None,
+            placed: false,
+            reason: String::new(),
+            size: [1.0 / 3.0, 2.0],
+            fitness: 0.7,
+            stones: 0,
+        });
+        let key = [7u8; 32];
+        store(&file, &key, &plan);
+        let back = load(&file, &key).expect("the same key reads the plan");
+        assert_eq!(back.origin[0].to_bits(), plan.origin[0].to_bits());
+        assert!(back.origin[1].is_nan());
+        assert_eq!(back.tiles, plan.tiles);
+        assert_eq!(back.garden_reports, plan.garden_reports);
+        assert!(
+            load(&file, &[8u8; 32]).is_none(),
+            "another key reads nothing"
+        );
+        // A file cut short is not a plan.
+        let bytes = fs::read(&file).unwrap();
+        fs::write(&file, &bytes[..bytes.len() - 3]).unwrap();
+        assert!(load(&file, &key).is_none());
+    }
+
+    #[test]
+    fn only_the_newest_files_are_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        for i in 0..KEEP + 3 {
+            let f = dir.path().join(format!("{i:02}.plan"));
+            store(&f, &[0u8; 32], &Plan::default());
+            // Distinct times, oldest first, whatever the file system's clock resolution.
+            let t = UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + i as u64);
+            fs::File::options()
+                .write(true)
+                .open(&f)
+                .unwrap()
+                .set_modified(t)
+                .unwrap();
+        }
+        store(&dir.path().join("new.plan"), &[0u8; 32], &Plan::default());
+        let mut left: Vec<String> = fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left.len(), KEEP);
+        assert!(left.contains(&"new.plan".to_string()));
+        assert!(
+            !left.contains(&"00.plan".to_string()),
+            "the oldest went first"
+        );
+    }
+}
