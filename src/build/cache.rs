@@ -1,19 +1,18 @@
-//! The analysis cache: a full build keeps its [`Plan`] so that `--tiles` can skip the
-//! analysis.
+//! The analysis cache: a full build keeps what it read and analysed ([`Dataset`] and
+//! [`Plan`]) so that `--tiles` can skip both.
 //!
 //! Regenerating one tile used to read and analyse the whole city (every frontage, kura, wall,
 //! hall, garden GA, person and tree), because a tile sees its neighbours. That analysis is a
 //! function of the input files, the parameters, the templates and the program, so a full
-//! build writes its plan to a cache file under a key of exactly those, and `--tiles` with the
-//! same key reads the plan back instead of analysing (the input is still read: the tiles'
-//! attributes, the DEM and the report come from it). Anything else (no cache, another key, a
-//! damaged or cut file) means the analysis runs as before: the cache can make a run faster,
-//! never different.
+//! build writes its input and plan to a cache file under a key of exactly those, and
+//! `--tiles` with the same key reads them back instead of reading the input and analysing.
+//! Anything else (no cache, another key, a damaged or cut file) means both run as before:
+//! the cache can make a run faster, never different.
 //!
 //! The cache lives outside the output directory (which holds only the city, to be copied to
 //! a web server as it is): `$EDO_CITY_CACHE`, else `$XDG_CACHE_HOME/edo-city`, else
 //! `~/.cache/edo-city`; `EDO_CITY_CACHE=off` (or empty) turns it off. One file per output
-//! directory, the newest [`KEEP`] kept.
+//! directory, the newest [`KEEP`] kept, and no more than [`KEEP_BYTES`] together.
 
 use std::fs;
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -23,12 +22,15 @@ use std::time::UNIX_EPOCH;
 use sha2::{Digest, Sha256};
 
 use super::BuildOptions;
-use crate::model::Plan;
+use crate::model::{Dataset, Plan};
 
 /// The first bytes of a cache file; a new layout of the file gets a new number.
-const MAGIC: &[u8; 24] = b"edo-city analysis v1\n\0\0\0";
+const MAGIC: &[u8; 24] = b"edo-city analysis v2\n\0\0\0";
 /// Cache files kept (one per output directory, the most recently written).
 pub const KEEP: usize = 16;
+/// Bytes the kept files may take together (a million-lot city's file is about 480 MB); the
+/// newest file is kept whatever its size.
+pub const KEEP_BYTES: u64 = 4 << 30;
 
 /// What a build did with the cache, for the summary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -121,8 +123,9 @@ fn walk(h: &mut Sha256, dir: &Path, skip: &Path, depth: usize) {
     }
 }
 
-/// The plan cached for `out` under `key`, or `None` (no file, another key, damaged).
-pub fn load(file: &Path, key: &[u8; 32]) -> Option<Plan> {
+/// The input and plan cached for `out` under `key`, or `None` (no file, another key,
+/// damaged).
+pub fn load(file: &Path, key: &[u8; 32]) -> Option<(Dataset, Plan)> {
     let mut r = BufReader::new(fs::File::open(file).ok()?);
     let mut head = [0u8; 24 + 32];
     r.read_exact(&mut head).ok()?;
@@ -131,13 +134,15 @@ pub fn load(file: &Path, key: &[u8; 32]) -> Option<Plan> {
     }
     let mut body = Vec::new();
     r.read_to_end(&mut body).ok()?;
-    postcard::from_bytes(&body).ok()
+    let (mut data, plan): (Dataset, Plan) = postcard::from_bytes(&body).ok()?;
+    data.share_field_names();
+    Some((data, plan))
 }
 
-/// Writes `plan` for `out` under `key` (a temporary renamed into place, so a reader sees the
-/// old file or the new one), then forgets all but the newest [`KEEP`] files. Failing to
-/// cache never fails a build: the next `--tiles` analyses instead.
-pub fn store(file: &Path, key: &[u8; 32], plan: &Plan) {
+/// Writes `data` and `plan` for `out` under `key` (a temporary renamed into place, so a
+/// reader sees the old file or the new one), then forgets all but the newest [`KEEP`]
+/// files. Failing to cache never fails a build: the next `--tiles` analyses instead.
+pub fn store(file: &Path, key: &[u8; 32], data: &Dataset, plan: &Plan) {
     let Some(dir) = file.parent() else {
         return;
     };
@@ -149,7 +154,7 @@ pub fn store(file: &Path, key: &[u8; 32], plan: &Plan) {
         let mut w = BufWriter::new(fs::File::create(&tmp)?);
         w.write_all(MAGIC)?;
         w.write_all(key)?;
-        postcard::to_io(plan, &mut w).map_err(std::io::Error::other)?;
+        postcard::to_io(&(data, plan), &mut w).map_err(std::io::Error::other)?;
         w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
         fs::rename(&tmp, file)
     })();
@@ -160,29 +165,42 @@ pub fn store(file: &Path, key: &[u8; 32], plan: &Plan) {
     evict(dir);
 }
 
-/// Removes all but the [`KEEP`] most recently written plans.
+/// Removes all but the [`KEEP`] most recently written plans, and the older ones beyond
+/// [`KEEP_BYTES`].
 fn evict(dir: &Path) {
+    evict_beyond(dir, KEEP, KEEP_BYTES);
+}
+
+/// Keeps the newest plans while there are at most `keep` of `keep_bytes` together (the
+/// newest always).
+fn evict_beyond(dir: &Path, keep: usize, keep_bytes: u64) {
     let Ok(entries) = fs::read_dir(dir) else {
         return;
     };
-    let mut plans: Vec<(std::time::SystemTime, PathBuf)> = entries
+    let mut plans: Vec<(std::time::SystemTime, u64, PathBuf)> = entries
         .filter_map(|e| e.ok())
         .map(|e| e.path())
         .filter(|p| p.extension().is_some_and(|x| x == "plan"))
-        .filter_map(|p| Some((fs::metadata(&p).ok()?.modified().ok()?, p)))
+        .filter_map(|p| {
+            let m = fs::metadata(&p).ok()?;
+            Some((m.modified().ok()?, m.len(), p))
+        })
         .collect();
-    if plans.len() <= KEEP {
-        return;
-    }
-    plans.sort();
-    for (_, p) in &plans[..plans.len() - KEEP] {
-        let _ = fs::remove_file(p);
+    // Newest first: each is kept while the count and the bytes allow.
+    plans.sort_by(|a, b| b.cmp(a));
+    let mut bytes = 0u64;
+    for (i, (_, len, p)) in plans.iter().enumerate() {
+        bytes = bytes.saturating_add(*len);
+        if i > 0 && (i >= keep || bytes > keep_bytes) {
+            let _ = fs::remove_file(p);
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use geo::polygon;
 
     #[test]
     fn a_plan_comes_back_as_it_went_in() {
@@ -202,9 +220,41 @@ mod tests {
             fitness: 0.7,
             stones: 0,
         });
+        let mut data = Dataset::default();
+        let mut names = crate::model::FieldNames::default();
+        for id in ["a", "b"] {
+            let attrs: crate::model::Attrs =
+                [(names.intern("id"), id.into())].into_iter().collect();
+            data.lots.push(crate::model::Lot {
+                id: id.into(),
+                record: 0,
+                outline: polygon![(x: 0.0, y: 0.0), (x: 1.0, y: 0.0), (x: 0.0, y: 1.0)],
+                lot_use: crate::model::LotUse::Other("畑".into()),
+                mtype: None,
+                district: None,
+                tile: None,
+                attrs,
+                ground: -0.0,
+            });
+        }
+        data.warnings.push(crate::model::Warning::new(
+            crate::model::WarningClass::Layer,
+            "w",
+        ));
         let key = [7u8; 32];
-        store(&file, &key, &plan);
-        let back = load(&file, &key).expect("the same key reads the plan");
+        store(&file, &key, &data, &plan);
+        let (data_back, back) = load(&file, &key).expect("the same key reads the plan");
+        assert_eq!(data_back.warnings, data.warnings);
+        let [a, b] = &data_back.lots[..] else {
+            panic!("two lots went in");
+        };
+        assert_eq!(a.attrs, data.lots[0].attrs);
+        assert_eq!(a.lot_use, data.lots[0].lot_use);
+        assert_eq!(a.outline, data.lots[0].outline);
+        assert!(a.ground.is_sign_negative(), "-0 stays -0");
+        // The names are shared again as reading shares them.
+        let name = |l: &crate::model::Lot| l.attrs.iter().next().unwrap().0.as_ptr();
+        assert_eq!(name(a), name(b));
         assert_eq!(back.origin[0].to_bits(), plan.origin[0].to_bits());
         assert!(back.origin[1].is_nan());
         assert_eq!(back.tiles, plan.tiles);
@@ -224,7 +274,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         for i in 0..KEEP + 3 {
             let f = dir.path().join(format!("{i:02}.plan"));
-            store(&f, &[0u8; 32], &Plan::default());
+            store(&f, &[0u8; 32], &Dataset::default(), &Plan::default());
             // Distinct times, oldest first, whatever the file system's clock resolution.
             let t = UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + i as u64);
             fs::File::options()
@@ -234,7 +284,8 @@ mod tests {
                 .set_modified(t)
                 .unwrap();
         }
-        store(&dir.path().join("new.plan"), &[0u8; 32], &Plan::default());
+        let new = dir.path().join("new.plan");
+        store(&new, &[0u8; 32], &Dataset::default(), &Plan::default());
         let mut left: Vec<String> = fs::read_dir(dir.path())
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -246,5 +297,33 @@ mod tests {
             !left.contains(&"00.plan".to_string()),
             "the oldest went first"
         );
+    }
+
+    #[test]
+    fn the_kept_files_stay_within_their_bytes_and_the_newest_stays() {
+        let dir = tempfile::tempdir().unwrap();
+        for (i, name) in ["old", "mid", "new"].iter().enumerate() {
+            let f = dir.path().join(format!("{name}.plan"));
+            fs::write(&f, [0u8; 100]).unwrap();
+            let t = UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + i as u64);
+            fs::File::options()
+                .write(true)
+                .open(&f)
+                .unwrap()
+                .set_modified(t)
+                .unwrap();
+        }
+        let left = || {
+            let mut v: Vec<String> = fs::read_dir(dir.path())
+                .unwrap()
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect();
+            v.sort();
+            v
+        };
+        evict_beyond(dir.path(), 16, 250);
+        assert_eq!(left(), ["mid.plan", "new.plan"]);
+        evict_beyond(dir.path(), 16, 10);
+        assert_eq!(left(), ["new.plan"], "the newest is kept whatever its size");
     }
 }

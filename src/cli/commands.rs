@@ -57,16 +57,21 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
     }
     if timings {
         let t = &outcome.timings;
+        let read_and_analyse = match outcome.cache {
+            edo_city::build::cache::CacheUse::Reused => format!(
+                "read and analyse {:.3} s from the cache",
+                t.analyse.as_secs_f64()
+            ),
+            _ => format!(
+                "read {:.3} s, analyse {:.3} s (kura plots and R-tree {:.3} s, people and trees {:.3} s)",
+                t.read.as_secs_f64(),
+                t.analyse.as_secs_f64(),
+                t.kura.as_secs_f64(),
+                t.billboards.as_secs_f64()
+            ),
+        };
         eprintln!(
-            "timings: read {:.3} s, analyse {:.3} s{} (kura plots and R-tree {:.3} s, people and trees {:.3} s), generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, total {:.3} s",
-            t.read.as_secs_f64(),
-            t.analyse.as_secs_f64(),
-            match outcome.cache {
-                edo_city::build::cache::CacheUse::Reused => " from the cache",
-                _ => "",
-            },
-            t.kura.as_secs_f64(),
-            t.billboards.as_secs_f64(),
+            "timings: {read_and_analyse}, generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, total {:.3} s",
             t.generate_and_write.as_secs_f64(),
             t.generate_cpu.as_secs_f64(),
             t.write_cpu.as_secs_f64(),
@@ -79,7 +84,9 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
             .iter()
             .map(|(name, d)| format!("{name} {:.3} s", d.as_secs_f64()))
             .collect();
-        eprintln!("timings of the steps after fences: {}", steps.join(", "));
+        if !steps.is_empty() {
+            eprintln!("timings of the steps after fences: {}", steps.join(", "));
+        }
     }
     Ok(())
 }

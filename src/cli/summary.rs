@@ -201,8 +201,9 @@ pub fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<(
     }
     if o.cache == edo_city::build::cache::CacheUse::Reused {
         say!(
-            "  analysis   reused: this input, these parameters and this program were analysed \
-             by the last full build into this directory (EDO_CITY_CACHE=off analyses again)"
+            "  analysis   reused: this input, these parameters and this program were read and \
+             analysed by the last full build into this directory (EDO_CITY_CACHE=off does both \
+             again)"
         );
     }
     say!("  in {:.2} s", o.timings.total.as_secs_f64());

@@ -9,7 +9,7 @@ use std::sync::Arc;
 /// features. A map per feature allocates a 500-byte node and copies every field name into
 /// every feature; at a million lots that was over half a gigabyte. Here the names are shared
 /// (`Arc<str>`, one per layer field, see [`FieldNames`]) and the pairs sit in one vector.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Attrs(Vec<(Arc<str>, Box<str>)>);
 
 impl Attrs {
@@ -39,6 +39,14 @@ impl Attrs {
     /// Whether the feature has no fields.
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()
+    }
+
+    /// Makes its names the shared ones of `names` (a deserialized feature has its own
+    /// copies; the analysis cache reads a million of them back).
+    pub fn share_names(&mut self, names: &mut FieldNames) {
+        for (k, _) in &mut self.0 {
+            *k = names.intern(k);
+        }
     }
 
     fn find(&self, name: &str) -> Result<usize, usize> {

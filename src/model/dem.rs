@@ -9,7 +9,7 @@
 use geo_types::Coord;
 
 /// An elevation grid: `z[row * ncols + col]`, row 0 at the top (north).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Dem {
     /// The DEM's file, for messages.
     pub file: String,

@@ -65,7 +65,7 @@ pub struct PaletteEntry {
 }
 
 /// A record of the landmarks layer, as read.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LandmarkRecord {
     /// Its id (the id field, else the record number from 1).
     pub id: String,

@@ -40,7 +40,7 @@ pub fn sane(c: Coord<f64>) -> bool {
 }
 
 /// What a lot (shikichi 敷地) is used for; decides which generator it gets.
-#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LotUse {
     /// Town lot (machi-chi 町地): gets a townhouse, machiya 町家.
@@ -83,7 +83,7 @@ impl LotUse {
 }
 
 /// One lot polygon with the attributes the pipeline needs, after the table join.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Lot {
     /// The `id` attribute, unique within the layer.
     pub id: String,
@@ -106,7 +106,7 @@ pub struct Lot {
 }
 
 /// A free-standing fence or wall from a line layer.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct FenceLine {
     /// The line's id (its field, else its record number from 1; parts `<id>-<n>`).
     pub id: String,
@@ -120,7 +120,7 @@ pub struct FenceLine {
 
 /// A polygon of the optional gardens layer (`layers.gardens`): where a user has drawn a rock
 /// garden's ground, whatever the lot's use.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct GardenArea {
     /// Its id (the layer's id field, else its record number from 1; parts `<id>-<n>`).
     pub id: String,
@@ -131,7 +131,7 @@ pub struct GardenArea {
 }
 
 /// A link placed in the city (the paper's hyperlinks): a point that opens a page or image.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Link {
     /// Its id (the id field, else its record number from 1).
     pub id: String,
@@ -148,7 +148,7 @@ pub struct Link {
 }
 
 /// A person or a tree given as a point (`people.shp`, `trees.shp`).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PointFeature {
     /// The point's id.
     pub id: String,
@@ -165,7 +165,7 @@ pub struct PointFeature {
 }
 
 /// A building footprint from the data, built as a house of its own height.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Footprint {
     /// The footprint's id, unique within the layer.
     pub id: String,
@@ -208,7 +208,7 @@ pub struct LayerInfo {
 }
 
 /// A street centreline with its full width in metres.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Street {
     /// The street's id (its record in the file).
     pub id: String,
@@ -236,8 +236,9 @@ pub struct Skipped {
     pub reason: String,
 }
 
-/// Everything read from the input directory, in input order.
-#[derive(Debug, Clone, Default)]
+/// Everything read from the input directory, in input order. (Serialized only into the
+/// analysis cache, `build::cache`, with the plan made from it.)
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct Dataset {
     /// Lot polygons, parts of multipart lots split.
     pub lots: Vec<Lot>,
@@ -273,8 +274,10 @@ pub struct Dataset {
     /// Every layer read, for the report.
     pub layers: Vec<LayerInfo>,
     /// Features left out while reading, with their reasons.
+    #[serde(with = "as_json")]
     pub skipped: Vec<Skipped>,
     /// What reading noticed.
+    #[serde(with = "as_json")]
     pub warnings: Vec<Warning>,
     /// How each attribute table matched its layer.
     pub joins: Vec<TableJoin>,
@@ -282,6 +285,20 @@ pub struct Dataset {
     /// street widths): the records that gave at least one usable feature, by role. The
     /// report's ledger checks every other record was skipped with a reason.
     pub records: BTreeMap<String, std::collections::BTreeSet<usize>>,
+}
+
+impl Dataset {
+    /// Shares the features' attribute names again, one allocation per name (as reading
+    /// made them) after the analysis cache read them back each on its own.
+    pub fn share_field_names(&mut self) {
+        let mut names = attrs::FieldNames::default();
+        for lot in &mut self.lots {
+            lot.attrs.share_names(&mut names);
+        }
+        for fence in &mut self.fence_lines {
+            fence.attrs.share_names(&mut names);
+        }
+    }
 }
 
 /// How an attribute table matched its layer.

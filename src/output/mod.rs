@@ -25,6 +25,8 @@ pub mod tiles3d;
 use std::borrow::Cow;
 use std::path::Path;
 
+use rayon::prelude::*;
+
 use sha2::{Digest, Sha256};
 
 use crate::generate::mesh::Mesh;
@@ -90,20 +92,26 @@ pub fn texture_library(set: &str) -> Result<Vec<Texture>, String> {
 /// [`crate::materials::Material::mask`]), each derived from the texture as it is now (a
 /// replaced tree texture gets its own mask).
 pub fn with_masks(mut lib: Vec<Texture>) -> Result<Vec<Texture>, String> {
+    let mut wanted: Vec<(&'static str, &'static str, &[u8])> = Vec::new();
     for m in crate::materials::MATERIALS {
         let (Some(mask), Some(tex)) = (m.mask, m.texture) else {
             continue;
         };
-        if lib.iter().any(|(n, _)| *n == mask) {
-            continue;
+        let have_mask = lib.iter().any(|(n, _)| *n == mask) || wanted.iter().any(|w| w.0 == mask);
+        if let (false, Some((_, bytes))) = (have_mask, lib.iter().find(|(n, _)| *n == tex)) {
+            wanted.push((mask, tex, bytes));
         }
-        let Some((_, bytes)) = lib.iter().find(|(n, _)| *n == tex) else {
-            continue;
-        };
-        lib.push((
-            mask,
-            Cow::Owned(mask_png(bytes).map_err(|e| format!("{tex}: {e}"))?),
-        ));
+    }
+    // Each mask decodes and encodes a PNG: in parallel, and pushed in the materials' order.
+    let masks: Vec<Result<Texture, String>> = wanted
+        .par_iter()
+        .map(|&(mask, tex, bytes)| {
+            let png = mask_png(bytes).map_err(|e| format!("{tex}: {e}"))?;
+            Ok((mask, Cow::Owned(png)))
+        })
+        .collect();
+    for m in masks {
+        lib.push(m?);
     }
     Ok(lib)
 }
