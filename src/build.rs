@@ -309,6 +309,12 @@ fn run(
 ) -> Result<BuildOutcome, BuildError> {
     let params = &opts.params;
     let mut timings = Timings::default();
+    // `--tiles` into a directory of another hypothesis is refused before a minute of reading
+    // and analysis at a million lots, not after (checked again under the lock below); a
+    // missing input is still reported as that.
+    if matches!(opts.selection, Selection::Tiles(_)) && opts.input.is_dir() {
+        shards::check_out_dir(opts)?;
+    }
     // A build caches its input and plan; `--tiles` of the same key reads them instead of
     // reading the input and analysing it.
     let cache_file = match opts.selection {

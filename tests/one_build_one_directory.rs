@@ -228,6 +228,37 @@ fn tiles_with_force_never_stamps_new_parameters_on_old_tiles() {
 }
 
 #[test]
+fn tiles_into_another_hypothesis_are_refused_before_the_input_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let town = dir.path().join("town");
+    common::copy_fixture("kyoto-small", &town);
+    let out = dir.path().join("out");
+    build_ok(&town, &out, &["--quiet"]);
+    let m = read_json(&out.join("manifest.json"));
+    let tile = m["tiles"][0]["id"].as_str().unwrap().to_string();
+    // Lots that no longer read: a run that read them would name them; the refusal comes
+    // first (at a million lots a minute of reading and analysis earlier).
+    std::fs::write(town.join("lots.shp"), b"not a shapefile").unwrap();
+    let p = dir.path().join("p.toml");
+    std::fs::write(&p, "seed = 5\n").unwrap();
+    let o = edo_city()
+        .arg("build")
+        .arg(&town)
+        .arg("--out")
+        .arg(&out)
+        .args(["--quiet", "--tiles", &tile, "--params"])
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr_of(&o);
+    assert!(
+        e.contains("--tiles only rewrites") && e.contains("seed"),
+        "{e}"
+    );
+}
+
+#[test]
 fn an_empty_tile_id_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
