@@ -9,6 +9,20 @@ use std::path::Path;
 
 use common::{all_files, build_ok, edo_city, fixture, read_json, synth};
 
+/// `edo-city build input --out out args... --params params`.
+fn build_with(input: &Path, out: &Path, args: &[&str], params: &Path) -> std::process::Output {
+    edo_city()
+        .arg("build")
+        .arg(input)
+        .arg("--out")
+        .arg(out)
+        .args(args)
+        .arg("--params")
+        .arg(params)
+        .output()
+        .unwrap()
+}
+
 fn stderr_of(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -187,15 +201,7 @@ fn merge_of_two_builds_names_the_parameter_that_differs() {
     two_shards(&town, &a, &b);
     let p = dir.path().join("p.toml");
     std::fs::write(&p, "seed = 5\n").unwrap();
-    let o = edo_city()
-        .arg("build")
-        .arg(&town)
-        .arg("--out")
-        .arg(&b)
-        .args(["--quiet", "--shard", "2/2", "--force", "--params"])
-        .arg(&p)
-        .output()
-        .unwrap();
+    let o = build_with(&town, &b, &["--quiet", "--shard", "2/2", "--force"], &p);
     assert!(o.status.success(), "{}", stderr_of(&o));
     let o = edo_city().arg("merge").arg(&a).arg(&b).output().unwrap();
     let e = stderr_of(&o);
@@ -212,15 +218,12 @@ fn tiles_with_force_never_stamps_new_parameters_on_old_tiles() {
     std::fs::write(&p, "seed = 5\n").unwrap();
     let m = read_json(&out.join("manifest.json"));
     let tile = m["tiles"][0]["id"].as_str().unwrap().to_string();
-    let o = edo_city()
-        .arg("build")
-        .arg(fixture("kyoto-small"))
-        .arg("--out")
-        .arg(&out)
-        .args(["--quiet", "--force", "--tiles", &tile, "--params"])
-        .arg(&p)
-        .output()
-        .unwrap();
+    let o = build_with(
+        &fixture("kyoto-small"),
+        &out,
+        &["--quiet", "--force", "--tiles", &tile],
+        &p,
+    );
     assert_eq!(o.status.code(), Some(2));
     let e = stderr_of(&o);
     assert!(e.contains("even with --force") && e.contains("seed"), "{e}");
@@ -241,15 +244,7 @@ fn tiles_into_another_hypothesis_are_refused_before_the_input_is_read() {
     std::fs::write(town.join("lots.shp"), b"not a shapefile").unwrap();
     let p = dir.path().join("p.toml");
     std::fs::write(&p, "seed = 5\n").unwrap();
-    let o = edo_city()
-        .arg("build")
-        .arg(&town)
-        .arg("--out")
-        .arg(&out)
-        .args(["--quiet", "--tiles", &tile, "--params"])
-        .arg(&p)
-        .output()
-        .unwrap();
+    let o = build_with(&town, &out, &["--quiet", "--tiles", &tile], &p);
     assert_eq!(o.status.code(), Some(2));
     let e = stderr_of(&o);
     assert!(

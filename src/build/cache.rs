@@ -269,6 +269,13 @@ mod tests {
         assert!(load(&file, &key).is_none());
     }
 
+    /// Sets `f`'s time of writing to `secs` after a fixed day long past.
+    fn written_at(f: &Path, secs: u64) {
+        let t = UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + secs);
+        let file = fs::File::options().write(true).open(f).unwrap();
+        file.set_modified(t).unwrap();
+    }
+
     #[test]
     fn only_the_newest_files_are_kept() {
         let dir = tempfile::tempdir().unwrap();
@@ -276,13 +283,7 @@ mod tests {
             let f = dir.path().join(format!("{i:02}.plan"));
             store(&f, &[0u8; 32], &Dataset::default(), &Plan::default());
             // Distinct times, oldest first, whatever the file system's clock resolution.
-            let t = UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + i as u64);
-            fs::File::options()
-                .write(true)
-                .open(&f)
-                .unwrap()
-                .set_modified(t)
-                .unwrap();
+            written_at(&f, i as u64);
         }
         let new = dir.path().join("new.plan");
         store(&new, &[0u8; 32], &Dataset::default(), &Plan::default());
@@ -305,13 +306,7 @@ mod tests {
         for (i, name) in ["old", "mid", "new"].iter().enumerate() {
             let f = dir.path().join(format!("{name}.plan"));
             fs::write(&f, [0u8; 100]).unwrap();
-            let t = UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + i as u64);
-            fs::File::options()
-                .write(true)
-                .open(&f)
-                .unwrap()
-                .set_modified(t)
-                .unwrap();
+            written_at(&f, i as u64);
         }
         let left = || {
             let mut v: Vec<String> = fs::read_dir(dir.path())
