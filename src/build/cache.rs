@@ -65,16 +65,34 @@ fn hex(bytes: &[u8]) -> String {
 
 /// The key of a build's analysis: the program (its size and time of writing), the
 /// parameters, and every file of the input, the templates and the textures (path, size,
-/// time of writing). Contents are not hashed: a million-lot input is gigabytes, and an edit
-/// changes a file's time.
+/// time of writing), and every file the parameters name outside the input (a DEM or a table
+/// kept elsewhere, with a shapefile's sidecars). Contents are not hashed: a million-lot
+/// input is gigabytes, and an edit changes a file's time.
 pub fn key(opts: &BuildOptions) -> [u8; 32] {
     let mut h = Sha256::new();
     h.update(env!("CARGO_PKG_VERSION").as_bytes());
     if let Ok(exe) = std::env::current_exe() {
         stamp(&mut h, &exe);
     }
-    h.update(serde_json::to_vec(&opts.params).unwrap_or_default());
+    let params = serde_json::to_value(&opts.params).unwrap_or_default();
+    h.update(params.to_string().as_bytes());
     let skip = super::absolute(&opts.out);
+    let input = super::absolute(&opts.input);
+    let mut named = Vec::new();
+    strings(&params, &mut named);
+    for s in named {
+        let p = super::absolute(&opts.input.join(s));
+        if p.starts_with(&input) || p == skip {
+            continue;
+        }
+        h.update(b"\0named\0");
+        // A folder above the input (a stray "..") would take in the whole disk.
+        if p.is_dir() && !input.starts_with(&p) {
+            walk(&mut h, &p, &skip, 2);
+        } else if p.is_file() {
+            siblings(&mut h, &p);
+        }
+    }
     let mut dirs = vec![opts.input.clone()];
     dirs.extend(opts.templates.clone());
     if !opts.params.textures.is_empty() {
@@ -85,6 +103,34 @@ pub fn key(opts: &BuildOptions) -> [u8; 32] {
         walk(&mut h, &dir, &skip, 0);
     }
     h.finalize().into()
+}
+
+/// Every string in the parameters (a file a layer, table or DEM names is among them).
+fn strings<'a>(v: &'a serde_json::Value, out: &mut Vec<&'a str>) {
+    match v {
+        serde_json::Value::String(s) if !s.is_empty() => out.push(s),
+        serde_json::Value::Array(a) => a.iter().for_each(|v| strings(v, out)),
+        serde_json::Value::Object(o) => o.values().for_each(|v| strings(v, out)),
+        _ => {}
+    }
+}
+
+/// A named file and the files beside it of the same stem (`lots.dbf` beside `lots.shp`).
+fn siblings(h: &mut Sha256, file: &Path) {
+    let (Some(dir), Some(stem)) = (file.parent(), file.file_stem()) else {
+        return;
+    };
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.file_stem() == Some(stem) && p.is_file())
+        .collect();
+    paths.sort();
+    for p in paths {
+        stamp(h, &p);
+    }
 }
 
 /// A file's path, size and modification time into the key.
@@ -274,6 +320,36 @@ mod tests {
         let t = UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + secs);
         let file = fs::File::options().write(true).open(f).unwrap();
         file.set_modified(t).unwrap();
+    }
+
+    #[test]
+    fn a_file_the_parameters_name_outside_the_input_is_in_the_key() {
+        let dir = tempfile::tempdir().unwrap();
+        let (input, elsewhere) = (dir.path().join("in"), dir.path().join("elsewhere"));
+        fs::create_dir_all(&input).unwrap();
+        fs::create_dir_all(&elsewhere).unwrap();
+        fs::write(input.join("lots.shp"), "x").unwrap();
+        fs::write(elsewhere.join("dem.asc"), "1").unwrap();
+        fs::write(elsewhere.join("dem.prj"), "p").unwrap();
+        let mut params = crate::params::Params::default();
+        params.layers.lots.file = "../elsewhere/dem.asc".into();
+        let opts = BuildOptions {
+            input: input.clone(),
+            out: dir.path().join("out"),
+            params,
+            templates: None,
+            threads: 1,
+            plan_image: false,
+            selection: super::super::Selection::All,
+            force: false,
+        };
+        let before = key(&opts);
+        assert_eq!(key(&opts), before, "the same files, the same key");
+        fs::write(elsewhere.join("dem.prj"), "another").unwrap();
+        assert_ne!(key(&opts), before, "a sidecar of the named file changed");
+        let again = key(&opts);
+        fs::write(input.join("lots.shp"), "xy").unwrap();
+        assert_ne!(key(&opts), again, "a file of the input changed");
     }
 
     #[test]
