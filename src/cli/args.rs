@@ -33,7 +33,9 @@ pub struct BuildArgs {
     #[arg(long)]
     pub no_plan: bool,
     /// Rewrite only these tiles (comma-separated ids) of an earlier full build in --out;
-    /// each comes out byte-identical to the same tile of a full build.
+    /// each comes out byte-identical to the same tile of a full build. The full build's
+    /// input and analysis are read back from ~/.cache/edo-city when nothing changed
+    /// (EDO_CITY_CACHE=off: read and analyse again).
     #[arg(long, value_delimiter = ',', conflicts_with = "shard")]
     pub tiles: Option<Vec<String>>,
     /// Build the I-th of N balanced, disjoint sets of tiles (e.g. 2/8), for a cluster;
