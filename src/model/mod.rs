@@ -603,7 +603,9 @@ impl PlannedHouse {
     }
 }
 
-/// The output of analysis: what to build, tile by tile.
+/// The output of analysis: what to build, tile by tile. Serialized only into the analysis
+/// cache (`build::cache`): a field added here is cached with it, and one whose type skips
+/// fields when it serializes needs `#[serde(with = "as_json")]`.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct Plan {
     /// Dataset origin in projected metres: output coordinates are relative to it.
