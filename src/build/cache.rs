@@ -340,7 +340,7 @@ mod tests {
             templates: None,
             threads: 1,
             plan_image: false,
-            selection: super::super::Selection::All,
+            selection: crate::build::Selection::All,
             force: false,
         };
         let before = key(&opts);
