@@ -317,14 +317,13 @@ fn run(
     }
     // A build caches its input and plan; `--tiles` of the same key reads them instead of
     // reading the input and analysing it.
-    let cache_file = match opts.selection {
+    let cache = match opts.selection {
         Selection::Shard { .. } => None,
-        _ => cache::file_for(&opts.out),
+        _ => cache::file_for(&opts.out).map(|file| (file, cache::key(opts))),
     };
-    let key = cache_file.as_ref().map(|_| cache::key(opts));
     let t = Instant::now();
-    let cached = match (&opts.selection, &cache_file, &key) {
-        (Selection::Tiles(_), Some(file), Some(key)) => {
+    let cached = match (&opts.selection, &cache) {
+        (Selection::Tiles(_), Some((file, key))) => {
             progress.start("reading the analysis cache", 0);
             let cached = cache::load(file, key);
             progress.finish();
@@ -339,10 +338,7 @@ fn run(
         None => read_and_analyse(&opts.input, params, catalog, progress)?,
     };
     // Any whole analysis is worth keeping (a `--tiles` after an edit of the input, too).
-    let store = match (reused, &cache_file, &key) {
-        (false, Some(file), Some(key)) => Some((file, key)),
-        _ => None,
-    };
+    let store = cache.as_ref().filter(|_| !reused);
     timings.read = read;
     timings.analyse = analysed;
     timings.kura = plan.kura_time;
@@ -387,7 +383,7 @@ fn run(
     // nobody waits for: a thread does it, and a CLI that exits first just ends it.
     std::thread::spawn(move || drop((data, plan)));
     let written = written.map(|o| BuildOutcome {
-        cache: match (reused, &cache_file) {
+        cache: match (reused, &cache) {
             (true, _) => cache::CacheUse::Reused,
             (false, Some(_)) => cache::CacheUse::Analysed,
             (false, None) => cache::CacheUse::Off,

@@ -55,12 +55,8 @@ pub fn file_for(out: &Path) -> Option<PathBuf> {
         },
     };
     let out = super::absolute(out);
-    let name = hex(&Sha256::digest(out.as_os_str().as_encoded_bytes())[..12]);
-    Some(dir.join(format!("{name}.plan")))
-}
-
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
+    let name = crate::output::sha256_hex(out.as_os_str().as_encoded_bytes());
+    Some(dir.join(format!("{}.plan", &name[..24])))
 }
 
 /// The key of a build's analysis: the program (its size and time of writing), the
