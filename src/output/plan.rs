@@ -129,32 +129,151 @@ fn paint(rgb: [u8; 3], a: u8) -> Paint<'static> {
 }
 
 fn line_path(view: &View, pts: &[Coord<f64>]) -> Option<tiny_skia::Path> {
-    let mut pb = PathBuilder::new();
-    for (i, c) in pts.iter().enumerate() {
-        let (x, y) = view.pixel(c);
-        if i == 0 {
-            pb.move_to(x, y)
-        } else {
-            pb.line_to(x, y)
-        }
-    }
-    pb.finish()
+    let mut batch = Batch::default();
+    batch.line(view, pts);
+    batch.finish().pop()
 }
 
-fn polygon_path(view: &View, poly: &Polygon<f64>) -> Option<tiny_skia::Path> {
-    let mut pb = PathBuilder::new();
-    for ring in std::iter::once(poly.exterior()).chain(poly.interiors()) {
-        for (i, c) in ring.0.iter().enumerate() {
+/// Shapes of one paint gathered into few paths, each drawn by one call. tiny-skia's cost is
+/// per call and per span of pixels, and side by side lots of one colour share their spans:
+/// a path per lot made the plan a third of a 30,052-lot build's CPU. A path holds at most
+/// [`Batch::SHAPES`] shapes, because tiny-skia builds every edge of a path before it draws
+/// (one path of a million lots would hold hundreds of megabytes of edges).
+#[derive(Default)]
+struct Batch {
+    done: Vec<tiny_skia::Path>,
+    open: PathBuilder,
+    shapes: usize,
+}
+
+impl Batch {
+    /// Shapes per path.
+    const SHAPES: usize = 1024;
+
+    /// A polygon's rings, the exterior counter-clockwise on screen and the holes clockwise,
+    /// so the nonzero rule fills the union of overlapping polygons and keeps their holes
+    /// (even-odd would punch a hole where two lots of the data overlap).
+    fn polygon(&mut self, view: &View, poly: &Polygon<f64>) {
+        self.push_ring(view, &poly.exterior().0, true);
+        for hole in poly.interiors() {
+            self.push_ring(view, &hole.0, false);
+        }
+        self.shape_done();
+    }
+
+    /// A closed ring (a shape of its own), counter-clockwise on screen.
+    fn ring(&mut self, view: &View, pts: &[Coord<f64>]) {
+        self.push_ring(view, pts, true);
+        self.shape_done();
+    }
+
+    /// A closed ring, turned to `outer`'s orientation.
+    fn push_ring(&mut self, view: &View, pts: &[Coord<f64>], outer: bool) {
+        let mut px: Vec<(f32, f32)> = pts.iter().map(|c| view.pixel(c)).collect();
+        let twice_area: f32 = px
+            .iter()
+            .zip(px.iter().cycle().skip(1))
+            .map(|(a, b)| a.0 * b.1 - b.0 * a.1)
+            .sum();
+        // Screen y points down, so a counter-clockwise ring has a negative shoelace sum.
+        if (twice_area > 0.0) == outer {
+            px.reverse();
+        }
+        if let Some((&(x, y), rest)) = px.split_first() {
+            self.open.move_to(x, y);
+            for &(x, y) in rest {
+                self.open.line_to(x, y);
+            }
+            self.open.close();
+        }
+    }
+
+    /// An open polyline.
+    fn line(&mut self, view: &View, pts: &[Coord<f64>]) {
+        for (i, c) in pts.iter().enumerate() {
             let (x, y) = view.pixel(c);
             if i == 0 {
-                pb.move_to(x, y)
+                self.open.move_to(x, y)
             } else {
-                pb.line_to(x, y)
+                self.open.line_to(x, y)
             }
         }
-        pb.close();
+        self.shape_done();
     }
-    pb.finish()
+
+    fn circle(&mut self, x: f32, y: f32, r: f32) {
+        self.open.push_circle(x, y, r);
+        self.shape_done();
+    }
+
+    fn shape_done(&mut self) {
+        self.shapes += 1;
+        if self.shapes.is_multiple_of(Self::SHAPES) {
+            self.close_path();
+        }
+    }
+
+    fn close_path(&mut self) {
+        if let Some(path) = std::mem::take(&mut self.open).finish() {
+            self.done.push(path);
+        }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.shapes == 0
+    }
+
+    /// The paths (none when nothing drawable was added).
+    fn finish(mut self) -> Vec<tiny_skia::Path> {
+        self.close_path();
+        self.done
+    }
+}
+
+/// Outlines of lots, houses and blocks.
+const OUTLINE: [u8; 3] = [90, 80, 70];
+
+/// Each colour's batch filled, then every batch outlined with a hairline. The fills are not
+/// anti-aliased (the outline smooths their edges): anti-aliasing the fills of 30,000 lots
+/// took as long as everything else in the plan.
+fn fill_then_outline(pm: &mut Pixmap, batches: BTreeMap<[u8; 3], Batch>, outline: [u8; 3]) {
+    let id = Transform::identity();
+    let paths: Vec<([u8; 3], Vec<tiny_skia::Path>)> = batches
+        .into_iter()
+        .map(|(colour, b)| (colour, b.finish()))
+        .collect();
+    for (colour, paths) in &paths {
+        let fill = crisp(paint(*colour, 255));
+        for path in paths {
+            pm.fill_path(path, &fill, FillRule::Winding, id, None);
+        }
+    }
+    let outline = paint(outline, 255);
+    for path in paths.iter().flat_map(|(_, p)| p) {
+        pm.stroke_path(path, &outline, &thin(), id, None);
+    }
+}
+
+/// Strokes a batch with one paint.
+fn stroke(pm: &mut Pixmap, batch: Batch, colour: [u8; 3], alpha: u8, stroke: &Stroke) {
+    let paint = paint(colour, alpha);
+    for path in batch.finish() {
+        pm.stroke_path(&path, &paint, stroke, Transform::identity(), None);
+    }
+}
+
+/// Fills a batch with one paint.
+fn fill(pm: &mut Pixmap, batch: Batch, paint: &Paint) {
+    for path in batch.finish() {
+        pm.fill_path(&path, paint, FillRule::Winding, Transform::identity(), None);
+    }
+}
+
+/// The paint without anti-aliasing: for shapes whose edges are outlined anyway, and small
+/// squares that stay squares.
+fn crisp(mut paint: Paint<'static>) -> Paint<'static> {
+    paint.anti_alias = false;
+    paint
 }
 
 /// Draws the plan; `None` when there is nothing to draw. `tile_grid` = (size, origin).
@@ -199,31 +318,35 @@ pub fn draw_plan(
     encode_png(&pm)
 }
 
-/// A one-pixel stroke.
+/// A hairline: one pixel wide at any scale, drawn by tiny-skia's line rasteriser instead of
+/// being stroked into a polygon (a third of the plan's time when every outline was one).
 fn thin() -> Stroke {
     Stroke {
-        width: 1.0,
+        width: 0.0,
         ..Stroke::default()
     }
 }
 
 /// Street bands as wide as the streets, and block outlines.
 fn draw_streets(pm: &mut Pixmap, view: &View, data: &Dataset) {
-    let id = Transform::identity();
+    // One batch per band width (its f32 bits: a key that sorts and compares exactly).
+    let mut bands: BTreeMap<u32, Batch> = BTreeMap::new();
     for street in &data.streets {
-        if let Some(path) = line_path(view, &street.line.0) {
-            let stroke = Stroke {
-                width: ((street.width * view.scale) as f32).max(1.0),
-                ..Stroke::default()
-            };
-            pm.stroke_path(&path, &paint([215, 212, 205], 255), &stroke, id, None);
-        }
+        let width = ((street.width * view.scale) as f32).max(1.0);
+        bands.entry(width.to_bits()).or_default().line(view, &street.line.0);
     }
+    for (width, batch) in bands {
+        let band = Stroke {
+            width: f32::from_bits(width),
+            ..Stroke::default()
+        };
+        stroke(pm, batch, [215, 212, 205], 255, &band);
+    }
+    let mut blocks = Batch::default();
     for block in &data.blocks {
-        if let Some(path) = polygon_path(view, block) {
-            pm.stroke_path(&path, &paint([160, 160, 160], 255), &thin(), id, None);
-        }
+        blocks.polygon(view, block);
     }
+    stroke(pm, blocks, [160, 160, 160], 255, &thin());
 }
 
 /// Lots without a house (other uses, given to a landmark, skipped ones), then every house by its type's colour.
@@ -234,7 +357,6 @@ fn draw_lots_and_houses(
     plan: &Plan,
     colours: &BTreeMap<String, [u8; 3]>,
 ) {
-    let id = Transform::identity();
     let skipped: HashSet<&str> = plan.skipped.iter().map(|s| s.id.as_str()).collect();
     let displaced: HashSet<&str> = (plan.landmark_report.displaced.iter())
         .filter(|d| d.kind == "machiya")
@@ -247,42 +369,36 @@ fn draw_lots_and_houses(
         .filter(|m| !m.is_footprint())
         .map(|m| m.id.as_str())
         .collect();
+    let mut lots: BTreeMap<[u8; 3], Batch> = BTreeMap::new();
     for lot in &data.lots {
         if planned.contains(lot.id.as_str()) {
             continue;
         }
-        if let Some(path) = polygon_path(view, &lot.outline) {
-            let fill = if displaced.contains(lot.id.as_str()) {
-                LANDMARK_LOT
-            } else if skipped.contains(lot.id.as_str()) {
-                SKIPPED
-            } else {
-                OTHER_USE
-            };
-            pm.fill_path(&path, &paint(fill, 255), FillRule::EvenOdd, id, None);
-            pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin(), id, None);
-        }
+        let fill = if displaced.contains(lot.id.as_str()) {
+            LANDMARK_LOT
+        } else if skipped.contains(lot.id.as_str()) {
+            SKIPPED
+        } else {
+            OTHER_USE
+        };
+        lots.entry(fill).or_default().polygon(view, &lot.outline);
     }
+    fill_then_outline(pm, lots, OUTLINE);
+    let mut houses: BTreeMap<[u8; 3], Batch> = BTreeMap::new();
     for m in plan.houses.values().flatten() {
         let colour = match m.footprint_height() {
             Some(_) => FOOTPRINT,
             None => colours.get(&m.mtype).copied().unwrap_or(TYPE_COLOURS[0]),
         };
-        if let Some(path) = polygon_path(view, &m.outline) {
-            pm.fill_path(&path, &paint(colour, 255), FillRule::EvenOdd, id, None);
-            pm.stroke_path(&path, &paint([90, 80, 70], 255), &thin(), id, None);
-        }
+        houses.entry(colour).or_default().polygon(view, &m.outline);
     }
+    fill_then_outline(pm, houses, OUTLINE);
 }
 
 /// Kura filled where built, outlined where the avoidance (`avoid`) refused them; whether any
 /// was refused (for the legend).
 fn draw_kura(pm: &mut Pixmap, view: &View, plan: &Plan, avoid: bool) -> bool {
-    let id = Transform::identity();
-    let refused = Stroke {
-        width: 1.5,
-        ..Stroke::default()
-    };
+    let (mut built, mut refused) = (Batch::default(), Batch::default());
     let mut refused_any = false;
     for m in plan.houses.values().flatten() {
         let Some(r) = m.kura.rect() else { continue };
@@ -292,119 +408,103 @@ fn draw_kura(pm: &mut Pixmap, view: &View, plan: &Plan, avoid: bool) -> bool {
             v: m.frontage.v_axis(),
         }
         .quad(r);
-        let Some(path) = line_path(view, &[q[0], q[1], q[2], q[3], q[0]]) else {
-            continue;
-        };
         if m.kura.to_build(avoid).is_some() {
-            pm.fill_path(&path, &paint(KURA, 255), FillRule::EvenOdd, id, None);
+            built.ring(view, &q);
         } else {
             refused_any = true;
-            pm.stroke_path(&path, &paint(KURA_REFUSED, 255), &refused, id, None);
+            refused.ring(view, &q);
         }
     }
+    fill(pm, built, &crisp(paint(KURA, 255)));
+    let width = Stroke {
+        width: 1.5,
+        ..Stroke::default()
+    };
+    stroke(pm, refused, KURA_REFUSED, 255, &width);
     refused_any
 }
 
 /// The halls' plots, filled (whether there was any).
 fn draw_halls(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
-    let mut any = false;
+    let mut halls = Batch::default();
     for h in plan.halls.values().flatten() {
-        let ring = h.outline();
-        let Some(path) = line_path(view, &[ring[0], ring[1], ring[2], ring[3], ring[0]]) else {
-            continue;
-        };
-        pm.fill_path(
-            &path,
-            &paint(HALL, 255),
-            FillRule::EvenOdd,
-            Transform::identity(),
-            None,
-        );
-        any = true;
+        halls.ring(view, &h.outline());
     }
+    let any = !halls.is_empty();
+    fill(pm, halls, &crisp(paint(HALL, 255)));
     any
 }
 
 /// The landmarks' footprints, filled and outlined (whether there was any).
 fn draw_landmarks(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
-    let mut any = false;
+    let mut landmarks = Batch::default();
     for l in plan.landmarks.values().flatten() {
-        let Some(path) = polygon_path(view, &l.footprint) else {
-            continue;
+        landmarks.polygon(view, &l.footprint);
+    }
+    let any = !landmarks.is_empty();
+    fill_then_outline(pm, BTreeMap::from([(LANDMARK, landmarks)]), [40, 20, 60]);
+    any
+}
+
+/// Walls and gates (section 4.3): a dark line along each wall segment, a red bar per gate
+/// (gates over walls); whether there was any.
+fn draw_fences(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
+    let (mut walls, mut gates) = (Batch::default(), Batch::default());
+    for f in plan.fences.values().flatten() {
+        match f.kind {
+            crate::model::FenceKind::Wall => walls.line(view, &[f.a, f.b]),
+            crate::model::FenceKind::Gate => gates.line(view, &[f.a, f.b]),
+        }
+    }
+    let any = !walls.is_empty() || !gates.is_empty();
+    for (batch, colour, width) in [(walls, FENCE, 2.0), (gates, GATE, 4.0)] {
+        let width = Stroke {
+            width,
+            ..Stroke::default()
         };
-        let id = Transform::identity();
-        pm.fill_path(&path, &paint(LANDMARK, 255), FillRule::EvenOdd, id, None);
-        pm.stroke_path(&path, &paint([40, 20, 60], 255), &thin(), id, None);
-        any = true;
+        stroke(pm, batch, colour, 255, &width);
     }
     any
 }
 
-/// Walls and gates (section 4.3): a dark line along each wall segment, a red bar per gate;
-/// whether there was any.
-fn draw_fences(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
-    let id = Transform::identity();
-    let (wall, gate_bar) = (
-        Stroke {
-            width: 2.0,
-            ..Stroke::default()
-        },
-        Stroke {
-            width: 4.0,
-            ..Stroke::default()
-        },
-    );
-    let mut any_fence = false;
-    for f in plan.fences.values().flatten() {
-        if let Some(path) = line_path(view, &[f.a, f.b]) {
-            any_fence = true;
-            let (colour, stroke) = match f.kind {
-                crate::model::FenceKind::Wall => (FENCE, &wall),
-                crate::model::FenceKind::Gate => (GATE, &gate_bar),
-            };
-            pm.stroke_path(&path, &paint(colour, 255), stroke, id, None);
-        }
-    }
-    any_fence
-}
-
-/// People and trees (section 4.4): a dot each, a tree's as wide as its crown; whether there
-/// was any.
+/// People and trees (section 4.4): a dot each, a tree's as wide as its crown (people over
+/// trees); whether there was any.
 fn draw_billboards(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
-    let mut any_billboard = false;
+    let (mut trees, mut people) = (Batch::default(), Batch::default());
     for b in plan.billboards.values().flatten() {
         let (x, y) = view.pixel(&b.at);
-        let (colour, r) = match b.kind {
-            crate::model::BillboardKind::Tree => (TREE, (b.height * 0.25 * view.scale) as f32),
-            crate::model::BillboardKind::Person => (PERSON, 2.5),
-        };
-        if let Some(dot) = tiny_skia::PathBuilder::from_circle(x, y, r.max(1.5)) {
-            any_billboard = true;
-            let id = Transform::identity();
-            pm.fill_path(&dot, &paint(colour, 220), FillRule::Winding, id, None);
+        match b.kind {
+            crate::model::BillboardKind::Tree => {
+                let r = (b.height * 0.25 * view.scale) as f32;
+                trees.circle(x, y, r.max(1.5));
+            }
+            crate::model::BillboardKind::Person => people.circle(x, y, 2.5),
         }
     }
-    any_billboard
+    let any = !trees.is_empty() || !people.is_empty();
+    // Dots stay anti-aliased: crisp, a small circle is a cross.
+    fill(pm, trees, &paint(TREE, 220));
+    fill(pm, people, &paint(PERSON, 220));
+    any
 }
 
 /// Street centrelines and each house's frontage, on top: in cadastral data the roads are
 /// parcels too and would hide them.
 fn draw_lines_on_top(pm: &mut Pixmap, view: &View, data: &Dataset, plan: &Plan) {
-    let id = Transform::identity();
+    let mut centrelines = Batch::default();
     for street in &data.streets {
-        if let Some(path) = line_path(view, &street.line.0) {
-            pm.stroke_path(&path, &paint([60, 90, 140], 160), &thin(), id, None);
-        }
+        centrelines.line(view, &street.line.0);
     }
-    let frontage = Stroke {
+    stroke(pm, centrelines, [60, 90, 140], 160, &thin());
+    let mut frontages = Batch::default();
+    for m in plan.houses.values().flatten() {
+        frontages.line(view, &[m.frontage.a, m.frontage.b]);
+    }
+    let width = Stroke {
         width: 2.5,
         ..Stroke::default()
     };
-    for m in plan.houses.values().flatten() {
-        if let Some(path) = line_path(view, &[m.frontage.a, m.frontage.b]) {
-            pm.stroke_path(&path, &paint(FRONTAGE, 255), &frontage, id, None);
-        }
-    }
+    stroke(pm, frontages, FRONTAGE, 255, &width);
 }
 
 /// PNG with fast compression: at 2400 x 2400 the default level took most of the plan's time.
@@ -562,5 +662,58 @@ fn draw_legend(pm: &mut Pixmap, colours: &BTreeMap<String, [u8; 3]>, shown: &Sho
             pm.fill_rect(r, &paint(*colour, 255), Transform::identity(), None);
         }
         draw_text(pm, x0 + 44.0, y, name, 2, [30, 30, 30]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geo_types::{coord, LineString};
+
+    fn square(x: f64, y: f64, side: f64, clockwise: bool) -> LineString<f64> {
+        let mut pts = vec![
+            coord! { x: x, y: y },
+            coord! { x: x + side, y: y },
+            coord! { x: x + side, y: y + side },
+            coord! { x: x, y: y + side },
+            coord! { x: x, y: y },
+        ];
+        if clockwise {
+            pts.reverse();
+        }
+        LineString(pts)
+    }
+
+    fn red_at(pm: &Pixmap, x: u32, y: u32) -> bool {
+        let p = pm.pixel(x, y).unwrap();
+        (p.red(), p.green(), p.blue()) == (255, 0, 0)
+    }
+
+    /// One path for many polygons must draw what a path each drew: the union of polygons
+    /// that overlap (whatever way the data winds them), and their holes left open.
+    #[test]
+    fn a_batch_fills_overlaps_and_keeps_holes() {
+        let view = View {
+            bounds: [0.0, 0.0, 100.0, 100.0],
+            scale: 1.0,
+        };
+        let mut batch = Batch::default();
+        // Two squares overlapping in 40..60, wound opposite ways.
+        batch.polygon(&view, &Polygon::new(square(0.0, 0.0, 60.0, false), vec![]));
+        batch.polygon(&view, &Polygon::new(square(40.0, 0.0, 60.0, true), vec![]));
+        // A square with a hole, the hole wound like its exterior (as careless data has it).
+        let holed = Polygon::new(
+            square(10.0, 70.0, 25.0, false),
+            vec![square(17.0, 77.0, 10.0, false)],
+        );
+        batch.polygon(&view, &holed);
+        let mut pm = Pixmap::new(100, 100).unwrap();
+        fill(&mut pm, batch, &paint([255, 0, 0], 255));
+        // Map y up, pixel y down: map (x, y) is pixel (x, 100 - y).
+        assert!(red_at(&pm, 50, 70), "the overlap is filled");
+        assert!(red_at(&pm, 20, 70) && red_at(&pm, 80, 70), "both squares are filled");
+        assert!(!red_at(&pm, 22, 18), "the hole stays open");
+        assert!(red_at(&pm, 12, 18), "around the hole is filled");
+        assert!(!red_at(&pm, 50, 10), "outside every polygon is not");
     }
 }
