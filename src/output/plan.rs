@@ -333,7 +333,10 @@ fn draw_streets(pm: &mut Pixmap, view: &View, data: &Dataset) {
     let mut bands: BTreeMap<u32, Batch> = BTreeMap::new();
     for street in &data.streets {
         let width = ((street.width * view.scale) as f32).max(1.0);
-        bands.entry(width.to_bits()).or_default().line(view, &street.line.0);
+        bands
+            .entry(width.to_bits())
+            .or_default()
+            .line(view, &street.line.0);
     }
     for (width, batch) in bands {
         let band = Stroke {
@@ -711,7 +714,10 @@ mod tests {
         fill(&mut pm, batch, &paint([255, 0, 0], 255));
         // Map y up, pixel y down: map (x, y) is pixel (x, 100 - y).
         assert!(red_at(&pm, 50, 70), "the overlap is filled");
-        assert!(red_at(&pm, 20, 70) && red_at(&pm, 80, 70), "both squares are filled");
+        assert!(
+            red_at(&pm, 20, 70) && red_at(&pm, 80, 70),
+            "both squares are filled"
+        );
         assert!(!red_at(&pm, 22, 18), "the hole stays open");
         assert!(red_at(&pm, 12, 18), "around the hole is filled");
         assert!(!red_at(&pm, 50, 10), "outside every polygon is not");

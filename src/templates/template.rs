@@ -343,7 +343,7 @@ impl Names<'_> {
         t.as_ref().map(|t| self.compile(t)).transpose()
     }
     fn or(&self, t: &Option<Text>, default: f64) -> Result<Expr, String> {
-        Ok(self.opt(t)?.unwrap_or(Expr::Const(default)))
+        Ok(self.opt(t)?.unwrap_or(Expr::constant(default)))
     }
     fn pair(&self, p: &[Text], loc: &Loc) -> Result<[Expr; 2], String> {
         match p {
