@@ -231,8 +231,8 @@ fn nan_max(a: f64, b: f64) -> f64 {
 }
 #[cfg(test)]
 mod tests {
-    use super::super::{compile, Expr, NoLot, FUNCTIONS};
     use super::*;
+    use crate::templates::expr::{compile, Expr, NoLot, FUNCTIONS};
 
     #[test]
     fn nesting_deeper_than_the_stack_still_evaluates() {
