@@ -129,19 +129,57 @@ fn paint(rgb: [u8; 3], a: u8) -> Paint<'static> {
 }
 
 fn line_path(view: &View, pts: &[Coord<f64>]) -> Option<tiny_skia::Path> {
-    let mut batch = Batch::default();
-    batch.line(view, pts);
-    batch.finish().pop()
+    let mut pb = PathBuilder::new();
+    push_line(&mut pb, view, pts);
+    pb.finish()
+}
+
+/// An open polyline.
+fn push_line(pb: &mut PathBuilder, view: &View, pts: &[Coord<f64>]) {
+    for (i, c) in pts.iter().enumerate() {
+        let (x, y) = view.pixel(c);
+        if i == 0 {
+            pb.move_to(x, y)
+        } else {
+            pb.line_to(x, y)
+        }
+    }
+}
+
+/// What a [`Batch`] does with each of its paths.
+enum Draw {
+    /// Fills it (nonzero rule).
+    Fill(Paint<'static>),
+    /// Strokes it.
+    Stroke(Paint<'static>, Stroke),
+    /// Fills it, then outlines it with a hairline of the second paint. The fill is meant
+    /// [`crisp`]: the outline smooths its edges, and anti-aliasing the fills of 30,000 lots
+    /// took as long as everything else in the plan.
+    FillOutlined(Paint<'static>, Paint<'static>),
+}
+
+impl Draw {
+    fn path(&self, pm: &mut Pixmap, path: &tiny_skia::Path) {
+        let id = Transform::identity();
+        match self {
+            Draw::Fill(paint) => pm.fill_path(path, paint, FillRule::Winding, id, None),
+            Draw::Stroke(paint, stroke) => pm.stroke_path(path, paint, stroke, id, None),
+            Draw::FillOutlined(fill, outline) => {
+                pm.fill_path(path, fill, FillRule::Winding, id, None);
+                pm.stroke_path(path, outline, &thin(), id, None);
+            }
+        }
+    }
 }
 
 /// Shapes of one paint gathered into few paths, each drawn by one call. tiny-skia's cost is
 /// per call and per span of pixels, and side by side lots of one colour share their spans:
 /// a path per lot made the plan a third of a 30,052-lot build's CPU. A path holds at most
-/// [`Batch::SHAPES`] shapes, because tiny-skia builds every edge of a path before it draws
-/// (one path of a million lots would hold hundreds of megabytes of edges).
-#[derive(Default)]
+/// [`Batch::SHAPES`] shapes and is drawn as soon as it is full, because tiny-skia builds
+/// every edge of a path before it draws, and a million lots' paths held at once would be
+/// hundreds of megabytes.
 struct Batch {
-    done: Vec<tiny_skia::Path>,
+    draw: Draw,
     open: PathBuilder,
     shapes: usize,
 }
@@ -150,21 +188,29 @@ impl Batch {
     /// Shapes per path.
     const SHAPES: usize = 1024;
 
+    fn new(draw: Draw) -> Batch {
+        Batch {
+            draw,
+            open: PathBuilder::new(),
+            shapes: 0,
+        }
+    }
+
     /// A polygon's rings, the exterior counter-clockwise on screen and the holes clockwise,
     /// so the nonzero rule fills the union of overlapping polygons and keeps their holes
     /// (even-odd would punch a hole where two lots of the data overlap).
-    fn polygon(&mut self, view: &View, poly: &Polygon<f64>) {
+    fn polygon(&mut self, pm: &mut Pixmap, view: &View, poly: &Polygon<f64>) {
         self.push_ring(view, &poly.exterior().0, true);
         for hole in poly.interiors() {
             self.push_ring(view, &hole.0, false);
         }
-        self.shape_done();
+        self.shape_done(pm);
     }
 
     /// A closed ring (a shape of its own), counter-clockwise on screen.
-    fn ring(&mut self, view: &View, pts: &[Coord<f64>]) {
+    fn ring(&mut self, pm: &mut Pixmap, view: &View, pts: &[Coord<f64>]) {
         self.push_ring(view, pts, true);
-        self.shape_done();
+        self.shape_done(pm);
     }
 
     /// A closed ring, turned to `outer`'s orientation.
@@ -189,33 +235,26 @@ impl Batch {
     }
 
     /// An open polyline.
-    fn line(&mut self, view: &View, pts: &[Coord<f64>]) {
-        for (i, c) in pts.iter().enumerate() {
-            let (x, y) = view.pixel(c);
-            if i == 0 {
-                self.open.move_to(x, y)
-            } else {
-                self.open.line_to(x, y)
-            }
-        }
-        self.shape_done();
+    fn line(&mut self, pm: &mut Pixmap, view: &View, pts: &[Coord<f64>]) {
+        push_line(&mut self.open, view, pts);
+        self.shape_done(pm);
     }
 
-    fn circle(&mut self, x: f32, y: f32, r: f32) {
+    fn circle(&mut self, pm: &mut Pixmap, x: f32, y: f32, r: f32) {
         self.open.push_circle(x, y, r);
-        self.shape_done();
+        self.shape_done(pm);
     }
 
-    fn shape_done(&mut self) {
+    fn shape_done(&mut self, pm: &mut Pixmap) {
         self.shapes += 1;
         if self.shapes.is_multiple_of(Self::SHAPES) {
-            self.close_path();
+            self.draw_open(pm);
         }
     }
 
-    fn close_path(&mut self) {
+    fn draw_open(&mut self, pm: &mut Pixmap) {
         if let Some(path) = std::mem::take(&mut self.open).finish() {
-            self.done.push(path);
+            self.draw.path(pm, &path);
         }
     }
 
@@ -223,49 +262,21 @@ impl Batch {
         self.shapes == 0
     }
 
-    /// The paths (none when nothing drawable was added).
-    fn finish(mut self) -> Vec<tiny_skia::Path> {
-        self.close_path();
-        self.done
+    /// Draws what is left; whether anything was added.
+    fn finish(mut self, pm: &mut Pixmap) -> bool {
+        self.draw_open(pm);
+        !self.is_empty()
     }
 }
 
 /// Outlines of lots, houses and blocks.
 const OUTLINE: [u8; 3] = [90, 80, 70];
 
-/// Each colour's batch filled, then every batch outlined with a hairline. The fills are not
-/// anti-aliased (the outline smooths their edges): anti-aliasing the fills of 30,000 lots
-/// took as long as everything else in the plan.
-fn fill_then_outline(pm: &mut Pixmap, batches: BTreeMap<[u8; 3], Batch>, outline: [u8; 3]) {
-    let id = Transform::identity();
-    let paths: Vec<([u8; 3], Vec<tiny_skia::Path>)> = batches
-        .into_iter()
-        .map(|(colour, b)| (colour, b.finish()))
-        .collect();
-    for (colour, paths) in &paths {
-        let fill = crisp(paint(*colour, 255));
-        for path in paths {
-            pm.fill_path(path, &fill, FillRule::Winding, id, None);
-        }
-    }
-    let outline = paint(outline, 255);
-    for path in paths.iter().flat_map(|(_, p)| p) {
-        pm.stroke_path(path, &outline, &thin(), id, None);
-    }
-}
-
-/// Strokes a batch with one paint.
-fn stroke(pm: &mut Pixmap, batch: Batch, colour: [u8; 3], alpha: u8, stroke: &Stroke) {
-    let paint = paint(colour, alpha);
-    for path in batch.finish() {
-        pm.stroke_path(&path, &paint, stroke, Transform::identity(), None);
-    }
-}
-
-/// Fills a batch with one paint.
-fn fill(pm: &mut Pixmap, batch: Batch, paint: &Paint) {
-    for path in batch.finish() {
-        pm.fill_path(&path, paint, FillRule::Winding, Transform::identity(), None);
+/// A stroke `width` pixels wide.
+fn wide(width: f32) -> Stroke {
+    Stroke {
+        width,
+        ..Stroke::default()
     }
 }
 
@@ -335,21 +346,17 @@ fn draw_streets(pm: &mut Pixmap, view: &View, data: &Dataset) {
         let width = ((street.width * view.scale) as f32).max(1.0);
         bands
             .entry(width.to_bits())
-            .or_default()
-            .line(view, &street.line.0);
+            .or_insert_with(|| Batch::new(Draw::Stroke(paint([215, 212, 205], 255), wide(width))))
+            .line(pm, view, &street.line.0);
     }
-    for (width, batch) in bands {
-        let band = Stroke {
-            width: f32::from_bits(width),
-            ..Stroke::default()
-        };
-        stroke(pm, batch, [215, 212, 205], 255, &band);
+    for batch in bands.into_values() {
+        batch.finish(pm);
     }
-    let mut blocks = Batch::default();
+    let mut blocks = Batch::new(Draw::Stroke(paint([160, 160, 160], 255), thin()));
     for block in &data.blocks {
-        blocks.polygon(view, block);
+        blocks.polygon(pm, view, block);
     }
-    stroke(pm, blocks, [160, 160, 160], 255, &thin());
+    blocks.finish(pm);
 }
 
 /// Lots without a house (other uses, given to a landmark, skipped ones), then every house by its type's colour.
@@ -372,6 +379,12 @@ fn draw_lots_and_houses(
         .filter(|m| !m.is_footprint())
         .map(|m| m.id.as_str())
         .collect();
+    let outlined = |colour: [u8; 3]| {
+        Batch::new(Draw::FillOutlined(
+            crisp(paint(colour, 255)),
+            paint(OUTLINE, 255),
+        ))
+    };
     let mut lots: BTreeMap<[u8; 3], Batch> = BTreeMap::new();
     for lot in &data.lots {
         if planned.contains(lot.id.as_str()) {
@@ -384,25 +397,34 @@ fn draw_lots_and_houses(
         } else {
             OTHER_USE
         };
-        lots.entry(fill).or_default().polygon(view, &lot.outline);
+        lots.entry(fill)
+            .or_insert_with(|| outlined(fill))
+            .polygon(pm, view, &lot.outline);
     }
-    fill_then_outline(pm, lots, OUTLINE);
+    for batch in lots.into_values() {
+        batch.finish(pm);
+    }
     let mut houses: BTreeMap<[u8; 3], Batch> = BTreeMap::new();
     for m in plan.houses.values().flatten() {
         let colour = match m.footprint_height() {
             Some(_) => FOOTPRINT,
             None => colours.get(&m.mtype).copied().unwrap_or(TYPE_COLOURS[0]),
         };
-        houses.entry(colour).or_default().polygon(view, &m.outline);
+        houses
+            .entry(colour)
+            .or_insert_with(|| outlined(colour))
+            .polygon(pm, view, &m.outline);
     }
-    fill_then_outline(pm, houses, OUTLINE);
+    for batch in houses.into_values() {
+        batch.finish(pm);
+    }
 }
 
 /// Kura filled where built, outlined where the avoidance (`avoid`) refused them; whether any
 /// was refused (for the legend).
 fn draw_kura(pm: &mut Pixmap, view: &View, plan: &Plan, avoid: bool) -> bool {
-    let (mut built, mut refused) = (Batch::default(), Batch::default());
-    let mut refused_any = false;
+    let mut built = Batch::new(Draw::Fill(crisp(paint(KURA, 255))));
+    let mut refused = Batch::new(Draw::Stroke(paint(KURA_REFUSED, 255), wide(1.5)));
     for m in plan.houses.values().flatten() {
         let Some(r) = m.kura.rect() else { continue };
         let q = crate::geom::frame::Frame {
@@ -411,103 +433,82 @@ fn draw_kura(pm: &mut Pixmap, view: &View, plan: &Plan, avoid: bool) -> bool {
             v: m.frontage.v_axis(),
         }
         .quad(r);
-        if m.kura.to_build(avoid).is_some() {
-            built.ring(view, &q);
-        } else {
-            refused_any = true;
-            refused.ring(view, &q);
+        match m.kura.to_build(avoid) {
+            Some(_) => built.ring(pm, view, &q),
+            None => refused.ring(pm, view, &q),
         }
     }
-    fill(pm, built, &crisp(paint(KURA, 255)));
-    let width = Stroke {
-        width: 1.5,
-        ..Stroke::default()
-    };
-    stroke(pm, refused, KURA_REFUSED, 255, &width);
-    refused_any
+    built.finish(pm);
+    refused.finish(pm)
 }
 
 /// The halls' plots, filled (whether there was any).
 fn draw_halls(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
-    let mut halls = Batch::default();
+    let mut halls = Batch::new(Draw::Fill(crisp(paint(HALL, 255))));
     for h in plan.halls.values().flatten() {
-        halls.ring(view, &h.outline());
+        halls.ring(pm, view, &h.outline());
     }
-    let any = !halls.is_empty();
-    fill(pm, halls, &crisp(paint(HALL, 255)));
-    any
+    halls.finish(pm)
 }
 
 /// The landmarks' footprints, filled and outlined (whether there was any).
 fn draw_landmarks(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
-    let mut landmarks = Batch::default();
+    let draw = Draw::FillOutlined(crisp(paint(LANDMARK, 255)), paint([40, 20, 60], 255));
+    let mut landmarks = Batch::new(draw);
     for l in plan.landmarks.values().flatten() {
-        landmarks.polygon(view, &l.footprint);
+        landmarks.polygon(pm, view, &l.footprint);
     }
-    let any = !landmarks.is_empty();
-    fill_then_outline(pm, BTreeMap::from([(LANDMARK, landmarks)]), [40, 20, 60]);
-    any
+    landmarks.finish(pm)
 }
 
 /// Walls and gates (section 4.3): a dark line along each wall segment, a red bar per gate
 /// (gates over walls); whether there was any.
 fn draw_fences(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
-    let (mut walls, mut gates) = (Batch::default(), Batch::default());
+    let mut walls = Batch::new(Draw::Stroke(paint(FENCE, 255), wide(2.0)));
+    let mut gates = Batch::new(Draw::Stroke(paint(GATE, 255), wide(4.0)));
     for f in plan.fences.values().flatten() {
         match f.kind {
-            crate::model::FenceKind::Wall => walls.line(view, &[f.a, f.b]),
-            crate::model::FenceKind::Gate => gates.line(view, &[f.a, f.b]),
+            crate::model::FenceKind::Wall => walls.line(pm, view, &[f.a, f.b]),
+            crate::model::FenceKind::Gate => gates.line(pm, view, &[f.a, f.b]),
         }
     }
-    let any = !walls.is_empty() || !gates.is_empty();
-    for (batch, colour, width) in [(walls, FENCE, 2.0), (gates, GATE, 4.0)] {
-        let width = Stroke {
-            width,
-            ..Stroke::default()
-        };
-        stroke(pm, batch, colour, 255, &width);
-    }
-    any
+    let any_wall = walls.finish(pm);
+    gates.finish(pm) || any_wall
 }
 
 /// People and trees (section 4.4): a dot each, a tree's as wide as its crown (people over
 /// trees); whether there was any.
 fn draw_billboards(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
-    let (mut trees, mut people) = (Batch::default(), Batch::default());
+    // Dots stay anti-aliased: crisp, a small circle is a cross.
+    let mut trees = Batch::new(Draw::Fill(paint(TREE, 220)));
+    let mut people = Batch::new(Draw::Fill(paint(PERSON, 220)));
     for b in plan.billboards.values().flatten() {
         let (x, y) = view.pixel(&b.at);
         match b.kind {
             crate::model::BillboardKind::Tree => {
                 let r = (b.height * 0.25 * view.scale) as f32;
-                trees.circle(x, y, r.max(1.5));
+                trees.circle(pm, x, y, r.max(1.5));
             }
-            crate::model::BillboardKind::Person => people.circle(x, y, 2.5),
+            crate::model::BillboardKind::Person => people.circle(pm, x, y, 2.5),
         }
     }
-    let any = !trees.is_empty() || !people.is_empty();
-    // Dots stay anti-aliased: crisp, a small circle is a cross.
-    fill(pm, trees, &paint(TREE, 220));
-    fill(pm, people, &paint(PERSON, 220));
-    any
+    let any_tree = trees.finish(pm);
+    people.finish(pm) || any_tree
 }
 
 /// Street centrelines and each house's frontage, on top: in cadastral data the roads are
 /// parcels too and would hide them.
 fn draw_lines_on_top(pm: &mut Pixmap, view: &View, data: &Dataset, plan: &Plan) {
-    let mut centrelines = Batch::default();
+    let mut centrelines = Batch::new(Draw::Stroke(paint([60, 90, 140], 160), thin()));
     for street in &data.streets {
-        centrelines.line(view, &street.line.0);
+        centrelines.line(pm, view, &street.line.0);
     }
-    stroke(pm, centrelines, [60, 90, 140], 160, &thin());
-    let mut frontages = Batch::default();
+    centrelines.finish(pm);
+    let mut frontages = Batch::new(Draw::Stroke(paint(FRONTAGE, 255), wide(2.5)));
     for m in plan.houses.values().flatten() {
-        frontages.line(view, &[m.frontage.a, m.frontage.b]);
+        frontages.line(pm, view, &[m.frontage.a, m.frontage.b]);
     }
-    let width = Stroke {
-        width: 2.5,
-        ..Stroke::default()
-    };
-    stroke(pm, frontages, FRONTAGE, 255, &width);
+    frontages.finish(pm);
 }
 
 /// PNG with fast compression: at 2400 x 2400 the default level took most of the plan's time.
@@ -700,18 +701,26 @@ mod tests {
             bounds: [0.0, 0.0, 100.0, 100.0],
             scale: 1.0,
         };
-        let mut batch = Batch::default();
+        let mut pm = Pixmap::new(100, 100).unwrap();
+        let mut batch = Batch::new(Draw::Fill(paint([255, 0, 0], 255)));
         // Two squares overlapping in 40..60, wound opposite ways.
-        batch.polygon(&view, &Polygon::new(square(0.0, 0.0, 60.0, false), vec![]));
-        batch.polygon(&view, &Polygon::new(square(40.0, 0.0, 60.0, true), vec![]));
+        batch.polygon(
+            &mut pm,
+            &view,
+            &Polygon::new(square(0.0, 0.0, 60.0, false), vec![]),
+        );
+        batch.polygon(
+            &mut pm,
+            &view,
+            &Polygon::new(square(40.0, 0.0, 60.0, true), vec![]),
+        );
         // A square with a hole, the hole wound like its exterior (as careless data has it).
         let holed = Polygon::new(
             square(10.0, 70.0, 25.0, false),
             vec![square(17.0, 77.0, 10.0, false)],
         );
-        batch.polygon(&view, &holed);
-        let mut pm = Pixmap::new(100, 100).unwrap();
-        fill(&mut pm, batch, &paint([255, 0, 0], 255));
+        batch.polygon(&mut pm, &view, &holed);
+        assert!(batch.finish(&mut pm));
         // Map y up, pixel y down: map (x, y) is pixel (x, 100 - y).
         assert!(red_at(&pm, 50, 70), "the overlap is filled");
         assert!(
