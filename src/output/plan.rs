@@ -146,6 +146,23 @@ fn push_line(pb: &mut PathBuilder, view: &View, pts: &[Coord<f64>]) {
     }
 }
 
+/// A closed ring through `pts`, in their order.
+fn push_closed<'a>(
+    pb: &mut PathBuilder,
+    view: &View,
+    mut pts: impl Iterator<Item = &'a Coord<f64>>,
+) {
+    if let Some(first) = pts.next() {
+        let (x, y) = view.pixel(first);
+        pb.move_to(x, y);
+        for c in pts {
+            let (x, y) = view.pixel(c);
+            pb.line_to(x, y);
+        }
+        pb.close();
+    }
+}
+
 /// What a [`Batch`] does with each of its paths.
 enum Draw {
     /// Fills it (nonzero rule).
@@ -213,24 +230,19 @@ impl Batch {
         self.shape_done(pm);
     }
 
-    /// A closed ring, turned to `outer`'s orientation.
+    /// A closed ring, turned to `outer`'s orientation. The turn is read from the map
+    /// coordinates (north up: clockwise there is counter-clockwise on screen), so no copy of
+    /// the ring is made.
     fn push_ring(&mut self, view: &View, pts: &[Coord<f64>], outer: bool) {
-        let mut px: Vec<(f32, f32)> = pts.iter().map(|c| view.pixel(c)).collect();
-        let twice_area: f32 = px
+        let twice_area: f64 = pts
             .iter()
-            .zip(px.iter().cycle().skip(1))
-            .map(|(a, b)| a.0 * b.1 - b.0 * a.1)
+            .zip(pts.iter().cycle().skip(1))
+            .map(|(a, b)| a.x * b.y - b.x * a.y)
             .sum();
-        // Screen y points down, so a counter-clockwise ring has a negative shoelace sum.
-        if (twice_area > 0.0) == outer {
-            px.reverse();
-        }
-        if let Some((&(x, y), rest)) = px.split_first() {
-            self.open.move_to(x, y);
-            for &(x, y) in rest {
-                self.open.line_to(x, y);
-            }
-            self.open.close();
+        if (twice_area < 0.0) == outer {
+            push_closed(&mut self.open, view, pts.iter().rev());
+        } else {
+            push_closed(&mut self.open, view, pts.iter());
         }
     }
 
@@ -258,14 +270,10 @@ impl Batch {
         }
     }
 
-    fn is_empty(&self) -> bool {
-        self.shapes == 0
-    }
-
     /// Draws what is left; whether anything was added.
     fn finish(mut self, pm: &mut Pixmap) -> bool {
         self.draw_open(pm);
-        !self.is_empty()
+        self.shapes > 0
     }
 }
 

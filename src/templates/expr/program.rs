@@ -99,7 +99,8 @@ pub(super) fn run(ops: &[Op], slots: &[f64], lot: &dyn Lot, stack: &mut [f64]) -
     stack[0]
 }
 
-/// A binary operator other than `And` and `Or` (those jump).
+/// A binary operator. A compiled program never meets `And` or `Or` here (it jumps past the
+/// right side instead); the test's tree evaluator does, with both sides evaluated.
 fn binary(op: Bin, x: f64, y: f64) -> f64 {
     match op {
         Bin::Add => x + y,
@@ -119,7 +120,8 @@ fn binary(op: Bin, x: f64, y: f64) -> f64 {
     }
 }
 
-/// A function of its arguments (their number checked when compiled). `If` jumps instead.
+/// A function of its arguments (their number checked when compiled). A compiled `if`
+/// jumps instead; the test's tree evaluator comes here with all three evaluated.
 fn call(f: Func, args: &[f64], lot: &dyn Lot) -> f64 {
     match f {
         Func::Min => args.iter().copied().fold(f64::INFINITY, nan_min),
