@@ -124,12 +124,9 @@ impl Mesh {
     /// Adds a face, dropping corners that collapsed onto their neighbour when rounded to
     /// millimetres; a face left with fewer than three corners is not added.
     pub fn face(&mut self, material: u16, corners: Vec<(u32, u32)>) {
-        let mut c: Vec<(u32, u32)> = Vec::with_capacity(corners.len());
-        for k in corners {
-            if c.last().map(|l| l.0) != Some(k.0) {
-                c.push(k);
-            }
-        }
+        // In place: a second vector per face was an allocation per face of the whole city.
+        let mut c = corners;
+        c.dedup_by_key(|k| k.0);
         while c.len() > 1 && c.first().map(|f| f.0) == c.last().map(|l| l.0) {
             c.pop();
         }

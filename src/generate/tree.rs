@@ -225,26 +225,42 @@ impl Shape {
     }
 }
 
-/// The corners of a ring: position indices, in counter-clockwise order about `d`.
-fn ring(put: &Put, mesh: &mut Mesh, at: V3, d: V3, reference: V3, r: f64, sides: u8) -> Vec<u32> {
+/// Appends the corners of a ring to `pool`: position indices, in counter-clockwise order
+/// about `d`. Returns where they start.
+#[allow(clippy::too_many_arguments)]
+fn ring(
+    put: &Put,
+    mesh: &mut Mesh,
+    pool: &mut Vec<u32>,
+    at: V3,
+    d: V3,
+    reference: V3,
+    r: f64,
+    sides: u8,
+) -> usize {
     let side = v3::cross(d, reference);
-    (0..sides)
-        .map(|k| {
-            let a = std::f64::consts::TAU * f64::from(k) / f64::from(sides);
-            let off = v3::add(
-                v3::scale(reference, r * a.cos()),
-                v3::scale(side, r * a.sin()),
-            );
-            put.vertex(mesh, v3::add(at, off))
-        })
-        .collect()
+    let start = pool.len();
+    pool.extend((0..sides).map(|k| {
+        let a = std::f64::consts::TAU * f64::from(k) / f64::from(sides);
+        let off = v3::add(
+            v3::scale(reference, r * a.cos()),
+            v3::scale(side, r * a.sin()),
+        );
+        put.vertex(mesh, v3::add(at, off))
+    }));
+    start
 }
 
 /// One tube per kept edge, from the parent's ring (or a ring of the child's own size where it
 /// forks off) to the child's ring.
 fn tubes(sk: &Skeleton, s: &Shape, look: Look, put: &Put, mesh: &mut Mesh) {
     let n = sk.nodes.len();
-    let mut own: Vec<Option<Vec<u32>>> = vec![None; n];
+    // Every ring's corners in one pool; `own[i]` is where node i's ring starts.
+    let mut pool: Vec<u32> = Vec::new();
+    let mut own: Vec<Option<usize>> = vec![None; n];
+    // The bark's texture coordinates of a tube's two rings, each looked up once, in the order
+    // the faces first ask for them (so they are numbered as before).
+    let (mut lo, mut hi): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
     for i in 0..n {
         let Some(p) = sk.nodes[i].parent.map(|p| p as usize) else {
             continue;
@@ -256,25 +272,30 @@ fn tubes(sk: &Skeleton, s: &Shape, look: Look, put: &Put, mesh: &mut Mesh) {
         let sides = s.sides[i];
         let continues = s.kids[p].first() == Some(&(i as u32)) && s.sides[p] == sides;
         let start = if continues {
-            own[p]
-                .get_or_insert_with(|| {
+            match own[p] {
+                Some(at) => at,
+                None => {
                     let q = &sk.nodes[p];
-                    ring(
+                    let at = ring(
                         put,
                         mesh,
+                        &mut pool,
                         q.at,
                         s.ring_dir[p],
                         s.reference[p],
                         q.radius,
                         sides,
-                    )
-                })
-                .clone()
+                    );
+                    own[p] = Some(at);
+                    at
+                }
+            }
         } else {
             let r = node.radius.min(sk.nodes[p].radius.max(node.radius));
             ring(
                 put,
                 mesh,
+                &mut pool,
                 sk.nodes[p].at,
                 s.dir[i],
                 s.reference[i],
@@ -285,22 +306,32 @@ fn tubes(sk: &Skeleton, s: &Shape, look: Look, put: &Put, mesh: &mut Mesh) {
         let end = ring(
             put,
             mesh,
+            &mut pool,
             node.at,
             s.ring_dir[i],
             s.reference[i],
             node.radius,
             sides,
         );
-        own[i] = Some(end.clone());
+        own[i] = Some(end);
         let (v0, v1) = (s.length[p] / BARK_REPEAT, s.length[i] / BARK_REPEAT);
         let m = usize::from(sides);
+        lo.clear();
+        lo.resize(m + 1, u32::MAX);
+        hi.clear();
+        hi.resize(m + 1, u32::MAX);
+        let uv = |row: &mut Vec<u32>, k: usize, v: f64, mesh: &mut Mesh| {
+            if row[k] == u32::MAX {
+                row[k] = mesh.uv(k as f64 / m as f64, v);
+            }
+            row[k]
+        };
         for k in 0..m {
-            let (u0, u1) = (k as f64 / m as f64, (k + 1) as f64 / m as f64);
             let corners = vec![
-                (start[k], mesh.uv(u0, v0)),
-                (start[(k + 1) % m], mesh.uv(u1, v0)),
-                (end[(k + 1) % m], mesh.uv(u1, v1)),
-                (end[k], mesh.uv(u0, v1)),
+                (pool[start + k], uv(&mut lo, k, v0, mesh)),
+                (pool[start + (k + 1) % m], uv(&mut lo, k + 1, v0, mesh)),
+                (pool[end + (k + 1) % m], uv(&mut hi, k + 1, v1, mesh)),
+                (pool[end + k], uv(&mut hi, k, v1, mesh)),
             ];
             mesh.face(look.bark, corners);
         }

@@ -33,6 +33,12 @@ fn disk_room(want: usize) -> Option<usize> {
 
 /// Writes `bytes` to `path` through a temporary file in the same directory.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    write_atomic_parts(path, &[bytes])
+}
+
+/// Writes the file made of `parts`, one after the other, to `path` through a temporary file
+/// in the same directory (a GLB's head and its BIN chunk, never copied into one buffer).
+pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> std::io::Result<()> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -40,12 +46,14 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let tmp = path.with_file_name(format!(".{name}.tmp-{}", run_token()));
     let result = (|| {
         let mut f = fs::File::create(&tmp)?;
-        match disk_room(bytes.len()) {
-            Some(fits) if fits < bytes.len() => {
-                f.write_all(&bytes[..fits])?;
-                return Err(std::io::Error::from_raw_os_error(28)); // ENOSPC
+        for bytes in parts {
+            match disk_room(bytes.len()) {
+                Some(fits) if fits < bytes.len() => {
+                    f.write_all(&bytes[..fits])?;
+                    return Err(std::io::Error::from_raw_os_error(28)); // ENOSPC
+                }
+                _ => f.write_all(bytes)?,
             }
-            _ => f.write_all(bytes)?,
         }
         f.flush()?;
         drop(f);

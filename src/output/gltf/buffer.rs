@@ -21,29 +21,55 @@ pub struct Buffer {
 }
 
 impl Buffer {
-    /// Appends `bytes` as a view (with `target`, if any); returns its index.
-    pub fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while !self.bin.len().is_multiple_of(8) {
-            self.bin.push(0);
-        }
+    /// Pads the buffer to the next view's 8-byte boundary; returns where the view starts.
+    fn align(&mut self) -> usize {
+        let start = self.bin.len().next_multiple_of(8);
+        self.bin.resize(start, 0);
+        start
+    }
+
+    /// Records the bytes from `start` to the end as a view (with `target`, if any); returns
+    /// its index.
+    fn close_view(&mut self, start: usize, target: Option<u32>) -> usize {
         let mut v = json!({
             "buffer": 0,
-            "byteOffset": self.bin.len(),
-            "byteLength": bytes.len(),
+            "byteOffset": start,
+            "byteLength": self.bin.len() - start,
         });
         if let Some(t) = target {
             v["target"] = json!(t);
         }
-        self.bin.extend_from_slice(bytes);
         self.views.push(v);
         self.views.len() - 1
+    }
+
+    /// Appends `bytes` as a view (with `target`, if any); returns its index.
+    pub fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        let start = self.align();
+        self.bin.extend_from_slice(bytes);
+        self.close_view(start, target)
+    }
+
+    /// Appends `data` little-endian as a view, written straight into the buffer (a tile's
+    /// vertices are most of its bytes; each copy of them was measured).
+    fn numbers<T: Copy, const N: usize>(
+        &mut self,
+        data: &[T],
+        bytes: impl Fn(T) -> [u8; N],
+        target: Option<u32>,
+    ) -> usize {
+        let start = self.align();
+        self.bin.resize(start + N * data.len(), 0);
+        for (out, &x) in self.bin[start..].chunks_exact_mut(N).zip(data) {
+            out.copy_from_slice(&bytes(x));
+        }
+        self.close_view(start, target)
     }
 
     /// A float accessor of `n`-component elements (`SCALAR`, `VEC2`, `VEC3`), with `min`
     /// and `max` when asked (positions must have them).
     pub fn floats(&mut self, data: &[f32], n: usize, bounds: bool) -> usize {
-        let bytes: Vec<u8> = data.iter().flat_map(|f| f.to_le_bytes()).collect();
-        let view = self.view(&bytes, Some(VERTICES));
+        let view = self.numbers(data, f32::to_le_bytes, Some(VERTICES));
         let kind = match n {
             1 => "SCALAR",
             2 => "VEC2",
@@ -74,15 +100,12 @@ impl Buffer {
 
     /// The index accessor: u16 while the vertices fit, else u32.
     pub fn indices(&mut self, idx: &[u32], vertices: usize) -> usize {
-        let (bytes, ctype): (Vec<u8>, u32) = if vertices <= u16::MAX as usize {
-            (
-                idx.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect(),
-                5123,
-            )
+        let (view, ctype) = if vertices <= u16::MAX as usize {
+            let view = self.numbers(idx, |i| (i as u16).to_le_bytes(), Some(INDICES));
+            (view, 5123)
         } else {
-            (idx.iter().flat_map(|&i| i.to_le_bytes()).collect(), 5125)
+            (self.numbers(idx, u32::to_le_bytes, Some(INDICES)), 5125)
         };
-        let view = self.view(&bytes, Some(INDICES));
         self.accessors.push(json!({
             "bufferView": view,
             "componentType": ctype,
@@ -93,30 +116,58 @@ impl Buffer {
     }
 }
 
+/// A GLB file in two pieces, written one after the other: the header with the JSON chunk and
+/// the BIN chunk's header, then the BIN bytes (not copied into one buffer with the head: they
+/// are most of a tile).
+pub struct Glb {
+    /// Header, JSON chunk, BIN chunk header.
+    pub head: Vec<u8>,
+    /// The BIN chunk's bytes, zero-padded to 4.
+    pub bin: Vec<u8>,
+}
+
+impl Glb {
+    /// The file's pieces in order.
+    pub fn parts(&self) -> [&[u8]; 2] {
+        [&self.head, &self.bin]
+    }
+
+    /// The file's length in bytes.
+    pub fn len(&self) -> usize {
+        self.head.len() + self.bin.len()
+    }
+
+    /// Whether the file is empty (never: a GLB has a header).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The whole file as one buffer.
+    pub fn to_vec(&self) -> Vec<u8> {
+        self.parts().concat()
+    }
+}
+
 /// The GLB container: header, JSON chunk (space-padded) and BIN chunk (zero-padded).
-pub fn glb(json: &Value, bin: &[u8]) -> Vec<u8> {
+pub fn glb(json: &Value, mut bin: Vec<u8>) -> Glb {
     let mut j = serde_json::to_vec(json).expect("glTF JSON serialises");
     while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
-    let mut b = bin.to_vec();
-    while !b.len().is_multiple_of(4) {
-        b.push(0);
+    bin.resize(bin.len().next_multiple_of(4), 0);
+    let total = 12 + 8 + j.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };
+    let mut head = Vec::with_capacity(28 + j.len());
+    head.extend_from_slice(b"glTF");
+    head.extend_from_slice(&2u32.to_le_bytes());
+    head.extend_from_slice(&(total as u32).to_le_bytes());
+    head.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    head.extend_from_slice(b"JSON");
+    head.extend_from_slice(&j);
+    if !bin.is_empty() {
+        head.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        head.extend_from_slice(b"BIN\0");
     }
-    let total = 12 + 8 + j.len() + if b.is_empty() { 0 } else { 8 + b.len() };
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&j);
-    if !b.is_empty() {
-        out.extend_from_slice(&(b.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"BIN\0");
-        out.extend_from_slice(&b);
-    }
-    out
+    Glb { head, bin }
 }
 
 #[cfg(test)]
@@ -129,7 +180,7 @@ mod tests {
         b.view(&[1, 2, 3], None);
         let second = b.view(&[4], None);
         assert_eq!(b.views[second]["byteOffset"], 8);
-        let out = glb(&json!({"asset": {"version": "2.0"}}), &b.bin);
+        let out = glb(&json!({"asset": {"version": "2.0"}}), b.bin).to_vec();
         assert_eq!(&out[0..4], b"glTF");
         let total = u32::from_le_bytes(out[8..12].try_into().unwrap()) as usize;
         assert_eq!(total, out.len());

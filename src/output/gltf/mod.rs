@@ -32,8 +32,29 @@ struct Primitive {
     ids: Vec<f32>,
     indices: Vec<u32>,
     /// (object, position index, uv index, normal bits) -> vertex.
-    seen: HashMap<(u32, u32, u32, [u32; 3]), u32, foldhash::fast::FixedState>,
-    features: std::collections::BTreeSet<u32>,
+    seen: HashMap<VertexKey, u32, foldhash::fast::FixedState>,
+    /// How many objects have faces here, and the last one: objects are added in order, so
+    /// a new one is one not equal to the last.
+    features: usize,
+    last: Option<u32>,
+    /// A face's vertices, kept to save an allocation per face.
+    corners: Vec<u32>,
+}
+
+/// A GLB vertex: (object, position index, uv index, normal bits), hashed as one word (the
+/// tuple went through the hasher field by field, a tenth of writing a tile with grown
+/// trees). Equal keys give equal words; unequal keys may too, which costs a comparison.
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct VertexKey(u32, u32, u32, [u32; 3]);
+
+impl std::hash::Hash for VertexKey {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        let VertexKey(o, p, t, n) = *self;
+        let a = (u64::from(o) << 32 | u64::from(p)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        let b = (u64::from(t) << 32 | u64::from(n[0])).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+        let c = (u64::from(n[1]) << 32 | u64::from(n[2])).wrapping_mul(0x1656_67B1_9E37_79F9);
+        state.write_u64(a ^ b.rotate_left(21) ^ c.rotate_left(42));
+    }
 }
 
 /// The face's unit normal from its corners (Newell's method, in f64 millimetres); `None`
@@ -60,29 +81,37 @@ impl Primitive {
             return;
         };
         let nb = n.map(f32::to_bits);
-        self.features.insert(object);
-        let mut idx = Vec::with_capacity(corners.len());
+        if self.last != Some(object) {
+            self.last = Some(object);
+            self.features += 1;
+        }
+        let mut idx = std::mem::take(&mut self.corners);
+        idx.clear();
         for &(p, t) in corners {
             let next = (self.positions.len() / 3) as u32;
-            let v = *self.seen.entry((object, p, t, nb)).or_insert_with(|| {
-                let q = mesh.positions[p as usize];
-                for k in 0..3 {
-                    self.positions
-                        .push(((q[k] - shift[k]) as f64 / 1000.0) as f32);
-                }
-                self.normals.extend_from_slice(&n);
-                let uv = mesh.uvs.get(t as usize).copied().unwrap_or([0, 0]);
-                self.uvs.push(uv[0] as f32 / 10_000.0);
-                self.uvs.push(1.0 - uv[1] as f32 / 10_000.0);
-                self.ids.push(object as f32);
-                next
-            });
+            let v = *self
+                .seen
+                .entry(VertexKey(object, p, t, nb))
+                .or_insert_with(|| {
+                    let q = mesh.positions[p as usize];
+                    for k in 0..3 {
+                        self.positions
+                            .push(((q[k] - shift[k]) as f64 / 1000.0) as f32);
+                    }
+                    self.normals.extend_from_slice(&n);
+                    let uv = mesh.uvs.get(t as usize).copied().unwrap_or([0, 0]);
+                    self.uvs.push(uv[0] as f32 / 10_000.0);
+                    self.uvs.push(1.0 - uv[1] as f32 / 10_000.0);
+                    self.ids.push(object as f32);
+                    next
+                });
             idx.push(v);
         }
         for k in 1..idx.len().saturating_sub(1) {
             self.indices
                 .extend_from_slice(&[idx[0], idx[k], idx[k + 1]]);
         }
+        self.corners = idx;
     }
 }
 
@@ -103,7 +132,7 @@ pub fn tile_glb(
     features: &[Feature],
     shift: [i64; 3],
     palette: Palette,
-) -> Vec<u8> {
+) -> buffer::Glb {
     // Node per kind, in order of first appearance; primitive per material, by material id.
     let mut kinds: Vec<(&str, std::collections::BTreeMap<u16, Primitive>)> = Vec::new();
     for (i, (mesh, f)) in meshes.iter().zip(features).enumerate() {
@@ -123,6 +152,15 @@ pub fn tile_glb(
         }
     }
     let mut buf = Buffer::default();
+    // The vertex data's bytes (and each view's padding), reserved once: grown by doubling,
+    // the buffer was copied again and again.
+    let floats: usize = (kinds.iter().flat_map(|(_, p)| p.values()))
+        .map(|p| {
+            4 * (p.positions.len() + p.normals.len() + p.uvs.len() + p.ids.len() + p.indices.len())
+                + 40
+        })
+        .sum();
+    buf.bin.reserve(floats);
     let mut used: Vec<u16> = Vec::new();
     let mut meshes_json = Vec::new();
     let mut nodes = Vec::new();
@@ -151,7 +189,7 @@ pub fn tile_glb(
                 "material": m,
                 "mode": 4,
                 "extensions": {"EXT_mesh_features": {"featureIds": [{
-                    "featureCount": p.features.len(),
+                    "featureCount": p.features,
                     "attribute": 0,
                     "propertyTable": 0,
                 }]}},
@@ -192,7 +230,7 @@ pub fn tile_glb(
         doc["samplers"] =
             json!([{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]);
     }
-    buffer::glb(&doc, &buf.bin)
+    buffer::glb(&doc, buf.bin)
 }
 
 /// The materials `used` (library ids, in first-use order) as glTF materials, with the
@@ -238,7 +276,7 @@ impl crate::output::sink::Sink for GlbSink {
         out: &std::path::Path,
         tile: &crate::output::sink::TileContent,
     ) -> std::io::Result<crate::output::sink::TileFiles> {
-        let bytes = tile_glb(
+        let glb = tile_glb(
             tile.id,
             tile.meshes,
             tile.features,
@@ -246,12 +284,12 @@ impl crate::output::sink::Sink for GlbSink {
             tile.palette,
         );
         let path = format!("tiles/{}.glb", tile.id);
-        crate::output::atomic::write_atomic(&out.join(&path), &bytes)?;
+        crate::output::atomic::write_atomic_parts(&out.join(&path), &glb.parts())?;
         Ok(crate::output::sink::TileFiles {
             files: vec![crate::output::report::ManifestFile {
                 path,
-                bytes: bytes.len() as u64,
-                sha256: crate::output::sha256_hex(&bytes),
+                bytes: glb.len() as u64,
+                sha256: crate::output::sha256_hex_parts(&glb.parts()),
             }],
             mesh_bytes: None,
         })
