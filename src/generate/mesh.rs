@@ -138,6 +138,16 @@ impl Mesh {
         }
     }
 
+    /// Empties the mesh for the next one of the same kind, keeping its storage (a tile's
+    /// grown trees are meshed one by one into the same scratch mesh).
+    pub fn clear(&mut self) {
+        self.positions.clear();
+        self.uvs.clear();
+        self.faces.clear();
+        self.pos_index.clear();
+        self.uv_index.clear();
+    }
+
     /// Releases the lookup tables once the mesh is complete.
     pub fn finish(mut self) -> Mesh {
         self.pos_index = FastMap::default();

@@ -39,6 +39,8 @@ pub fn build<'a>(
     // Bytes per square metre of height of the trees of each species meshed so far: once the
     // budget is nearly spent, a tree expected not to fit is not grown at all.
     let mut density: std::collections::HashMap<&str, f64> = std::collections::HashMap::new();
+    // One scratch mesh for every tree: its storage and maps are grown once, not per tree.
+    let mut one = Mesh::new(String::new());
     for b in order {
         let Some(form) = &b.tree else { continue };
         let Some(species) = catalog.species.get(&form.species) else {
@@ -67,7 +69,7 @@ pub fn build<'a>(
             }
         };
         grown.skeleton.squeeze(form.squeeze);
-        let mut one = Mesh::new(String::new());
+        one.clear();
         let place = Placement {
             at: b.at,
             ground: b.ground,

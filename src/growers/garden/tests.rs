@@ -183,3 +183,34 @@ fn sizes_follow_zipf() {
     assert!((slope + s.zipf).abs() < 0.25, "{slope}");
     assert!(r2 > 0.9, "{r2}");
 }
+
+/// A child copied from a parent takes the parent's scores instead of being scored again: over
+/// generations of the city's GA every layout's scores are still exactly what scoring it gives,
+/// and copies did happen (or the shortcut was never tried).
+#[test]
+fn scores_carried_from_a_parent_are_the_layouts_own() {
+    let s = Settings::sized(12.0, 8.0);
+    let p = GaParams {
+        population: 30,
+        gathered: true,
+        ..GaParams::default()
+    };
+    let mut rng = Pcg64::seed_from_u64(7);
+    let mut pop = Population::random(&s, &p, &mut rng);
+    let mut copies = 0;
+    for _ in 0..15 {
+        let next = pop.next(&s, &p, &mut rng);
+        for c in &next.members {
+            let fresh = rules::scores(&c.layout, &s);
+            assert_eq!(c.scores.map(f64::to_bits), fresh.map(f64::to_bits));
+            assert_eq!(c.fitness.to_bits(), rules::fitness(&fresh).to_bits());
+        }
+        // The elites are carried over; any other layout of the last generation is a copy.
+        let carried = (next.members.iter())
+            .filter(|c| pop.members.iter().any(|m| m.layout == c.layout))
+            .count();
+        copies += carried.saturating_sub(p.elite);
+        pop = next;
+    }
+    assert!(copies > 0, "no child was a copy of a parent in 15 generations");
+}
