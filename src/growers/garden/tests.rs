@@ -212,5 +212,8 @@ fn scores_carried_from_a_parent_are_the_layouts_own() {
         copies += carried.saturating_sub(p.elite);
         pop = next;
     }
-    assert!(copies > 0, "no child was a copy of a parent in 15 generations");
+    assert!(
+        copies > 0,
+        "no child was a copy of a parent in 15 generations"
+    );
 }

@@ -14,8 +14,6 @@
 pub mod buffer;
 pub mod metadata;
 
-use std::collections::HashMap;
-
 use serde_json::{json, Value};
 
 use crate::generate::mesh::Mesh;
@@ -31,8 +29,8 @@ struct Primitive {
     uvs: Vec<f32>,
     ids: Vec<f32>,
     indices: Vec<u32>,
-    /// (object, position index, uv index, normal bits) -> vertex.
-    seen: HashMap<VertexKey, u32, foldhash::fast::FixedState>,
+    /// The vertices made so far, found by their object's position index.
+    seen: Vertices,
     /// How many objects have faces here, and the last one: objects are added in order, so
     /// a new one is one not equal to the last.
     features: usize,
@@ -41,19 +39,50 @@ struct Primitive {
     corners: Vec<u32>,
 }
 
-/// A GLB vertex: (object, position index, uv index, normal bits), hashed as one word (the
-/// tuple went through the hasher field by field, a tenth of writing a tile with grown
-/// trees). Equal keys give equal words; unequal keys may too, which costs a comparison.
-#[derive(Clone, Copy, PartialEq, Eq)]
-struct VertexKey(u32, u32, u32, [u32; 3]);
+/// The vertices of a primitive by (object, position index, uv index, normal bits), without
+/// hashing: a vertex is one of the few made from its position (one per normal and texture
+/// coordinate), so each position of the current object heads a short chain. A hash map of
+/// the four was a tenth of writing a tile of grown trees, and missed the cache on every
+/// corner of a tile's million.
+#[derive(Default)]
+struct Vertices {
+    /// Per position index: (object + 1, first vertex + 1) of the object last seen there;
+    /// a slot of another object is empty.
+    heads: Vec<(u32, u32)>,
+    /// Per vertex: the next vertex + 1 made from the same position, 0 at the end.
+    next: Vec<u32>,
+    /// Per vertex: its uv index and normal bits.
+    keys: Vec<(u32, [u32; 3])>,
+}
 
-impl std::hash::Hash for VertexKey {
-    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
-        let VertexKey(o, p, t, n) = *self;
-        let a = (u64::from(o) << 32 | u64::from(p)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        let b = (u64::from(t) << 32 | u64::from(n[0])).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
-        let c = (u64::from(n[1]) << 32 | u64::from(n[2])).wrapping_mul(0x1656_67B1_9E37_79F9);
-        state.write_u64(a ^ b.rotate_left(21) ^ c.rotate_left(42));
+impl Vertices {
+    /// The vertex of `object`'s position `p` with uv `t` and normal `n`, or `None` with the
+    /// vertex it would be added as registered by [`Vertices::add`].
+    fn find(&mut self, object: u32, p: u32, t: u32, n: [u32; 3], positions: usize) -> Option<u32> {
+        let p = p as usize;
+        if self.heads.len() <= p {
+            self.heads.resize(positions.max(p + 1), (0, 0));
+        }
+        let (owner, mut v) = self.heads[p];
+        if owner != object + 1 {
+            return None;
+        }
+        while v != 0 {
+            if self.keys[v as usize - 1] == (t, n) {
+                return Some(v - 1);
+            }
+            v = self.next[v as usize - 1];
+        }
+        None
+    }
+
+    /// Registers vertex `v` (the next one) as `object`'s position `p` with uv `t`, normal `n`.
+    fn add(&mut self, v: u32, object: u32, p: u32, t: u32, n: [u32; 3]) {
+        let slot = &mut self.heads[p as usize];
+        let rest = if slot.0 == object + 1 { slot.1 } else { 0 };
+        *slot = (object + 1, v + 1);
+        self.next.push(rest);
+        self.keys.push((t, n));
     }
 }
 
@@ -88,11 +117,11 @@ impl Primitive {
         let mut idx = std::mem::take(&mut self.corners);
         idx.clear();
         for &(p, t) in corners {
-            let next = (self.positions.len() / 3) as u32;
-            let v = *self
-                .seen
-                .entry(VertexKey(object, p, t, nb))
-                .or_insert_with(|| {
+            let v = match self.seen.find(object, p, t, nb, mesh.positions.len()) {
+                Some(v) => v,
+                None => {
+                    let v = (self.positions.len() / 3) as u32;
+                    self.seen.add(v, object, p, t, nb);
                     let q = mesh.positions[p as usize];
                     for k in 0..3 {
                         self.positions
@@ -103,8 +132,9 @@ impl Primitive {
                     self.uvs.push(uv[0] as f32 / 10_000.0);
                     self.uvs.push(1.0 - uv[1] as f32 / 10_000.0);
                     self.ids.push(object as f32);
-                    next
-                });
+                    v
+                }
+            };
             idx.push(v);
         }
         for k in 1..idx.len().saturating_sub(1) {
