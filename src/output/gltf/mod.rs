@@ -334,3 +334,32 @@ impl crate::output::sink::Sink for GlbSink {
         crate::output::tiles3d::write_tileset(out, manifest, warnings).map(|f| vec![f])
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A vertex is shared by the corners of one object with the same position, uv and normal,
+    /// and by nothing else: not across uvs, normals or objects.
+    #[test]
+    fn vertices_are_shared_within_an_object_only() {
+        let mut v = Vertices::default();
+        let n = [1, 2, 3];
+        assert_eq!(v.find(0, 5, 1, n, 10), None);
+        v.add(0, 0, 5, 1, n);
+        assert_eq!(v.find(0, 5, 1, n, 10), Some(0));
+        assert_eq!(v.find(0, 5, 2, n, 10), None);
+        v.add(1, 0, 5, 2, n);
+        assert_eq!(v.find(0, 5, 1, n, 10), Some(0));
+        assert_eq!(v.find(0, 5, 2, n, 10), Some(1));
+        assert_eq!(v.find(0, 5, 1, [1, 2, 4], 10), None);
+        assert_eq!(v.find(0, 6, 1, n, 10), None);
+        // The next object: object 0's vertices at position 5 are not its own.
+        assert_eq!(v.find(1, 5, 1, n, 10), None);
+        v.add(2, 1, 5, 1, n);
+        assert_eq!(v.find(1, 5, 1, n, 10), Some(2));
+        assert_eq!(v.find(1, 5, 2, n, 10), None);
+        // A larger mesh than the first: its positions past the first's are new.
+        assert_eq!(v.find(1, 40, 1, n, 50), None);
+    }
+}
