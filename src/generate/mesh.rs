@@ -8,10 +8,69 @@ use std::collections::HashMap;
 
 use geo_types::Coord;
 
-/// The vertex and edge maps of a mesh: a fast non-cryptographic hash with a fixed seed
-/// (foldhash, hashbrown's own). SipHash spent about a tenth of a single-thread build here;
-/// only lookups go through these maps, so no output depends on the hash.
+/// The edge maps of a mesh: a fast non-cryptographic hash with a fixed seed (foldhash,
+/// hashbrown's own). SipHash spent about a tenth of a single-thread build here; only lookups
+/// go through these maps, so no output depends on the hash.
 type FastMap<K, V> = HashMap<K, V, foldhash::fast::FixedState>;
+
+/// The positions or texture coordinates of a mesh by value: a table of indices into the
+/// mesh's own list, hashed by [`word`]. An entry is 4 bytes, not the key's 24 plus the
+/// index: a tile of grown trees holds a million positions, and a map of keys missed the
+/// cache on every corner. Only lookups go through it, so no output depends on the hash.
+type IndexTable = hashbrown::HashTable<u32>;
+
+/// A key's hash: its coordinates spread by odd multipliers and folded into one word, then
+/// mixed (the table takes its bucket from the low bits and its tag from the top seven).
+fn word<const N: usize>(key: [i64; N]) -> u64 {
+    const K: [u64; 3] = [
+        0x9E37_79B9_7F4A_7C15,
+        0xC2B2_AE3D_27D4_EB4F,
+        0x1656_67B1_9E37_79F9,
+    ];
+    let mut w = (key.iter().zip(K)).fold(0u64, |w, (&c, k)| {
+        w.rotate_left(23) ^ (c as u64).wrapping_mul(k)
+    });
+    // The finaliser of MurmurHash3: every bit of the word reaches every bit of the hash.
+    w ^= w >> 33;
+    w = w.wrapping_mul(0xFF51_AFD7_ED55_8CCD);
+    w ^= w >> 33;
+    w = w.wrapping_mul(0xC4CE_B9FE_1A85_EC53);
+    w ^ (w >> 33)
+}
+
+/// The index of `key` in `list`, added to both when new.
+fn index_of<const N: usize, T: Copy + PartialEq>(
+    table: &mut IndexTable,
+    list: &mut Vec<T>,
+    key: T,
+    wide: impl Fn(T) -> [i64; N],
+) -> u32 {
+    let next = list.len() as u32;
+    if next == 0 && table.capacity() == 0 {
+        // A house or a tree has hundreds of corners: grown from nothing, the table
+        // rehashed six times.
+        table.reserve(256, |&i| word(wide(list[i as usize])));
+    }
+    let hash = word(wide(key));
+    let found = {
+        let list = &*list;
+        match table.entry(
+            hash,
+            |&i| list[i as usize] == key,
+            |&i| word(wide(list[i as usize])),
+        ) {
+            hashbrown::hash_table::Entry::Occupied(e) => Some(*e.get()),
+            hashbrown::hash_table::Entry::Vacant(v) => {
+                v.insert(next);
+                None
+            }
+        }
+    };
+    found.unwrap_or_else(|| {
+        list.push(key);
+        next
+    })
+}
 
 /// One face: a material and its corners as (position index, uv index), counter-clockwise
 /// seen from outside.
@@ -35,29 +94,8 @@ pub struct Mesh {
     pub uvs: Vec<[i32; 2]>,
     /// The faces, in the order they were built.
     pub faces: Vec<Face>,
-    pos_index: FastMap<Key<3>, u32>,
-    uv_index: FastMap<Key<2>, u32>,
-}
-
-/// A map key hashed as one word: an array is hashed as a slice (its length, then its bytes
-/// through foldhash's long-input path), which was a tenth of a build with grown trees.
-/// Equal keys give equal words; unequal keys may too, which only costs a comparison.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct Key<const N: usize>([i64; N]);
-
-impl<const N: usize> std::hash::Hash for Key<N> {
-    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
-        // Odd multipliers spread each coordinate over the word before they are combined.
-        const K: [u64; 3] = [
-            0x9E37_79B9_7F4A_7C15,
-            0xC2B2_AE3D_27D4_EB4F,
-            0x1656_67B1_9E37_79F9,
-        ];
-        let word = (self.0.iter().zip(K)).fold(0u64, |w, (&c, k)| {
-            w.rotate_left(23) ^ (c as u64).wrapping_mul(k)
-        });
-        state.write_u64(word);
-    }
+    pos_index: IndexTable,
+    uv_index: IndexTable,
 }
 
 /// Converts map coordinates (east, north, height; metres) to the output frame.
@@ -88,16 +126,7 @@ impl Mesh {
 
     /// The index of a position, added when new.
     fn position_index(&mut self, key: [i64; 3]) -> u32 {
-        let next = self.positions.len() as u32;
-        if next == 0 {
-            // A house or a tree has hundreds of corners: grown from nothing, the map
-            // rehashed six times.
-            self.pos_index.reserve(256);
-        }
-        *self.pos_index.entry(Key(key)).or_insert_with(|| {
-            self.positions.push(key);
-            next
-        })
+        index_of(&mut self.pos_index, &mut self.positions, key, |k| k)
     }
 
     /// Adds (or finds) a texture coordinate.
@@ -108,17 +137,7 @@ impl Mesh {
 
     /// The index of a texture coordinate, added when new.
     fn uv_index_of(&mut self, key: [i32; 2]) -> u32 {
-        let next = self.uvs.len() as u32;
-        if next == 0 {
-            self.uv_index.reserve(64);
-        }
-        *self
-            .uv_index
-            .entry(Key(key.map(i64::from)))
-            .or_insert_with(|| {
-                self.uvs.push(key);
-                next
-            })
+        index_of(&mut self.uv_index, &mut self.uvs, key, |k| k.map(i64::from))
     }
 
     /// Adds a face, dropping corners that collapsed onto their neighbour when rounded to
@@ -150,8 +169,8 @@ impl Mesh {
 
     /// Releases the lookup tables once the mesh is complete.
     pub fn finish(mut self) -> Mesh {
-        self.pos_index = FastMap::default();
-        self.uv_index = FastMap::default();
+        self.pos_index = IndexTable::default();
+        self.uv_index = IndexTable::default();
         self
     }
 }
@@ -215,5 +234,39 @@ impl Mesh {
         let corners: usize = self.faces.iter().map(|f| f.corners.len()).sum();
         (26 * self.positions.len() + 17 * self.uvs.len() + 14 * corners + 2 * self.faces.len())
             as u64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The index tables number positions and texture coordinates by first use, equal keys
+        /// share an index and unequal ones never do (a small range makes most keys repeat,
+        /// and a thousand keys make the table grow), and a cleared mesh starts again from 0.
+        #[test]
+        fn equal_keys_share_an_index_in_order_of_first_use(
+            keys in proptest::collection::vec((-3i64..3, -3i64..3, -3i64..3), 1..1000)
+        ) {
+            let mut mesh = Mesh::new("t".into());
+            for round in 0..2 {
+                let mut first: Vec<[i64; 3]> = Vec::new();
+                for &(x, y, z) in &keys {
+                    let key = [x * 1_000_003, y, z];
+                    let i = mesh.position_index(key);
+                    let t = mesh.uv_index_of([x as i32, (y + z) as i32]);
+                    let expect = first.iter().position(|&k| k == key).unwrap_or_else(|| {
+                        first.push(key);
+                        first.len() - 1
+                    });
+                    prop_assert_eq!(i as usize, expect, "round {}", round);
+                    prop_assert_eq!(mesh.uvs[t as usize], [x as i32, (y + z) as i32]);
+                }
+                prop_assert_eq!(&mesh.positions, &first);
+                mesh.clear();
+            }
+        }
     }
 }
