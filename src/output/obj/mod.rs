@@ -30,14 +30,7 @@ impl Sink for ObjSink {
 
     fn write_tile(&self, out: &Path, tile: &TileContent) -> std::io::Result<TileFiles> {
         let id = tile.id;
-        // Room for the whole file at once (the estimate is a little above what is printed):
-        // a tile of grown trees grown by doubling was copied again and again.
-        let estimate: u64 = tile
-            .meshes
-            .iter()
-            .map(|m| m.obj_bytes_estimate() + 64)
-            .sum();
-        let mut obj = Vec::with_capacity(512 + estimate as usize);
+        let mut obj = Vec::with_capacity(tile.meshes.len() * 4096);
         let sizes = if self.by_kind {
             let kinds: Vec<&str> = tile.features.iter().map(|f| f.kind.as_str()).collect();
             write_tile_by_kind(&mut obj, id, tile.origin, tile.meshes, &kinds, tile.palette);
