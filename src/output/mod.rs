@@ -35,16 +35,8 @@ use report::ManifestFile;
 
 /// The sha256 of `bytes` in lower-case hex, as the manifest lists every file.
 pub fn sha256_hex(bytes: &[u8]) -> String {
-    sha256_hex_parts(&[bytes])
-}
-
-/// The sha256 of a file written as `parts`, one after the other.
-pub fn sha256_hex_parts(parts: &[&[u8]]) -> String {
-    let mut h = Sha256::new();
-    for p in parts {
-        h.update(p);
-    }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    let digest = Sha256::digest(bytes);
+    digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// Where the texture library is written, relative to the output directory: inside `tiles/`,

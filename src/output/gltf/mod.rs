@@ -314,12 +314,12 @@ impl crate::output::sink::Sink for GlbSink {
             tile.palette,
         );
         let path = format!("tiles/{}.glb", tile.id);
-        crate::output::atomic::write_atomic_parts(&out.join(&path), &glb.parts())?;
+        let sha256 = crate::output::atomic::write_atomic_hashed(&out.join(&path), &glb.parts())?;
         Ok(crate::output::sink::TileFiles {
             files: vec![crate::output::report::ManifestFile {
                 path,
                 bytes: glb.len() as u64,
-                sha256: crate::output::sha256_hex_parts(&glb.parts()),
+                sha256,
             }],
             mesh_bytes: None,
         })

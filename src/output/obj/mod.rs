@@ -10,10 +10,10 @@ pub mod mtl;
 use std::io::Write;
 use std::path::Path;
 
+use super::atomic;
 use super::palette::Palette;
 use super::report::ManifestFile;
 use super::sink::{Sink, TileContent, TileFiles};
-use super::{atomic, sha256_hex};
 use crate::generate::mesh::Mesh;
 
 /// The OBJ format: `tiles/<id>.obj` and its `tiles/<id>.mtl`.
@@ -46,17 +46,17 @@ impl Sink for ObjSink {
         };
         let mtl = mtl::tile_mtl_text(tile.meshes, tile.palette).into_bytes();
         let dir = out.join("tiles");
-        atomic::write_atomic(&dir.join(format!("{id}.obj")), &obj)?;
-        atomic::write_atomic(&dir.join(format!("{id}.mtl")), &mtl)?;
-        let entry = |path: String, bytes: &[u8]| ManifestFile {
+        let obj_sha = atomic::write_atomic_hashed(&dir.join(format!("{id}.obj")), &[&obj])?;
+        let mtl_sha = atomic::write_atomic_hashed(&dir.join(format!("{id}.mtl")), &[&mtl])?;
+        let entry = |path: String, bytes: &[u8], sha256: String| ManifestFile {
             path,
             bytes: bytes.len() as u64,
-            sha256: sha256_hex(bytes),
+            sha256,
         };
         Ok(TileFiles {
             files: vec![
-                entry(format!("tiles/{id}.obj"), &obj),
-                entry(format!("tiles/{id}.mtl"), &mtl),
+                entry(format!("tiles/{id}.obj"), &obj, obj_sha),
+                entry(format!("tiles/{id}.mtl"), &mtl, mtl_sha),
             ],
             mesh_bytes: sizes,
         })
