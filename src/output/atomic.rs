@@ -33,13 +33,7 @@ fn disk_room(want: usize) -> Option<usize> {
 
 /// Writes `bytes` to `path` through a temporary file in the same directory.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    write_atomic_parts(path, &[bytes])
-}
-
-/// Writes the file made of `parts`, one after the other, to `path` through a temporary file
-/// in the same directory (a GLB's head and its BIN chunk, never copied into one buffer).
-pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> std::io::Result<()> {
-    write_pieces(path, parts.len(), |i| parts[i])
+    write_pieces(path, 1, |_| bytes)
 }
 
 /// Writes `count` pieces, `piece(i)` asked for in order, through a temporary file.
@@ -75,9 +69,10 @@ fn write_pieces<'a>(
     result
 }
 
-/// [`write_atomic_parts`], returning the file's sha256 in lower-case hex, taken a piece at a
-/// time just before the piece is written: the bytes are hashed while the write still finds
-/// them in the cache (a tile is read from memory once, not twice).
+/// Writes the file made of `parts`, one after the other, like [`write_atomic`] (a GLB's head
+/// and its BIN chunk are never copied into one buffer), and returns its sha256 in lower-case
+/// hex, taken a piece at a time just before the piece is written: the bytes are hashed while
+/// the write still finds them in the cache (a tile is read from memory once, not twice).
 pub fn write_atomic_hashed(path: &Path, parts: &[&[u8]]) -> std::io::Result<String> {
     use sha2::{Digest, Sha256};
     /// Bytes hashed and written at a time: well inside a core's L2 cache.

@@ -42,10 +42,5 @@ pub fn write_links(
         })
         .collect();
     let bytes = serde_json::to_vec_pretty(&items).expect("serialises");
-    super::atomic::write_atomic(&out.join("links.json"), &bytes)?;
-    Ok(Some(ManifestFile {
-        path: "links.json".into(),
-        bytes: bytes.len() as u64,
-        sha256: super::sha256_hex(&bytes),
-    }))
+    super::write_listed(out, "links.json".into(), &[&bytes]).map(Some)
 }

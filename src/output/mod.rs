@@ -39,6 +39,17 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// Writes `<out>/<path>` from `parts` (see [`atomic::write_atomic_hashed`]) and lists it for
+/// the manifest: every file of a build is written and listed this one way.
+pub fn write_listed(out: &Path, path: String, parts: &[&[u8]]) -> std::io::Result<ManifestFile> {
+    let sha256 = atomic::write_atomic_hashed(&out.join(&path), parts)?;
+    Ok(ManifestFile {
+        bytes: parts.iter().map(|p| p.len() as u64).sum(),
+        path,
+        sha256,
+    })
+}
+
 /// Where the texture library is written, relative to the output directory: inside `tiles/`,
 /// so a tile's MTL and GLB reach it as `textures/<file>` without climbing out of the tile's
 /// folder (trimesh 5 refuses `../` paths).
@@ -150,14 +161,7 @@ fn write_texture_files<'a>(
     let dir = out.join(TEXTURE_DIR);
     std::fs::create_dir_all(&dir)?;
     files
-        .map(|(name, bytes)| {
-            atomic::write_atomic(&dir.join(name), bytes)?;
-            Ok(ManifestFile {
-                path: format!("{TEXTURE_DIR}/{name}"),
-                bytes: bytes.len() as u64,
-                sha256: sha256_hex(bytes),
-            })
-        })
+        .map(|(name, bytes)| write_listed(out, format!("{TEXTURE_DIR}/{name}"), &[bytes]))
         .collect()
 }
 

@@ -10,7 +10,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::report::ManifestFile;
-use super::{atomic, obj, sha256_hex};
+use super::{atomic, obj};
 use crate::generate::tree;
 use crate::model::Plan;
 use crate::params::Params;
@@ -45,12 +45,11 @@ pub fn write_species(
     }
     let mut files = Vec::new();
     let mut put = |name: String, bytes: &[u8]| -> std::io::Result<()> {
-        atomic::write_atomic(&dir.join(&name), bytes)?;
-        files.push(ManifestFile {
-            path: format!("species/{name}"),
-            bytes: bytes.len() as u64,
-            sha256: sha256_hex(bytes),
-        });
+        files.push(super::write_listed(
+            out,
+            format!("species/{name}"),
+            &[bytes],
+        )?);
         Ok(())
     };
     let used: BTreeMap<&str, ()> = trees

@@ -184,13 +184,13 @@ pub fn tile_glb(
     let mut buf = Buffer::default();
     // The vertex data's bytes (and each view's padding), reserved once: grown by doubling,
     // the buffer was copied again and again.
-    let floats: usize = (kinds.iter().flat_map(|(_, p)| p.values()))
+    let vertex_bytes: usize = (kinds.iter().flat_map(|(_, p)| p.values()))
         .map(|p| {
             4 * (p.positions.len() + p.normals.len() + p.uvs.len() + p.ids.len() + p.indices.len())
                 + 40
         })
         .sum();
-    buf.bin.reserve(floats);
+    buf.bin.reserve(vertex_bytes);
     let mut used: Vec<u16> = Vec::new();
     let mut meshes_json = Vec::new();
     let mut nodes = Vec::new();
@@ -314,13 +314,8 @@ impl crate::output::sink::Sink for GlbSink {
             tile.palette,
         );
         let path = format!("tiles/{}.glb", tile.id);
-        let sha256 = crate::output::atomic::write_atomic_hashed(&out.join(&path), &glb.parts())?;
         Ok(crate::output::sink::TileFiles {
-            files: vec![crate::output::report::ManifestFile {
-                path,
-                bytes: glb.len() as u64,
-                sha256,
-            }],
+            files: vec![crate::output::write_listed(out, path, &glb.parts())?],
             mesh_bytes: None,
         })
     }

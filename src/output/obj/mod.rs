@@ -10,10 +10,9 @@ pub mod mtl;
 use std::io::Write;
 use std::path::Path;
 
-use super::atomic;
 use super::palette::Palette;
-use super::report::ManifestFile;
 use super::sink::{Sink, TileContent, TileFiles};
+use super::write_listed;
 use crate::generate::mesh::Mesh;
 
 /// The OBJ format: `tiles/<id>.obj` and its `tiles/<id>.mtl`.
@@ -45,18 +44,10 @@ impl Sink for ObjSink {
             ))
         };
         let mtl = mtl::tile_mtl_text(tile.meshes, tile.palette).into_bytes();
-        let dir = out.join("tiles");
-        let obj_sha = atomic::write_atomic_hashed(&dir.join(format!("{id}.obj")), &[&obj])?;
-        let mtl_sha = atomic::write_atomic_hashed(&dir.join(format!("{id}.mtl")), &[&mtl])?;
-        let entry = |path: String, bytes: &[u8], sha256: String| ManifestFile {
-            path,
-            bytes: bytes.len() as u64,
-            sha256,
-        };
         Ok(TileFiles {
             files: vec![
-                entry(format!("tiles/{id}.obj"), &obj, obj_sha),
-                entry(format!("tiles/{id}.mtl"), &mtl, mtl_sha),
+                write_listed(out, format!("tiles/{id}.obj"), &[&obj])?,
+                write_listed(out, format!("tiles/{id}.mtl"), &[&mtl])?,
             ],
             mesh_bytes: sizes,
         })

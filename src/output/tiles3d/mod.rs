@@ -219,10 +219,5 @@ pub fn write_tileset(
 ) -> std::io::Result<ManifestFile> {
     let json = tileset(manifest, warnings).map_err(std::io::Error::other)?;
     let bytes = serde_json::to_vec_pretty(&json).expect("serialises");
-    super::atomic::write_atomic(&out.join("tileset.json"), &bytes)?;
-    Ok(ManifestFile {
-        path: "tileset.json".into(),
-        bytes: bytes.len() as u64,
-        sha256: super::sha256_hex(&bytes),
-    })
+    super::write_listed(out, "tileset.json".into(), &[&bytes])
 }
