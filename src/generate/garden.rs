@@ -8,7 +8,9 @@
 
 use geo_types::Coord;
 
-use super::mesh::{Frame, Mesh};
+use smallvec::smallvec;
+
+use super::mesh::{Corners, Frame, Mesh};
 use crate::growers::garden::{Layout, Settings};
 use crate::materials;
 
@@ -58,7 +60,7 @@ pub fn build(
         (s.width, s.depth),
         (0.0, s.depth),
     ];
-    let q: Vec<(u32, u32)> = corners
+    let q: Corners = corners
         .iter()
         .map(|&(x, y)| {
             let p = v(&mut bed, x, y, z);
@@ -142,7 +144,7 @@ fn disc(
         })
         .collect();
     for k in 0..n {
-        m.face(mat, vec![(centre, cuv), pts[k], pts[(k + 1) % n]]);
+        m.face(mat, smallvec![(centre, cuv), pts[k], pts[(k + 1) % n]]);
     }
 }
 
@@ -238,7 +240,7 @@ fn stone(
     for l in 0..2 {
         for k in 0..n {
             let k1 = (k + 1) % n;
-            let f = vec![
+            let f = smallvec![
                 (rings[l][k], m.uv(per(k, l).0, per(k, l).1)),
                 (rings[l][k1], m.uv(per(k + 1, l).0, per(k + 1, l).1)),
                 (
@@ -252,14 +254,14 @@ fn stone(
     }
     let top = m.uv(0.5, 1.0);
     for k in 0..n {
-        let f = vec![
+        let f = smallvec![
             (rings[2][k], top),
             (rings[2][(k + 1) % n], top),
             (apex, top),
         ];
         m.face(mat, f);
     }
-    let bottom: Vec<(u32, u32)> = rings[0].iter().rev().map(|&i| (i, top)).collect();
+    let bottom: Corners = rings[0].iter().rev().map(|&i| (i, top)).collect();
     m.face(mat, bottom);
 }
 
@@ -338,7 +340,7 @@ fn walls(m: &mut Mesh, site: &GardenSite, frame: Frame, s: &Settings) {
         for k in 0..4 {
             let k1 = (k + 1) % 4;
             let along = if k % 2 == 0 { len } else { t };
-            let f = vec![
+            let f = smallvec![
                 (lo[k], m.uv(0.0, 0.0)),
                 (lo[k1], m.uv(along / 2.0, 0.0)),
                 (hi[k1], m.uv(along / 2.0, h / 2.0)),
@@ -346,9 +348,9 @@ fn walls(m: &mut Mesh, site: &GardenSite, frame: Frame, s: &Settings) {
             ];
             m.face(wall, f);
         }
-        let top: Vec<(u32, u32)> = (0..4).map(|k| (hi[k], m.uv(k as f64 * 0.5, 0.0))).collect();
+        let top: Corners = (0..4).map(|k| (hi[k], m.uv(k as f64 * 0.5, 0.0))).collect();
         m.face(roof, top);
-        let bottom: Vec<(u32, u32)> = (0..4).rev().map(|k| (lo[k], m.uv(0.0, 0.0))).collect();
+        let bottom: Corners = (0..4).rev().map(|k| (lo[k], m.uv(0.0, 0.0))).collect();
         m.face(wall, bottom);
     }
 }

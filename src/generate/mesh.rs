@@ -65,6 +65,9 @@ fn index_of<const N: usize, T: Copy + PartialEq>(
     })
 }
 
+/// A face's corners: up to four kept in the face itself, more on the heap.
+pub type Corners = smallvec::SmallVec<[(u32, u32); 4]>;
+
 /// One face: a material and its corners as (position index, uv index), counter-clockwise
 /// seen from outside.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,7 +76,7 @@ pub struct Face {
     pub material: u16,
     /// The corners: (position index, texture coordinate index), counter-clockwise seen from
     /// outside.
-    pub corners: Vec<(u32, u32)>,
+    pub corners: Corners,
 }
 
 /// One OBJ object (`o <name>`).
@@ -135,7 +138,7 @@ impl Mesh {
 
     /// Adds a face, dropping corners that collapsed onto their neighbour when rounded to
     /// millimetres; a face left with fewer than three corners is not added.
-    pub fn face(&mut self, material: u16, corners: Vec<(u32, u32)>) {
+    pub fn face(&mut self, material: u16, corners: Corners) {
         // In place: a second vector per face was an allocation per face of the whole city.
         let mut c = corners;
         c.dedup_by_key(|k| k.0);

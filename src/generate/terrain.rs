@@ -7,6 +7,8 @@
 
 use geo_types::Coord;
 
+use smallvec::smallvec;
+
 use super::mesh::{Frame, Mesh};
 use crate::materials;
 use crate::model::dem::Dem;
@@ -64,8 +66,8 @@ pub fn terrain_mesh(name: String, dem: &Dem, bounds: [f64; 4], frame: Frame) -> 
         for i in 0..xs.len() - 1 {
             // Counter-clockwise seen from above: up is the outside of the ground.
             let (a, b, c, d) = (ids[j][i], ids[j][i + 1], ids[j + 1][i + 1], ids[j + 1][i]);
-            mesh.face(material, vec![a, b, c]);
-            mesh.face(material, vec![a, c, d]);
+            mesh.face(material, smallvec![a, b, c]);
+            mesh.face(material, smallvec![a, c, d]);
         }
     }
     Some(mesh.finish())

@@ -13,6 +13,8 @@
 
 use geo_types::Coord;
 
+use smallvec::smallvec;
+
 use super::mesh::{Frame, Mesh};
 use crate::growers::lsystem::presets::GOLDEN_ANGLE;
 use crate::growers::skeleton::Skeleton;
@@ -327,7 +329,7 @@ fn tubes(sk: &Skeleton, s: &Shape, look: Look, put: &Put, mesh: &mut Mesh) {
             row[k]
         };
         for k in 0..m {
-            let corners = vec![
+            let corners = smallvec![
                 (pool[start + k], uv(&mut lo, k, v0, mesh)),
                 (pool[start + (k + 1) % m], uv(&mut lo, k + 1, v0, mesh)),
                 (pool[end + (k + 1) % m], uv(&mut hi, k + 1, v1, mesh)),
