@@ -59,21 +59,27 @@ fn push_mm(buf: &mut Vec<u8>, v: i64) {
     push_fixed(buf, v, 1000, 3);
 }
 
-/// Appends `v / scale` with `digits` decimals, `scale == 10^digits`.
+/// Appends `v / scale` with `digits` decimals, `scale == 10^digits`: `v`'s digits with the
+/// point set in, so one integer formatting (not a division and two) per number.
 fn push_fixed(buf: &mut Vec<u8>, v: i64, scale: i64, digits: usize) {
+    debug_assert_eq!(10i64.checked_pow(digits as u32), Some(scale));
     let mut itoa_buf = itoa::Buffer::new();
     if v < 0 {
         buf.push(b'-');
     }
-    let a = v.unsigned_abs();
-    let scale = scale as u64;
-    buf.extend_from_slice(itoa_buf.format(a / scale).as_bytes());
-    buf.push(b'.');
-    let frac = itoa_buf.format(a % scale).as_bytes();
-    for _ in frac.len()..digits {
-        buf.push(b'0');
+    let all = itoa_buf.format(v.unsigned_abs()).as_bytes();
+    match all.len().checked_sub(digits) {
+        Some(whole) if whole > 0 => {
+            buf.extend_from_slice(&all[..whole]);
+            buf.push(b'.');
+            buf.extend_from_slice(&all[whole..]);
+        }
+        _ => {
+            buf.extend_from_slice(b"0.");
+            buf.extend(std::iter::repeat_n(b'0', digits - all.len()));
+            buf.extend_from_slice(all);
+        }
     }
-    buf.extend_from_slice(frac);
 }
 
 /// The tile's header: version, origin, frame, the MTL.
@@ -202,10 +208,12 @@ pub fn write_tile_by_kind(
         buf.push(b'\n');
         // (material, mesh, face) over the kind's meshes, with each mesh's index bases.
         let mut faces: Vec<(u16, usize, usize)> = Vec::new();
-        let mut bases = Vec::new();
+        // Each mesh's index bases by its index (a search per face was quadratic in a tile's
+        // houses).
+        let mut bases = vec![(0u64, 0u64); meshes.len()];
         for (i, mesh) in meshes.iter().enumerate().filter(|(i, _)| kinds[*i] == kind) {
             vertices(buf, mesh);
-            bases.push((i, v_base, vt_base));
+            bases[i] = (v_base, vt_base);
             v_base += mesh.positions.len() as u64;
             vt_base += mesh.uvs.len() as u64;
             faces.extend(
@@ -218,7 +226,7 @@ pub fn write_tile_by_kind(
         faces.sort();
         let mut current = None;
         for (material, i, k) in faces {
-            let &(_, vb, tb) = bases.iter().find(|b| b.0 == i).expect("a base per mesh");
+            let (vb, tb) = bases[i];
             use_material(buf, &mut current, material, palette);
             face(buf, &meshes[i].faces[k], vb, tb);
         }
@@ -257,5 +265,29 @@ mod tests {
         }
         assert_eq!(fixed(-12_345, 10_000, 4), "-1.2345");
         assert_eq!(fixed(7, 10_000, 4), "0.0007");
+    }
+
+    proptest::proptest! {
+        /// The digits with the point set in are the whole part, the point and the fraction
+        /// padded to `digits`, for numbers of every length (and i64's ends).
+        #[test]
+        fn fixed_point_is_whole_point_fraction(
+            v in proptest::prop_oneof![
+                -20_000i64..20_000,
+                proptest::num::i64::ANY,
+                proptest::strategy::Just(i64::MIN),
+                proptest::strategy::Just(i64::MAX),
+            ],
+            digits in 1usize..6,
+        ) {
+            let scale = 10i64.pow(digits as u32);
+            let a = v.unsigned_abs();
+            let (whole, frac) = (a / scale as u64, a % scale as u64);
+            let sign = if v < 0 { "-" } else { "" };
+            proptest::prop_assert_eq!(
+                fixed(v, scale, digits),
+                format!("{sign}{whole}.{frac:0digits$}")
+            );
+        }
     }
 }
