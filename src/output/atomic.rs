@@ -83,7 +83,7 @@ pub fn write_atomic_hashed(path: &Path, parts: &[&[u8]]) -> std::io::Result<Stri
         h.update(pieces[i]);
         pieces[i]
     })?;
-    Ok(h.finalize().iter().map(|b| format!("{b:02x}")).collect())
+    Ok(super::hex(&h.finalize()))
 }
 
 /// This process's part of a temporary name: its pid and a random number drawn once, so the

@@ -35,7 +35,11 @@ use report::ManifestFile;
 
 /// The sha256 of `bytes` in lower-case hex, as the manifest lists every file.
 pub fn sha256_hex(bytes: &[u8]) -> String {
-    let digest = Sha256::digest(bytes);
+    hex(&Sha256::digest(bytes))
+}
+
+/// A digest in lower-case hex.
+fn hex(digest: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 

@@ -131,21 +131,6 @@ impl Glb {
     pub fn parts(&self) -> [&[u8]; 2] {
         [&self.head, &self.bin]
     }
-
-    /// The file's length in bytes.
-    pub fn len(&self) -> usize {
-        self.head.len() + self.bin.len()
-    }
-
-    /// Whether the file is empty (never: a GLB has a header).
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The whole file as one buffer.
-    pub fn to_vec(&self) -> Vec<u8> {
-        self.parts().concat()
-    }
 }
 
 /// The GLB container: header, JSON chunk (space-padded) and BIN chunk (zero-padded).
@@ -180,7 +165,9 @@ mod tests {
         b.view(&[1, 2, 3], None);
         let second = b.view(&[4], None);
         assert_eq!(b.views[second]["byteOffset"], 8);
-        let out = glb(&json!({"asset": {"version": "2.0"}}), b.bin).to_vec();
+        let out = glb(&json!({"asset": {"version": "2.0"}}), b.bin)
+            .parts()
+            .concat();
         assert_eq!(&out[0..4], b"glTF");
         let total = u32::from_le_bytes(out[8..12].try_into().unwrap()) as usize;
         assert_eq!(total, out.len());
