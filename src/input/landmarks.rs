@@ -201,6 +201,9 @@ pub fn models_dir(input: &Path, params: &Params) -> PathBuf {
 fn finish(dir: &Path, params: &Params, file: &str, raws: Vec<Raw>, data: &mut Dataset) {
     let l = &params.layers.landmarks;
     let models_dir = models_dir(dir, params);
+    // Model files, and every file they name, are read only inside the input directory and
+    // the models directory the parameter file names.
+    let confined = super::confine::Confined::new([dir, models_dir.as_path()]);
     let mut loaded: BTreeMap<String, Result<Arc<Model>, String>> = BTreeMap::new();
     let mut seen = std::collections::HashSet::new();
     for raw in raws {
@@ -252,7 +255,8 @@ fn finish(dir: &Path, params: &Params, file: &str, raws: Vec<Raw>, data: &mut Da
             };
             let m = loaded.entry(model.clone()).or_insert_with(|| {
                 let mut notes = Vec::new();
-                let r = load_model(&models_dir.join(&model), &model, &mut notes).map(Arc::new);
+                let r = load_model(&models_dir.join(&model), &model, &confined, &mut notes)
+                    .map(Arc::new);
                 for n in notes {
                     data.warnings
                         .push(crate::model::Warning::layer("landmarks", file, n));

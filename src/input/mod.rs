@@ -19,6 +19,7 @@ pub mod table;
 pub mod widths;
 
 mod areas;
+pub mod confine;
 mod landmarks;
 mod lines;
 mod links;

@@ -1,0 +1,355 @@
+//! A glTF or GLB landmark model. The gltf crate parses and validates the document; the
+//! files it names (buffers, images) are read here, through [`Confined`], because the crate's
+//! own importer follows `../` and `file:///` anywhere, reads devices until memory runs out
+//! and panics on a URI whose percent-encoding is not UTF-8. Every count the document
+//! declares is checked before the crate is asked to read that many elements.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use super::{excerpt, grey_material, image_kind, stem_of, texture, too_many};
+use super::{MAX_MODEL_BYTES, MAX_TRIANGLES};
+use crate::input::confine::Confined;
+use crate::model::landmark::{Model, ModelMaterial, ModelTriangle};
+
+/// The most nodes a scene may place (a node reached twice through a DAG counts twice): a
+/// 6 KB file of nodes that each name the next twice would otherwise place a mesh 2^n times.
+const MAX_INSTANCES: usize = 100_000;
+/// The most vertices an accessor may declare.
+const MAX_ELEMENTS: usize = 3 * MAX_TRIANGLES;
+
+/// A glTF or GLB (its bytes; `dir` is where its relative URIs point): the default scene's
+/// meshes (else the first scene's) with their nodes' transforms, triangle primitives only.
+pub(super) fn load_gltf(
+    bytes: Vec<u8>,
+    dir: &Path,
+    shown: &str,
+    confined: &Confined,
+    notes: &mut Vec<String>,
+) -> Result<Model, String> {
+    let bad = |e: &dyn std::fmt::Display| {
+        // The crate lists every invalid field; the first few say enough.
+        let e = e.to_string();
+        let e = match e.char_indices().nth(400) {
+            Some((i, _)) => format!("{} ...", &e[..i]),
+            None => e,
+        };
+        format!("{shown} is not a readable glTF: {e}")
+    };
+    let g = gltf::Gltf::from_slice(&bytes).map_err(|e| bad(&e))?;
+    drop(bytes);
+    let buffers = buffers(&g, dir, shown, confined)?;
+    check_accessors(&g.document, shown)?;
+    let mut model = Model::default();
+    for m in g.document.materials() {
+        let c = m.pbr_metallic_roughness().base_color_factor();
+        let tex = m
+            .pbr_metallic_roughness()
+            .base_color_texture()
+            .and_then(|info| gltf_image(info.texture().source(), &buffers, dir, confined, notes));
+        model.materials.push(ModelMaterial {
+            name: m
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("material{}", m.index().unwrap_or(0))),
+            kd: [c[0], c[1], c[2]],
+            texture: tex,
+        });
+    }
+    let grey = model.materials.len() as u32;
+    let mut needs_grey = false;
+    let scene = g
+        .document
+        .default_scene()
+        .or_else(|| g.document.scenes().next());
+    let mut stack: Vec<(gltf::Node, [[f64; 4]; 4])> = scene
+        .into_iter()
+        .flat_map(|s| s.nodes())
+        .map(|n| (n, IDENTITY))
+        .collect();
+    let mut placed = 0usize;
+    while let Some((node, parent)) = stack.pop() {
+        placed += 1;
+        if placed > MAX_INSTANCES {
+            return Err(format!(
+                "{shown} places more than {MAX_INSTANCES} nodes (its node tree repeats itself, \
+                 or has a cycle): export it with its instances applied"
+            ));
+        }
+        let local = node.transform().matrix().map(|c| c.map(f64::from));
+        let world = mul(&parent, &local);
+        for child in node.children() {
+            stack.push((child, world));
+        }
+        let Some(mesh) = node.mesh() else { continue };
+        for prim in mesh.primitives() {
+            if prim.mode() != gltf::mesh::Mode::Triangles {
+                continue;
+            }
+            let material = match prim.material().index() {
+                Some(k) => k as u32,
+                None => {
+                    needs_grey = true;
+                    grey
+                }
+            };
+            add_primitive(&mut model, &prim, &buffers, &world, material, shown)?;
+        }
+    }
+    if needs_grey {
+        model.materials.push(grey_material());
+    }
+    Ok(model)
+}
+
+/// One triangle primitive placed by `world`, its size checked against the model's budget
+/// before it is read.
+fn add_primitive(
+    model: &mut Model,
+    prim: &gltf::Primitive,
+    buffers: &[gltf::buffer::Data],
+    world: &[[f64; 4]; 4],
+    material: u32,
+    shown: &str,
+) -> Result<(), String> {
+    let bad = |why: &str| format!("{shown} is not a readable glTF: {why}");
+    let Some(pos_accessor) = prim.get(&gltf::Semantic::Positions) else {
+        return Ok(());
+    };
+    let corners = prim.indices().map_or(pos_accessor.count(), |i| i.count());
+    let triangles = model.triangles.len() + corners / 3;
+    if triangles > MAX_TRIANGLES || model.positions.len() + pos_accessor.count() > MAX_ELEMENTS {
+        return Err(too_many(shown, triangles));
+    }
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+    let Some(pos) = reader.read_positions() else {
+        return Ok(());
+    };
+    let base = model.positions.len() as u32;
+    model
+        .positions
+        .extend(pos.map(|p| apply(world, p.map(f64::from))));
+    let n = model.positions.len() as u32 - base;
+    let uv_base = model.uvs.len() as u32;
+    if let Some(t) = reader.read_tex_coords(0) {
+        // glTF's v runs down the image, OBJ's (and ours) up.
+        model.uvs.extend(
+            t.into_f32()
+                .take(n as usize)
+                .map(|[u, v]| [f64::from(u), 1.0 - f64::from(v)]),
+        );
+    }
+    let nt = model.uvs.len() as u32 - uv_base;
+    let indices: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..n).collect(),
+    };
+    // A mirrored transform turns the faces inside out: wind them back.
+    let flip = det3(world) < 0.0;
+    for tri in indices.chunks_exact(3) {
+        if tri.iter().any(|&i| i >= n) {
+            return Err(bad("a primitive's index names a vertex it lacks"));
+        }
+        let t = if flip {
+            [tri[0], tri[2], tri[1]]
+        } else {
+            [tri[0], tri[1], tri[2]]
+        };
+        model.triangles.push(ModelTriangle {
+            positions: t.map(|i| base + i),
+            uvs: (nt == n).then(|| t.map(|i| uv_base + i)),
+            material,
+        });
+    }
+    Ok(())
+}
+
+/// The document's buffers: the GLB's binary chunk, data URIs, and files beside the model
+/// read through `confined`, each at least as long as it declares, together under
+/// [`MAX_MODEL_BYTES`].
+fn buffers(
+    g: &gltf::Gltf,
+    dir: &Path,
+    shown: &str,
+    confined: &Confined,
+) -> Result<Vec<gltf::buffer::Data>, String> {
+    let mut blob = g.blob.clone();
+    let mut total = 0u64;
+    let mut out = Vec::new();
+    for b in g.document.buffers() {
+        let mut data = match b.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                format!(
+                    "{shown}: buffer {} is the GLB's binary chunk, which is missing: it is \
+                     damaged",
+                    b.index()
+                )
+            })?,
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                gltf::buffer::Data::from_source(b.source(), None)
+                    .map_err(|e| format!("{shown}: buffer {}'s data URI: {e}", b.index()))?
+                    .0
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                let path = local_uri(uri, dir, shown)?;
+                let left = MAX_MODEL_BYTES.saturating_sub(total);
+                confined.read(&path, &format!("{shown}: buffer {}", excerpt(uri)), left)?
+            }
+        };
+        if data.len() < b.length() {
+            return Err(format!(
+                "{shown}: buffer {} declares {} bytes and holds {}: it is damaged",
+                b.index(),
+                b.length(),
+                data.len()
+            ));
+        }
+        total += data.len() as u64;
+        if total > MAX_MODEL_BYTES {
+            return Err(format!(
+                "{shown}: its buffers hold more than {MAX_MODEL_BYTES} bytes: decimate it"
+            ));
+        }
+        data.resize(data.len().next_multiple_of(4), 0);
+        out.push(gltf::buffer::Data(data));
+    }
+    Ok(out)
+}
+
+/// The file a relative URI names, percent-decoded; a URI with a scheme (`file:`, `http:`)
+/// or whose decoding is not UTF-8 is refused.
+fn local_uri(uri: &str, dir: &Path, shown: &str) -> Result<std::path::PathBuf, String> {
+    if uri.contains(':') {
+        return Err(format!(
+            "{shown}: the URI `{}` names a scheme or drive: a model names its files by paths \
+             relative to itself (or embeds them)",
+            excerpt(uri)
+        ));
+    }
+    let decoded = urlencoding::decode(uri).map_err(|_| {
+        format!(
+            "{shown}: the URI `{}` is not valid percent-encoded UTF-8",
+            excerpt(uri)
+        )
+    })?;
+    Ok(dir.join(&*decoded))
+}
+
+/// Refuses accessors that declare more elements than a model may hold, and sparse parts
+/// larger than their accessor: the crate would allocate or walk that many.
+fn check_accessors(doc: &gltf::Document, shown: &str) -> Result<(), String> {
+    for a in doc.accessors() {
+        let sparse = a.sparse().map_or(0, |s| s.count());
+        if a.count() > MAX_ELEMENTS || sparse > a.count() {
+            return Err(format!(
+                "{shown}: accessor {} declares {} elements ({} sparse), more than a model may \
+                 hold ({MAX_ELEMENTS}) or than it has: it is damaged, or too large to place",
+                a.index(),
+                a.count(),
+                sparse
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A glTF image's bytes: from a buffer view, or a file beside the model (data URIs and web
+/// addresses are left out with a note).
+fn gltf_image(
+    image: gltf::Image,
+    buffers: &[gltf::buffer::Data],
+    dir: &Path,
+    confined: &Confined,
+    notes: &mut Vec<String>,
+) -> Option<(String, Arc<Vec<u8>>)> {
+    match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let data = buffers.get(view.buffer().index())?;
+            let end = view.offset().checked_add(view.length())?;
+            let bytes = data.0.get(view.offset()..end)?;
+            let ext = image_kind(bytes).or_else(|| {
+                notes.push("an embedded texture is neither a PNG nor a JPEG".into());
+                None
+            })?;
+            let name = image
+                .name()
+                .map(stem_of)
+                .unwrap_or_else(|| format!("image{}", image.index()));
+            Some((format!("{name}.{ext}"), Arc::new(bytes.to_vec())))
+        }
+        gltf::image::Source::Uri { uri, .. } => {
+            if uri.starts_with("data:") {
+                notes.push(format!(
+                    "texture `{}` is a data URI: save it as a file beside the model",
+                    excerpt(uri)
+                ));
+                return None;
+            }
+            match local_uri(uri, dir, "texture") {
+                Ok(path) => texture(&path, uri, confined, notes),
+                Err(e) => {
+                    notes.push(format!("{e}: its material keeps its colour"));
+                    None
+                }
+            }
+        }
+    }
+}
+
+const IDENTITY: [[f64; 4]; 4] = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
+
+/// `a * b`, column-major as glTF stores them (`m[column][row]`).
+fn mul(a: &[[f64; 4]; 4], b: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
+    let mut out = [[0.0; 4]; 4];
+    for (c, col) in out.iter_mut().enumerate() {
+        for (r, v) in col.iter_mut().enumerate() {
+            *v = (0..4).map(|k| a[k][r] * b[c][k]).sum();
+        }
+    }
+    out
+}
+
+/// A point through a column-major transform.
+fn apply(m: &[[f64; 4]; 4], p: [f64; 3]) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for (r, v) in out.iter_mut().enumerate() {
+        *v = m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r];
+    }
+    out
+}
+
+/// The determinant of the upper 3x3.
+fn det3(m: &[[f64; 4]; 4]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[2][1] * m[1][2])
+        - m[1][0] * (m[0][1] * m[2][2] - m[2][1] * m[0][2])
+        + m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transforms_compose_translation_after_scale() {
+        // Column-major: a translation by (1, 2, 3) and a scale by 2.
+        let t = [
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [1.0, 2.0, 3.0, 1.0],
+        ];
+        let s = [
+            [2.0, 0.0, 0.0, 0.0],
+            [0.0, 2.0, 0.0, 0.0],
+            [0.0, 0.0, 2.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
+        assert_eq!(apply(&mul(&t, &s), [1.0, 1.0, 1.0]), [3.0, 4.0, 5.0]);
+        assert_eq!(det3(&s), 8.0);
+    }
+}
