@@ -70,7 +70,9 @@ pub(super) fn load_gltf(
     let mut placed = 0usize;
     while let Some((node, parent)) = stack.pop() {
         placed += 1;
-        if placed > MAX_INSTANCES {
+        // Every node waiting on the stack will be placed: counting them too bounds the stack
+        // itself (a node listing thousands of children, each listing them again).
+        if placed + stack.len() + node.children().len() > MAX_INSTANCES {
             return Err(format!(
                 "{shown} places more than {MAX_INSTANCES} nodes (its node tree repeats itself, \
                  or has a cycle): export it with its instances applied"
