@@ -306,7 +306,12 @@ fn declared_sizes_node_repeats_and_triangle_counts_are_checked_before_allocating
     .map(|m| row(m.split('.').next().unwrap(), m))
     .collect();
     let report = build(tmp.path(), &rows);
-    assert_eq!(placed(&report), vec!["ok".to_string()], "{}", report["landmarks"]);
+    assert_eq!(
+        placed(&report),
+        vec!["ok".to_string()],
+        "{}",
+        report["landmarks"]
+    );
     for id in ["sparse", "sparse11"] {
         assert!(
             why(&report, id).contains("too large to place"),
@@ -325,5 +330,37 @@ fn declared_sizes_node_repeats_and_triangle_counts_are_checked_before_allocating
         why(&report, "big").contains("triangles"),
         "{}",
         why(&report, "big")
+    );
+}
+
+#[test]
+fn landmark_triangles_are_budgeted_per_tile_with_the_rest_skipped() {
+    let tmp = tempfile::tempdir().unwrap();
+    let models = tmp.path().join("models");
+    std::fs::create_dir_all(&models).unwrap();
+    // 600,000 triangles: under the model limit; two at one point pass the tile's budget.
+    let mut obj = String::from("v 0 0 0\nv 10 0 0\nv 0 10 0\n");
+    for _ in 0..600_000 {
+        obj += "f 1 2 3\n";
+    }
+    std::fs::write(models.join("heavy.obj"), obj).unwrap();
+    let rows = vec![row("first", "heavy.obj"), row("second", "heavy.obj")];
+    let report = build(tmp.path(), &rows);
+    assert_eq!(placed(&report), vec!["first".to_string()]);
+    let w = why(&report, "second");
+    assert!(
+        w.contains("past 1000000") && w.contains("holds 600000"),
+        "{w}"
+    );
+    // The ledger closes: both read, one built, one skipped.
+    let lm = report["accounting"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["role"] == "landmarks")
+        .unwrap();
+    assert_eq!(
+        (lm["built"].as_u64(), lm["skipped"].as_u64()),
+        (Some(1), Some(1))
     );
 }

@@ -50,6 +50,16 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
             Err(reason) => skip(&mut report, plan, &file, (&r.id, r.record), reason),
         }
     }
+    // Budgets before the palette, so a skipped model's textures are not written.
+    let mut budget = Budget::default();
+    let mut kept = Vec::with_capacity(placed.len());
+    for p in placed {
+        match budget.take(&p.tile, p.model.triangles.len()) {
+            Ok(()) => kept.push(p),
+            Err(reason) => skip(&mut report, plan, &file, (&p.id, p.record), reason),
+        }
+    }
+    let placed = kept;
     let (palette, textures, bases) = palette(&placed, library);
     for mut p in placed {
         let Some(&base) = bases.get(&p.model.file) else {
@@ -78,6 +88,44 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
     plan.palette = palette;
     plan.model_textures = textures;
     plan.landmark_report = report;
+}
+
+/// Landmark triangles one tile may hold: one model at the model limit fills a tile (its GLB
+/// is then ~120 MB); ten rows naming it at one point would make a tile no viewer opens.
+pub const MAX_TILE_TRIANGLES: usize = 1_000_000;
+/// Landmark triangles one build may hold (~1 GB of GLB in all).
+pub const MAX_BUILD_TRIANGLES: usize = 8_000_000;
+
+/// Landmark triangles taken so far, per tile and for the build: the records in their order
+/// take them, so which ones are skipped does not depend on threads or `--tiles`.
+#[derive(Default)]
+struct Budget {
+    tiles: BTreeMap<String, usize>,
+    build: usize,
+}
+
+impl Budget {
+    /// Takes `triangles` for `tile`, or says which budget it would pass.
+    fn take(&mut self, tile: &str, triangles: usize) -> Result<(), String> {
+        let in_tile = self.tiles.get(tile).copied().unwrap_or(0);
+        if in_tile + triangles > MAX_TILE_TRIANGLES {
+            return Err(format!(
+                "its model's {triangles} triangles would bring tile {tile}'s landmarks past \
+                 {MAX_TILE_TRIANGLES} (it holds {in_tile}): decimate the models or place \
+                 fewer in one tile"
+            ));
+        }
+        if self.build + triangles > MAX_BUILD_TRIANGLES {
+            return Err(format!(
+                "its model's {triangles} triangles would bring the build's landmarks past \
+                 {MAX_BUILD_TRIANGLES} (it holds {}): decimate the models",
+                self.build
+            ));
+        }
+        self.tiles.insert(tile.to_string(), in_tile + triangles);
+        self.build += triangles;
+        Ok(())
+    }
 }
 
 /// A landmark not placed: in the report's `landmarks.skipped` and the build's skipped list
@@ -401,5 +449,26 @@ fn displace(p: &PlannedLandmark, data: &Dataset, plan: &mut Plan, out: &mut Vec<
             }
             false
         });
+    }
+}
+
+#[cfg(test)]
+mod budget_tests {
+    use super::*;
+
+    #[test]
+    fn budgets_hold_per_tile_and_per_build_in_record_order() {
+        let mut b = Budget::default();
+        b.take("a", MAX_TILE_TRIANGLES - 10).unwrap();
+        let e = b.take("a", 11).unwrap_err();
+        assert!(e.contains("tile a") && e.contains("holds 999990"), "{e}");
+        b.take("a", 10).unwrap();
+        // Other tiles fill the build's budget, and then nothing more is taken anywhere.
+        let tiles = MAX_BUILD_TRIANGLES / MAX_TILE_TRIANGLES;
+        for t in 1..tiles {
+            b.take(&format!("t{t}"), MAX_TILE_TRIANGLES).unwrap();
+        }
+        let e = b.take("fresh", 1).unwrap_err();
+        assert!(e.contains("the build's landmarks"), "{e}");
     }
 }
