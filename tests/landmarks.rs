@@ -343,3 +343,92 @@ fn a_glb_of_our_own_is_a_landmark_too() {
     // A tile is at most a few hundred metres; at 0.1 it is tens.
     assert!(b[3] - b[0] < 40.0 && b[3] - b[0] > 1.0, "{b:?}");
 }
+
+#[test]
+fn rows_without_an_id_and_points_far_outside_the_city_are_skipped_before_anything_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let input = tmp.path().join("in");
+    let models = tmp.path().join("models");
+    std::fs::create_dir_all(&models).unwrap();
+    triangle_obj(&models, "ok.obj", 0.0, 10.0);
+    let (x, y) = (-22600.0, -109600.0);
+    let rows = [
+        format!("good,ok.obj,,{x},{y},0,1,"),
+        format!(",ok.obj,,{},{y},0,1,", x + 20.0),
+        format!(",ok.obj,,{},{y},0,1,", x + 40.0),
+        format!("farx,ok.obj,,5e7,{y},0,1,"),
+        format!("fary,ok.obj,,{x},9e7,0,1,"),
+        format!("huge,ok.obj,,1e300,{y},0,1,"),
+        format!("nearby,ok.obj,,{},{y},0,1,", x - 1500.0),
+    ];
+    let params = town(&input, &(rows.join("\n") + "\n"), "anchor = \"origin\"\n");
+    let text = std::fs::read_to_string(&params).unwrap().replace(
+        &format!("{:?}", models_dir_str()),
+        &format!("{:?}", models.display().to_string()),
+    );
+    std::fs::write(&params, text).unwrap();
+    // A link far out, beside the fixture's two.
+    let mut links = std::fs::read_to_string(input.join("links.csv")).unwrap();
+    links.push_str("9,Far away,https://example.org/,,1e300,-109800.0\n");
+    std::fs::write(input.join("links.csv"), links).unwrap();
+    let out = tmp.path().join("out");
+    let report = build_ok(&input, &out, &["--params", params.to_str().unwrap()]);
+    let l = &report["landmarks"];
+    let placed: Vec<&str> = l["placed"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["id"].as_str().unwrap())
+        .collect();
+    let mut placed = placed;
+    placed.sort();
+    assert_eq!(placed, ["good", "nearby"], "{l}");
+    let skipped = report["skipped"].as_array().unwrap();
+    let reason = |layer: &str, id: &str| -> Vec<String> {
+        skipped
+            .iter()
+            .filter(|s| s["layer"] == layer && s["id"] == id)
+            .map(|s| s["reason"].as_str().unwrap().to_string())
+            .collect()
+    };
+    // Both rows without an id are listed, with their spreadsheet rows.
+    let no_id = reason("landmarks", "");
+    assert_eq!(no_id.len(), 2, "{skipped:?}");
+    assert!(no_id[0].contains("no `id`"), "{no_id:?}");
+    for id in ["farx", "fary", "huge"] {
+        let r = reason("landmarks", id);
+        assert!(
+            r.len() == 1 && (r[0].contains("outside the city") || r[0].contains("CRS's origin")),
+            "{id}: {r:?}"
+        );
+    }
+    let far_link = reason("links", "9");
+    assert!(
+        far_link.len() == 1 && far_link[0].contains("CRS's origin"),
+        "{far_link:?}"
+    );
+    // Every row is accounted for, the manifest is written, and no tile lies far out.
+    for a in report["accounting"].as_array().unwrap() {
+        assert_eq!(a["unaccounted"], 0, "{a}");
+    }
+    let lm = report["accounting"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["role"] == "landmarks")
+        .unwrap();
+    assert_eq!(
+        (lm["read"].as_u64(), lm["built"].as_u64()),
+        (Some(7), Some(2))
+    );
+    let manifest = read_json(&out.join("manifest.json"));
+    let links = read_json(&out.join("links.json"));
+    assert_eq!(links.as_array().unwrap().len(), 2);
+    let tiles = manifest["tiles"].as_array().unwrap();
+    let plain = build_ok(
+        &fixture("kyoto-small"),
+        &tmp.path().join("plain"),
+        &["--quiet"],
+    );
+    assert!(tiles.len() <= plain["tiles"].as_array().unwrap().len() + 1);
+}

@@ -286,6 +286,34 @@ pub fn map_polygon(poly: &mut Polygon<f64>, f: &mut CoordsFn) -> Result<(), Stri
     result
 }
 
+/// How far outside the box of the city's lots, footprints and streets a point feature (a
+/// landmark, a link) may lie, metres: a temple on the edge of town stands outside its lots,
+/// a point kilometres away is a typo or a coordinate in another CRS.
+pub const CITY_MARGIN: f64 = 2000.0;
+
+/// Why `at` (output CRS) cannot be a feature of the city whose box is `city`, or `None`.
+pub fn beyond_city(at: Coord<f64>, city: Option<geo_types::Rect<f64>>) -> Option<String> {
+    if !(at.x.is_finite() && at.y.is_finite()) {
+        return Some("its coordinates are not finite numbers: give its x, y".into());
+    }
+    if !crate::model::sane(at) {
+        return Some(format!(
+            "it lies {:.0e} m or more from the CRS's origin: check its x, y",
+            crate::model::FAR
+        ));
+    }
+    let city = city?;
+    let dx = (city.min().x - at.x).max(at.x - city.max().x).max(0.0);
+    let dy = (city.min().y - at.y).max(at.y - city.max().y).max(0.0);
+    let off = dx.hypot(dy);
+    (off > CITY_MARGIN).then(|| {
+        format!(
+            "it lies {off:.0} m outside the city (the box of its lots, footprints and streets \
+             widened by {CITY_MARGIN} m): check its x, y, and that they are in the output CRS"
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -370,5 +398,37 @@ mod tests {
             let (p, _) = organise_rings(vec![square(0.0, 0.0, 1.0, clockwise)]);
             assert!(p[0].exterior().is_ccw());
         }
+    }
+
+    #[test]
+    fn points_far_outside_the_city_are_named_with_the_distance() {
+        let city = Some(geo_types::Rect::new(
+            Coord { x: 0.0, y: 0.0 },
+            Coord { x: 100.0, y: 100.0 },
+        ));
+        assert_eq!(beyond_city(Coord { x: 50.0, y: 50.0 }, city), None);
+        assert_eq!(
+            beyond_city(
+                Coord {
+                    x: -1999.0,
+                    y: 50.0
+                },
+                city
+            ),
+            None
+        );
+        let far = beyond_city(Coord { x: 5e7, y: 50.0 }, city).unwrap();
+        assert!(far.contains("49999900 m outside"), "{far}");
+        assert!(beyond_city(Coord { x: 1e300, y: 0.0 }, city).is_some());
+        assert!(beyond_city(
+            Coord {
+                x: f64::NAN,
+                y: 0.0
+            },
+            None
+        )
+        .is_some());
+        assert_eq!(beyond_city(Coord { x: 9e7, y: 0.0 }, None), None);
+        assert!(beyond_city(Coord { x: 2e8, y: 0.0 }, None).is_some());
     }
 }

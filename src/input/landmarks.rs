@@ -206,6 +206,7 @@ fn finish(dir: &Path, params: &Params, file: &str, raws: Vec<Raw>, data: &mut Da
     let confined = super::confine::Confined::new([dir, models_dir.as_path()]);
     let mut loaded: BTreeMap<String, Result<Arc<Model>, String>> = BTreeMap::new();
     let mut seen = std::collections::HashSet::new();
+    let city = data.city_box();
     for raw in raws {
         let get = |k: &str| raw.attrs.get(k).map(String::as_str).unwrap_or("");
         let number = |k: &str, default: f64| -> Result<f64, String> {
@@ -227,6 +228,9 @@ fn finish(dir: &Path, params: &Params, file: &str, raws: Vec<Raw>, data: &mut Da
                 );
             }
             let (at, footprint) = raw.place.clone()?;
+            if let Some(why) = super::geometry::beyond_city(at, city) {
+                return Err(why);
+            }
             let model = match (get(&l.model_field), get(&l.kind_field)) {
                 ("", "") => {
                     return Err(format!(

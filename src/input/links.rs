@@ -40,6 +40,7 @@ fn link(
     at: Coord<f64>,
     get: &dyn Fn(&str) -> String,
     l: &LinksLayer,
+    city: Option<geo_types::Rect<f64>>,
 ) -> Result<Link, String> {
     let (title, url, image) = (get(&l.title_field), get(&l.url_field), get(&l.image_field));
     if let Some(p) = url_problem(&url).or_else(|| url_problem(&image)) {
@@ -51,8 +52,8 @@ fn link(
             l.url_field, l.image_field
         ));
     }
-    if !(at.x.is_finite() && at.y.is_finite()) {
-        return Err("no usable coordinates".into());
+    if let Some(why) = super::geometry::beyond_city(at, city) {
+        return Err(why);
     }
     Ok(Link {
         id,
@@ -72,6 +73,7 @@ pub(super) fn read_link_points(
     data: &mut Dataset,
 ) -> Result<(), InputError> {
     let field = |name: &str| resolve_field(name, &o.layer.fields, o.layer.text_encoding);
+    let city = data.city_box();
     for f in &o.layer.features {
         let mut points =
             points_of(&f.shape).map_err(|kind| o.wrong_shape(f.record, kind, "points"))?;
@@ -88,7 +90,7 @@ pub(super) fn read_link_points(
             0 => Err("null shape: the record has no point; place it or delete the record".into()),
             _ => to_target(o, target, &mut points[..1])
                 .map_err(|e| e.to_string())
-                .and_then(|_| link(id.clone(), f.record, points[0], &get, l)),
+                .and_then(|_| link(id.clone(), f.record, points[0], &get, l, city)),
         };
         push(data, result, &o.file, id, f.record);
     }
@@ -124,6 +126,7 @@ pub(super) fn read_link_table(
         }
     }
     let mut rows = 0;
+    let city = data.city_box();
     for (record, row) in reader.records().enumerate() {
         let row = row.map_err(|e| err(format!("row {}: {e}", record + 2)))?;
         rows += 1;
@@ -143,7 +146,7 @@ pub(super) fn read_link_table(
             x: num(&l.x_field),
             y: num(&l.y_field),
         };
-        let result = link(id.clone(), record, at, &get, l);
+        let result = link(id.clone(), record, at, &get, l, city);
         push(data, result, &file, id, record);
     }
     data.layers.push(LayerInfo {

@@ -18,7 +18,7 @@ pub struct Table {
     /// Rows in file order: (id, values), each id once.
     pub rows: Vec<(String, BTreeMap<String, String>)>,
     /// Rows not used, as the spreadsheet numbers them (the header is row 1), with the id
-    /// and why: a repeated id (the first row with it is used), an id that is a date.
+    /// and why: a repeated id (the first row with it is used), an id that is a date, no id.
     pub unusable: Vec<(usize, String, String)>,
     /// What the reader noticed and the user should know (ignored files, unnamed columns,
     /// formulas without values).
@@ -27,7 +27,7 @@ pub struct Table {
 
 impl Table {
     /// A table from its header and rows (row numbers as the spreadsheet shows them): drops
-    /// rows without an id, keeps the first row of each id, and warns about columns without a
+    /// blank rows, lists rows with values but no id as unusable, keeps the first row of each id, and warns about columns without a
     /// name that hold values.
     fn assemble(
         path: &Path,
@@ -81,6 +81,17 @@ impl Table {
         for (n, values) in rows {
             let (id, map) = make_row(headers, values, id_col);
             if id.is_empty() {
+                // A blank row is no record; a row with values and no id is one, not used.
+                if !map.is_empty() {
+                    t.unusable.push((
+                        n,
+                        String::new(),
+                        format!(
+                            "the row has values but no `{}`: give it an id",
+                            headers[id_col]
+                        ),
+                    ));
+                }
                 continue;
             }
             match first.get(&id) {
@@ -337,6 +348,19 @@ mod tests {
         assert_eq!(t.rows[0].1.get("mtype").map(String::as_str), Some("総二階"));
         assert!(!t.rows[0].1.contains_key("district"));
         assert_eq!(t.rows[1].1.get("district").map(String::as_str), Some("北"));
+    }
+
+    #[test]
+    fn rows_without_an_id_are_listed_and_blank_rows_are_not() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("landmarks.csv");
+        std::fs::write(&p, "id,model\na,a.obj\n,b.obj\n,\n c ,c.obj\n").unwrap();
+        let t = read_csv(&p, "id").unwrap();
+        assert_eq!(t.rows.len(), 2);
+        assert_eq!(t.unusable.len(), 1, "{:?}", t.unusable);
+        let (row, id, why) = &t.unusable[0];
+        assert_eq!((*row, id.as_str()), (3, ""));
+        assert!(why.contains("no `id`"), "{why}");
     }
 
     #[test]

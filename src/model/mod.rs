@@ -288,6 +288,34 @@ pub struct Dataset {
 }
 
 impl Dataset {
+    /// The box of the city read so far (lots, footprints, streets), or `None` before any:
+    /// what a point feature of another layer (a landmark, a link) must lie near.
+    pub fn city_box(&self) -> Option<geo_types::Rect<f64>> {
+        use geo::BoundingRect;
+        let boxes = self
+            .lots
+            .iter()
+            .filter_map(|l| l.outline.bounding_rect())
+            .chain(
+                self.footprints
+                    .iter()
+                    .filter_map(|f| f.outline.bounding_rect()),
+            )
+            .chain(self.streets.iter().filter_map(|s| s.line.bounding_rect()));
+        boxes.reduce(|a, b| {
+            geo_types::Rect::new(
+                Coord {
+                    x: a.min().x.min(b.min().x),
+                    y: a.min().y.min(b.min().y),
+                },
+                Coord {
+                    x: a.max().x.max(b.max().x),
+                    y: a.max().y.max(b.max().y),
+                },
+            )
+        })
+    }
+
     /// Shares the features' attribute names again, one allocation per name (as reading
     /// made them) after the analysis cache read them back each on its own.
     pub fn share_field_names(&mut self) {
