@@ -17,6 +17,15 @@ macro_rules! say {
     }};
 }
 
+/// `eprintln!` that never panics: with stderr closed (`2>&1 | head -c 10`) a message that
+/// cannot be shown is dropped, and the exit code still tells what happened.
+macro_rules! tell {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod cli;
 
 /// mimalloc instead of the system allocator: a build makes and drops millions of small
@@ -90,11 +99,11 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if closed_pipe(&e) => ExitCode::SUCCESS,
         Err(e) if e.downcast_ref::<Problems>().is_some() => {
-            eprintln!("{e}");
+            tell!("{e}");
             ExitCode::from(1)
         }
         Err(e) => {
-            eprintln!("error: {e:#}");
+            tell!("error: {e:#}");
             ExitCode::from(2)
         }
     }

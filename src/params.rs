@@ -581,9 +581,10 @@ impl Params {
             path: path.to_string(),
             message: e.to_string(),
         })?;
+        // Lines of the merged text would mislead: the message alone.
         let params: Params = toml::from_str(&merged_text).map_err(|e| ParamsError::Parse {
             path: path.to_string(),
-            message: e.to_string(),
+            message: crate::model::source::message(&e),
         })?;
         params.validate(path)?;
         Ok(params)
@@ -791,7 +792,7 @@ fn resolved_table(
     let parse = |t: &str, p: &str| -> Result<toml::Table, ParamsError> {
         t.parse::<toml::Table>().map_err(|e| ParamsError::Parse {
             path: p.to_string(),
-            message: e.to_string(),
+            message: crate::model::source::toml_at(t, &e),
         })
     };
     check_user_keys(text, path)?;
@@ -866,7 +867,7 @@ fn check_user_keys(text: &str, path: &str) -> Result<(), ParamsError> {
         .map(|_| ())
         .map_err(|e| ParamsError::Parse {
             path: path.to_string(),
-            message: e.to_string(),
+            message: crate::model::source::toml_at(text, &e),
         })
 }
 

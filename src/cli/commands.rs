@@ -70,7 +70,7 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
                 t.billboards.as_secs_f64()
             ),
         };
-        eprintln!(
+        tell!(
             "timings: {read_and_analyse}, generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, total {:.3} s",
             t.generate_and_write.as_secs_f64(),
             t.generate_cpu.as_secs_f64(),
@@ -85,7 +85,7 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
             .map(|(name, d)| format!("{name} {:.3} s", d.as_secs_f64()))
             .collect();
         if !steps.is_empty() {
-            eprintln!("timings of the steps after fences: {}", steps.join(", "));
+            tell!("timings of the steps after fences: {}", steps.join(", "));
         }
     }
     Ok(())

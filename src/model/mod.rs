@@ -9,6 +9,7 @@ pub mod attrs;
 pub mod crowd;
 pub mod dem;
 pub mod landmark;
+pub mod source;
 pub mod tile;
 pub mod warning;
 

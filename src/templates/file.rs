@@ -238,13 +238,7 @@ pub struct FaceSource {
     pub base: Option<Text>,
 }
 
-/// 1-based line and column of a byte offset.
-pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, col)
-}
+pub use crate::model::source::line_col;
 
 fn as_text(x: NumOrText) -> String {
     match x {
@@ -295,14 +289,8 @@ impl Ctx<'_> {
 
 /// Parses one template file. The error is `file:line:column: message`.
 pub fn parse(file: &str, text: &str) -> Result<Source, String> {
-    let raw: RawTemplate = toml::from_str(text).map_err(|e| {
-        let at = e.span().map(|s| line_col(text, s.start));
-        let msg = e.message().trim_end().to_string();
-        match at {
-            Some((l, c)) => format!("{file}:{l}:{c}: {msg}"),
-            None => format!("{file}: {msg}"),
-        }
-    })?;
+    let raw: RawTemplate =
+        toml::from_str(text).map_err(|e| crate::model::source::toml_error(file, text, &e))?;
     let cx = Ctx { file, text };
     let nums = |m: BTreeMap<String, Spanned<f64>>| -> Vec<(String, Src<f64>)> {
         m.into_iter().map(|(k, v)| (k, cx.src(v))).collect()

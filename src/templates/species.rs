@@ -346,13 +346,8 @@ pub fn parse(file: &str, text: &str) -> Result<Species, String> {
         let (l, c) = line_col(text, span.start);
         format!("{file}:{l}:{c}")
     };
-    let raw: RawSpecies = toml::from_str(text).map_err(|e| {
-        let msg = e.message().trim_end().to_string();
-        match e.span() {
-            Some(s) => format!("{}: {msg}", at(s)),
-            None => format!("{file}: {msg}"),
-        }
-    })?;
+    let raw: RawSpecies =
+        toml::from_str(text).map_err(|e| crate::model::source::toml_error(file, text, &e))?;
     let material = |s: &Spanned<String>, what: &str| -> Result<u16, String> {
         materials::find(s.get_ref()).ok_or_else(|| {
             format!(

@@ -67,6 +67,7 @@ impl Expr {
 /// Parses `text` (one argument of a module) with `names` as the parameters it may use.
 /// An error gives the character offset in `text` and what is wrong.
 pub fn parse(text: &[char], names: &[String]) -> Result<Expr, (usize, String)> {
+    check_size(text)?;
     let mut p = Parser {
         s: text,
         i: 0,
@@ -78,6 +79,39 @@ pub fn parse(text: &[char], names: &[String]) -> Result<Expr, (usize, String)> {
         return Err((p.i, format!("unexpected `{}` in an expression", p.s[p.i])));
     }
     Ok(e)
+}
+
+/// Operators an argument may hold: the parser and [`Expr::eval`] recurse once per level,
+/// and a run of 20,000 `(` or `-` overflows the stack. The presets' most is 4.
+pub const MAX_OPERATORS: usize = 128;
+/// Brackets an argument may nest.
+pub const MAX_DEPTH: usize = 32;
+
+/// Refuses an argument with too many operators or brackets nested too deep, before
+/// parsing: the error gives where the limit is passed.
+fn check_size(text: &[char]) -> Result<(), (usize, String)> {
+    let (mut ops, mut depth) = (0usize, 0usize);
+    for (i, c) in text.iter().enumerate() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth = depth.saturating_sub(1),
+            '+' | '-' | '*' | '/' | '^' => ops += 1,
+            _ => {}
+        }
+        if depth > MAX_DEPTH {
+            return Err((
+                i,
+                format!("brackets nested more than {MAX_DEPTH} deep: simplify the expression"),
+            ));
+        }
+        if ops > MAX_OPERATORS {
+            return Err((
+                i,
+                format!("more than {MAX_OPERATORS} operators: simplify the expression"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 struct Parser<'a> {
@@ -235,5 +269,20 @@ mod tests {
         let err = parse(&chars, &["l".to_string()]).unwrap_err();
         assert_eq!(err.0, 2);
         assert!(err.1.contains("unknown parameter `k`"), "{}", err.1);
+    }
+
+    #[test]
+    fn deep_nesting_and_long_chains_are_refused_not_overflowed() {
+        let refuse = |s: String| {
+            let chars: Vec<char> = s.chars().collect();
+            parse(&chars, &[]).unwrap_err()
+        };
+        let (at, m) = refuse(format!("{}1{}", "(".repeat(20_000), ")".repeat(20_000)));
+        assert!(at == MAX_DEPTH && m.contains("nested"), "{at} {m}");
+        let (_, m) = refuse(format!("{}1", "-".repeat(20_000)));
+        assert!(m.contains("operators"), "{m}");
+        let (_, m) = refuse(vec!["1"; 20_000].join("^"));
+        assert!(m.contains("operators"), "{m}");
+        assert_eq!(eval(&vec!["1"; 100].join("+"), &[], &[]), 100.0);
     }
 }

@@ -96,7 +96,7 @@ pub fn parse_rule(text: &str, index: usize) -> Result<Rule, LsError> {
     let chars: Vec<char> = text.chars().collect();
     let err = |column: usize, message: String| LsError::Syntax {
         place,
-        text: text.to_string(),
+        text: shown(text),
         column: column + 1,
         message,
     };
@@ -171,6 +171,14 @@ fn symbol(c: char) -> Result<u8, String> {
     }
 }
 
+/// A rule's text as an error quotes it: its first 60 characters (a rule can be 100 KB).
+fn shown(text: &str) -> String {
+    match text.char_indices().nth(60) {
+        Some((i, _)) => format!("{}...", &text[..i]),
+        None => text.to_string(),
+    }
+}
+
 /// Modules with argument expressions; `offset` is where `s` starts in the whole text.
 fn parse_modules(
     s: &[char],
@@ -181,7 +189,7 @@ fn parse_modules(
 ) -> Result<Vec<Template>, LsError> {
     let err = |column: usize, message: String| LsError::Syntax {
         place,
-        text: text.to_string(),
+        text: shown(text),
         column: offset + column + 1,
         message,
     };
@@ -409,5 +417,13 @@ mod tests {
         rules.rewrite(&w, &mut out, &mut rng, 100_000, 1).unwrap();
         let x = out.modules.iter().filter(|m| m.sym == b'X').count() as f64 / 8000.0;
         assert!((x - 0.75).abs() < 0.02, "{x}");
+    }
+
+    #[test]
+    fn a_rule_nested_20000_deep_is_an_error_quoting_a_short_excerpt() {
+        let rule = format!("A=F({}1{})", "(".repeat(20_000), ")".repeat(20_000));
+        let e = parse_rule(&rule, 0).unwrap_err().to_string();
+        assert!(e.contains("nested more than"), "{}", &e[..e.len().min(300)]);
+        assert!(e.len() < 300, "{} bytes", e.len());
     }
 }

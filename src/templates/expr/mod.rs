@@ -147,24 +147,74 @@ impl Lot for NoLot {
 /// assert_eq!(e.eval(&[7.0, 12.0], &NoLot), 4.5);
 /// ```
 pub fn compile(text: &str, slot: &dyn Fn(&str) -> Option<usize>) -> Result<Expr, String> {
+    let shown = crate::model::source::excerpt(text);
+    check_size(text).map_err(|e| format!("`{shown}`: {e}"))?;
     let tree = evalexpr::build_operator_tree::<DefaultNumericTypes>(text)
-        .map_err(|e| format!("cannot parse `{text}`: {e}"))?;
-    let tree = lower(&tree, slot).map_err(|e| format!("in `{text}`: {e}"))?;
+        .map_err(|e| format!("cannot parse `{shown}`: {e}"))?;
+    let tree = lower(&tree, slot, 0).map_err(|e| format!("in `{shown}`: {e}"))?;
     Ok(Expr::of(&tree))
 }
 
-fn lower(node: &Node, slot: &dyn Fn(&str) -> Option<usize>) -> Result<Tree, String> {
+/// Characters an expression may have: a template's longest is a few hundred.
+pub const MAX_CHARS: usize = 4000;
+/// Brackets an expression may nest, and operators deep its tree may be: evalexpr and
+/// [`lower`] recurse once per level, and 20,000 levels overflow the stack.
+pub const MAX_DEPTH: usize = 64;
+
+/// Operator characters an expression may have (the shipped templates' most is 17).
+pub const MAX_OPERATORS: usize = 256;
+
+/// Refuses an expression too long or nested too deep before evalexpr reads it.
+fn check_size(text: &str) -> Result<(), String> {
+    if text.len() > MAX_CHARS {
+        return Err(format!(
+            "{} characters, more than {MAX_CHARS}: split it into named values",
+            text.len()
+        ));
+    }
+    // evalexpr descends once per operator it inserts under another (a run of `-`, a chain
+    // of `^`): the operators are counted, as the brackets are.
+    let operators = text.bytes().filter(|b| b"+-*/%^!<>=&|".contains(b)).count();
+    if operators > MAX_OPERATORS {
+        return Err(format!(
+            "{operators} operator characters, more than {MAX_OPERATORS}: split it into named \
+             values"
+        ));
+    }
+    let mut depth = 0usize;
+    for b in text.bytes() {
+        match b {
+            b'(' | b'[' | b'{' => depth += 1,
+            b')' | b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        if depth > MAX_DEPTH {
+            return Err(format!(
+                "brackets nested more than {MAX_DEPTH} deep: split it into named values"
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn lower(node: &Node, slot: &dyn Fn(&str) -> Option<usize>, depth: usize) -> Result<Tree, String> {
+    if depth > 4 * MAX_DEPTH {
+        return Err(format!(
+            "operators nested more than {} deep: split it into named values",
+            4 * MAX_DEPTH
+        ));
+    }
     let kids = node.children();
     let child = |i: usize| -> Result<Box<Tree>, String> {
         kids.get(i)
             .ok_or_else(|| "an operator lacks an operand".to_string())
-            .and_then(|k| lower(k, slot))
+            .and_then(|k| lower(k, slot, depth + 1))
             .map(Box::new)
     };
     let bin = |op: Bin| -> Result<Tree, String> { Ok(Tree::Bin(op, child(0)?, child(1)?)) };
     Ok(match node.operator() {
         Operator::RootNode => match kids {
-            [one] => lower(one, slot)?,
+            [one] => lower(one, slot, depth + 1)?,
             [] => return Err("empty expression".into()),
             _ => return Err("a list of values is not a number".into()),
         },
@@ -206,7 +256,7 @@ fn lower(node: &Node, slot: &dyn Fn(&str) -> Option<usize>) -> Result<Tree, Stri
                             FUNCTIONS.iter().map(|f| f.0).collect::<Vec<_>>().join(", ")
                         )
                     })?;
-            let args = arguments(kids, slot)?;
+            let args = arguments(kids, slot, depth)?;
             let ok = match arity {
                 Some(n) => args.len() == n,
                 None => !args.is_empty(),
@@ -225,7 +275,11 @@ fn lower(node: &Node, slot: &dyn Fn(&str) -> Option<usize>) -> Result<Tree, Stri
 }
 
 /// A call's arguments: evalexpr gives one child, a tuple when there are several.
-fn arguments(kids: &[Node], slot: &dyn Fn(&str) -> Option<usize>) -> Result<Vec<Tree>, String> {
+fn arguments(
+    kids: &[Node],
+    slot: &dyn Fn(&str) -> Option<usize>,
+    depth: usize,
+) -> Result<Vec<Tree>, String> {
     let mut node = match kids {
         [one] => one,
         [] => return Ok(Vec::new()),
@@ -235,9 +289,13 @@ fn arguments(kids: &[Node], slot: &dyn Fn(&str) -> Option<usize>) -> Result<Vec<
         node = &node.children()[0];
     }
     match node.operator() {
-        Operator::Tuple => node.children().iter().map(|k| lower(k, slot)).collect(),
+        Operator::Tuple => node
+            .children()
+            .iter()
+            .map(|k| lower(k, slot, depth + 1))
+            .collect(),
         Operator::RootNode if node.children().is_empty() => Ok(Vec::new()),
-        _ => Ok(vec![lower(node, slot)?]),
+        _ => Ok(vec![lower(node, slot, depth + 1)?]),
     }
 }
 impl Expr {
@@ -338,5 +396,32 @@ mod tests {
         let mut s = Vec::new();
         e.slots(&mut s);
         assert_eq!(s, vec![0, 2]);
+    }
+
+    #[test]
+    fn deep_or_long_expressions_are_refused_before_parsing() {
+        let none = |_: &str| None;
+        let deep = format!("{}1{}", "(".repeat(1000), ")".repeat(1000));
+        let e = compile(&deep, &none).unwrap_err();
+        assert!(
+            e.contains("nested more than 64"),
+            "{}",
+            &e[..e.len().min(200)]
+        );
+        assert!(e.len() < 300, "{e}");
+        let chain = vec!["1"; 1500].join("+");
+        let e = compile(&chain, &none).unwrap_err();
+        assert!(e.contains("more than 256"), "{e}");
+        // Within the counts, the tree's depth is still bounded as it is lowered.
+        let chain = vec!["1"; 250].join("+");
+        assert_eq!(compile(&chain, &none).unwrap().eval(&[], &NoLot), 250.0);
+        let negs = format!("{}1", "-".repeat(3000));
+        assert!(compile(&negs, &none).is_err());
+        let long = "1".repeat(MAX_CHARS + 1);
+        assert!(compile(&long, &none).unwrap_err().contains("characters"));
+        let huge = format!("{}1{}", "(".repeat(20_000), ")".repeat(20_000));
+        assert!(compile(&huge, &none).unwrap_err().contains("characters"));
+        // Ordinary nesting is fine.
+        assert_eq!(eval("((((1 + 1))))*((2))"), 4.0);
     }
 }
