@@ -73,6 +73,9 @@ pub fn build_alone(
                     t.param_names().join(", ")
                 )
             })?;
+        if let Some(why) = crate::templates::template::value_problem(*v) {
+            return Err(format!("--set {k}={v}: {why}"));
+        }
         overrides.push((slot, *v));
     }
     let site = Site::rectangle(width, depth);

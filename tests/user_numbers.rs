@@ -238,3 +238,157 @@ fn the_numbers_that_once_panicked_aborted_or_ran_for_minutes_are_refused() {
     let (code, stderr) = run_limited(&tiny);
     assert_eq!(code, Some(0), "{tiny:?}: {stderr}");
 }
+
+/// The numbers of templates, species and `[crowd]`, and nesting in their expressions
+/// (issue 39): each refused with exit 2 naming the key or the place, never a panic, an
+/// abort or a stack overflow.
+#[test]
+fn template_species_and_crowd_numbers_and_nesting_are_refused_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = common::fixture("kyoto-small").display().to_string();
+    let out = dir.path().join("out").display().to_string();
+    let params = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p.display().to_string()
+    };
+    let build = |p: String| -> Vec<String> {
+        [
+            "build",
+            &input,
+            "--out",
+            &out,
+            "--quiet",
+            "--no-plan",
+            "--params",
+            &p,
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    };
+    // A species that asks for 1e15 symbols, one with a rule nested 20,000 deep, and a
+    // template whose derived value is nested 20,000 deep.
+    // Each species in a directory of its own (a tree command reads every species of its
+    // directory), from the shipped cherry with its rules replaced.
+    let sakura = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("templates/trees/sakura.toml"),
+    )
+    .unwrap();
+    let species = |name: &str, rules: &str, extra: &str| {
+        let d = dir.path().join(name);
+        std::fs::create_dir_all(d.join("trees")).unwrap();
+        let start = sakura.find("rules = [").unwrap();
+        let end = start + sakura[start..].find("\n]").unwrap() + 2;
+        let text = format!(
+            "{}rules = [{rules}]\ngenerations = 60\n{extra}{}",
+            &sakura[..start],
+            &sakura[end..].replace("generations = 6\n", "")
+        )
+        .replace("name = \"sakura\"", &format!("name = \"{name}\""));
+        std::fs::write(d.join(format!("trees/{name}.toml")), text).unwrap();
+        d.display().to_string()
+    };
+    let huge = species("huge", "\"A=AA\"", "max_symbols = 1000000000000000\n");
+    let deep = format!("\"A=F({}1{})\"", "(".repeat(20_000), ")".repeat(20_000));
+    let deep = species("deep", &deep, "");
+    let nested = dir.path().join("nested");
+    std::fs::create_dir_all(&nested).unwrap();
+    std::fs::write(
+        nested.join("nested.toml"),
+        format!(
+            "name = \"nested\"\nextends = \"hiraya\"\n[derived]\nd = \"{}1{}\"\n",
+            "(".repeat(20_000),
+            ")".repeat(20_000)
+        ),
+    )
+    .unwrap();
+    let tree = |species: &str, t: &str| -> Vec<String> {
+        ["tree", "--species", species, "--templates", t]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let cases: Vec<(Vec<String>, &[&str])> = vec![
+        (
+            build(params(
+                "t1.toml",
+                "[template.hiraya]\neave_height = 1e300\n",
+            )),
+            &["eave_height", "at most 1000"],
+        ),
+        (
+            build(params(
+                "t2.toml",
+                "[template.hiraya]\nhisashi_depth = 1e6\n",
+            )),
+            &["hisashi_depth", "at most 1000"],
+        ),
+        (
+            build(params(
+                "t3.toml",
+                "[people]\nmotion = \"boids\"\n[crowd]\nweights = [1e308, 1e308, 1e308]\n",
+            )),
+            &["[crowd]", "at most 1000"],
+        ),
+        (tree("huge", &huge), &["max_symbols", "give 1 to 50000000"]),
+        (tree("deep", &deep), &["deep.toml", "nested more than"]),
+        (
+            [
+                "template",
+                "nested",
+                "--templates",
+                &nested.display().to_string(),
+                "-o",
+                &dir.path().join("n.obj").display().to_string(),
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+            &["nested.toml:4:5", "more than 4000"],
+        ),
+        (
+            [
+                "template",
+                "hiraya",
+                "--set",
+                "eave_height=1e7",
+                "-o",
+                &dir.path().join("h.obj").display().to_string(),
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+            &["eave_height", "at most 1000"],
+        ),
+        (
+            [
+                "lsystem",
+                "--axiom",
+                "A",
+                "--rule",
+                "A=AA",
+                "--generations",
+                "60",
+                "--max-symbols",
+                "1000000000000000",
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+            &["max_symbols", "give 1 to 50000000"],
+        ),
+    ];
+    for (args, says) in cases {
+        let (code, stderr) = run_limited(&args);
+        assert_eq!(code, Some(2), "{:?}: {stderr}", &args[..2]);
+        for s in says {
+            assert!(
+                stderr.contains(s),
+                "{:?}: `{s}` not in {stderr}",
+                &args[..2]
+            );
+        }
+        assert!(stderr.len() < 2000, "{} bytes: {stderr}", stderr.len());
+    }
+}

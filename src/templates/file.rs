@@ -292,8 +292,17 @@ pub fn parse(file: &str, text: &str) -> Result<Source, String> {
     let raw: RawTemplate =
         toml::from_str(text).map_err(|e| crate::model::source::toml_error(file, text, &e))?;
     let cx = Ctx { file, text };
-    let nums = |m: BTreeMap<String, Spanned<f64>>| -> Vec<(String, Src<f64>)> {
-        m.into_iter().map(|(k, v)| (k, cx.src(v))).collect()
+    // A template's own numbers are bounded as a parameter file's are.
+    let nums = |m: BTreeMap<String, Spanned<f64>>| -> Result<Vec<(String, Src<f64>)>, String> {
+        m.into_iter()
+            .map(|(k, v)| {
+                let s = cx.src(v);
+                match super::template::value_problem(s.value) {
+                    Some(why) => Err(format!("{}: `{k}` = {} {why}", s.loc, s.value)),
+                    None => Ok((k, s)),
+                }
+            })
+            .collect()
     };
     let parts = raw
         .part
@@ -383,8 +392,8 @@ pub fn parse(file: &str, text: &str) -> Result<Source, String> {
         extends: raw.extends.map(|e| cx.src(e)),
         is_abstract: raw.is_abstract,
         height: cx.opt(raw.height),
-        params: nums(raw.params),
-        attributes: nums(raw.attributes),
+        params: nums(raw.params)?,
+        attributes: nums(raw.attributes)?,
         derived: raw
             .derived
             .into_iter()

@@ -340,9 +340,9 @@ impl Catalog {
                             t.param_names().join(", ")
                         ))
                         })?;
-                    if !v.is_finite() {
+                    if let Some(why) = template::value_problem(*v) {
                         return Err(TemplateError::Invalid(format!(
-                            "parameter file: [{where_}template.{name}] `{k}` is not a number"
+                            "parameter file: [{where_}template.{name}] `{k}` = {v} {why}"
                         )));
                     }
                     Ok((slot, *v))

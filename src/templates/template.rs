@@ -736,10 +736,32 @@ fn roof(p: &PartSource, scalar: &Names, all: &Names, loc: &Loc) -> Result<Option
     }))
 }
 
+/// The largest size of a number a user gives a template (a parameter's default or the
+/// parameter file's value, `--set`, a feature's attribute): metres, degrees and counts of a
+/// building are far below it; 1e7 made a house 10,000 km tall.
+pub const MAX_VALUE: f64 = 1000.0;
+/// The largest size of a derived value (areas and products of metres stay well below it).
+pub const MAX_DERIVED: f64 = 1e6;
+
+/// Why `v` cannot be a value a user gives a template, or `None`.
+pub fn value_problem(v: f64) -> Option<String> {
+    if !v.is_finite() {
+        Some("is not a number".into())
+    } else if v.abs() > MAX_VALUE {
+        Some(format!(
+            "is larger than a building's numbers may be (at most {MAX_VALUE} in size): give \
+             it in metres, degrees or a count"
+        ))
+    } else {
+        None
+    }
+}
+
 impl Template {
     /// Every scalar slot for one feature: the inputs, the params (defaults, then `overrides`),
-    /// the attributes (defaults, then the feature's own), then the derived values.
-    /// A derived value that is not a finite number is an error naming it.
+    /// the attributes (defaults, then the feature's own, each within [`MAX_VALUE`]), then
+    /// the derived values. A derived value that is not a finite number, or is larger than
+    /// [`MAX_DERIVED`], is an error naming it.
     pub fn evaluate(
         &self,
         inputs: &[f64; N_INPUTS],
@@ -759,14 +781,21 @@ impl Template {
                 .clone()
                 .find(|k| self.names[*k].eq_ignore_ascii_case(name))
             {
+                if let Some(why) = value_problem(*v) {
+                    return Err(format!(
+                        "template {}: the feature's attribute `{name}` = {v} {why}",
+                        self.name
+                    ));
+                }
                 slots[k] = *v;
             }
         }
         for (k, e, loc) in &self.derived {
             let x = e.eval(&slots, lot);
-            if !x.is_finite() {
+            if !x.is_finite() || x.abs() > MAX_DERIVED {
                 return Err(format!(
-                    "template {}: `{}` ({loc}) is {x} for this feature",
+                    "template {}: `{}` ({loc}) is {x} for this feature (at most {MAX_DERIVED:e} \
+                     in size)",
                     self.name, self.names[*k]
                 ));
             }

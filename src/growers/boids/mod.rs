@@ -102,9 +102,37 @@ impl BoidParams {
         {
             return Some("the rule weights and the wander must be 0 or more".into());
         }
+        // Past these a step's arithmetic leaves the floats (weights of 1e308 made the
+        // headings NaN and the grid's index panic); no crowd of people comes near them.
+        if [p.separation, p.alignment, p.cohesion, p.wander]
+            .iter()
+            .any(|w| *w > MAX_WEIGHT)
+        {
+            return Some(format!(
+                "the rule weights and the wander must be at most {MAX_WEIGHT} (per second), \
+                 got [{}, {}, {}] and {}",
+                p.separation, p.alignment, p.cohesion, p.wander
+            ));
+        }
+        if p.r2 > MAX_ZONE || p.max_speed > MAX_SPEED || p.dt > MAX_DT {
+            return Some(format!(
+                "r2 may be at most {MAX_ZONE}, the fastest speed {MAX_SPEED} and the step \
+                 {MAX_DT}: got r2 = {}, speed {}, dt {}",
+                p.r2, p.max_speed, p.dt
+            ));
+        }
         None
     }
 }
+
+/// The largest rule weight or wander (per second).
+pub const MAX_WEIGHT: f64 = 1000.0;
+/// The largest cohesion zone `r2`.
+pub const MAX_ZONE: f64 = 10_000.0;
+/// The largest speed.
+pub const MAX_SPEED: f64 = 1000.0;
+/// The longest step.
+pub const MAX_DT: f64 = 3600.0;
 
 /// One agent: where it is, its heading (a unit vector) and its speed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -385,6 +413,24 @@ mod tests {
         p = BoidParams::seed();
         p.dt = f64::NAN;
         assert!(p.problem().is_some());
+        p = BoidParams::seed();
+        (p.separation, p.alignment, p.cohesion) = (1e308, 1e308, 1e308);
+        assert!(p.problem().unwrap().contains("at most 1000"));
+        p = BoidParams::seed();
+        p.dt = 1e9;
+        assert!(p.problem().unwrap().contains("dt 1000000000"));
+        // At the bounds a flock still steps to finite positions.
+        p = BoidParams::seed();
+        (p.separation, p.alignment, p.cohesion, p.wander) = (1000.0, 1000.0, 1000.0, 1000.0);
+        assert!(p.problem().is_none());
+        let mut f = Flock::random(40, 50.0, 30.0, p, true, 3);
+        for _ in 0..50 {
+            f.step();
+        }
+        assert!(f
+            .boids
+            .iter()
+            .all(|b| b.pos.iter().chain(&b.heading).all(|v| v.is_finite())));
     }
 }
 

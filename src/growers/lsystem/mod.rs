@@ -25,6 +25,9 @@ pub const MAX_GENERATIONS: usize = 10_000;
 pub const WORK_FACTOR: usize = 20;
 /// The default of `max_symbols`.
 pub const DEFAULT_MAX_SYMBOLS: usize = 2_000_000;
+/// The largest `max_symbols` one may ask for: a word of this many modules and their
+/// parameters is about a gigabyte, and rewriting may write [`WORK_FACTOR`] times it.
+pub const MAX_MAX_SYMBOLS: usize = 50_000_000;
 
 /// Where in an L-system a problem is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -76,6 +79,9 @@ pub enum LsError {
     /// More generations than [`MAX_GENERATIONS`].
     #[error("{0} generations asked for; at most {MAX_GENERATIONS}")]
     TooManyGenerations(usize),
+    /// A `max_symbols` over [`MAX_MAX_SYMBOLS`] (or 0).
+    #[error("max_symbols = {0}: give 1 to {MAX_MAX_SYMBOLS}")]
+    MaxSymbols(usize),
     /// The rules kept rewriting without end.
     #[error(
         "the rules never end: {written} symbols written over {generation} generations \
@@ -112,6 +118,9 @@ impl LSystem {
     ) -> Result<LSystem, LsError> {
         if generations > MAX_GENERATIONS {
             return Err(LsError::TooManyGenerations(generations));
+        }
+        if max_symbols == 0 || max_symbols > MAX_MAX_SYMBOLS {
+            return Err(LsError::MaxSymbols(max_symbols));
         }
         let axiom = grammar::parse_axiom(axiom)?;
         let rules = rules
@@ -186,6 +195,9 @@ mod tests {
         assert!(matches!(e, LsError::NeverEnds { .. }), "{e}");
         let e = LSystem::parse("A", &[], 10_001, 10).unwrap_err();
         assert!(matches!(e, LsError::TooManyGenerations(10_001)));
+        let e = LSystem::parse("A", &["A=AA".into()], 60, 1_000_000_000_000_000).unwrap_err();
+        assert!(e.to_string().contains("give 1 to 50000000"), "{e}");
+        assert!(LSystem::parse("A", &[], 1, 0).is_err());
     }
 
     #[test]
