@@ -687,25 +687,65 @@ pub fn check(
     Ok(report::assemble_report(&manifest))
 }
 
-/// Draws the plan of an earlier build (its manifest names the input and the parameters);
-/// with `tile`, only that tile at full resolution.
-pub fn draw_plan_of(out: &Path, tile: Option<&str>) -> Result<Vec<u8>, BuildError> {
-    draw_plan_from(
-        &shards::previous_manifest(out, "`edo-city plan` draws a finished build")?,
-        tile,
-    )
+/// Draws the plan of an earlier build from its parameters and the input read again: `input`
+/// (and `templates`) as given, else those an older manifest recorded by their paths (a
+/// published manifest names them alone, so they must be given); with `tile`, only that tile
+/// at full resolution.
+pub fn draw_plan_of(
+    out: &Path,
+    tile: Option<&str>,
+    input: Option<&Path>,
+    templates: Option<&Path>,
+) -> Result<Vec<u8>, BuildError> {
+    let manifest = shards::previous_manifest(out, "`edo-city plan` draws a finished build")?;
+    let recorded = PathBuf::from(&manifest.input.input);
+    let input = match input {
+        Some(i) => i.to_path_buf(),
+        None if recorded.is_absolute() && recorded.is_dir() => recorded,
+        None => {
+            return Err(BuildError::Config(format!(
+                "give the input directory with --input (the build read `{}`; its manifest, \
+                 published with the city, does not say where it is)",
+                manifest.input.input
+            )))
+        }
+    };
+    let id = report::input_id(&absolute(&input));
+    if !manifest.input.input_id.is_empty() && manifest.input.input_id != id {
+        return Err(BuildError::Config(format!(
+            "{} is not the input of the build in {} (it read `{}`): give that directory",
+            input.display(),
+            out.display(),
+            manifest.input.input
+        )));
+    }
+    let templates = match (templates, &manifest.input.templates) {
+        (Some(t), _) => Some(t.to_path_buf()),
+        (None, None) => None,
+        (None, Some(t)) if Path::new(t).is_absolute() && Path::new(t).is_dir() => {
+            Some(PathBuf::from(t))
+        }
+        (None, Some(t)) => {
+            return Err(BuildError::Config(format!(
+                "give the template directory the build used with --templates (it used `{t}`; \
+                 its manifest does not say where it is)"
+            )))
+        }
+    };
+    draw_plan_from(&manifest, tile, &input, templates.as_deref())
 }
 
-/// Draws the plan of the build a manifest describes (see [`draw_plan_of`]).
+/// Draws the plan of the build a manifest describes, reading `input` again (see
+/// [`draw_plan_of`]).
 pub fn draw_plan_from(
     manifest: &report::Manifest,
     tile: Option<&str>,
+    input: &Path,
+    templates: Option<&Path>,
 ) -> Result<Vec<u8>, BuildError> {
     let params = &manifest.params;
-    let templates = manifest.input.templates.as_ref().map(PathBuf::from);
-    let catalog = load_catalog(params, templates.as_deref())?;
-    let input = PathBuf::from(&manifest.input.input);
-    let (data, plan, _, _) = read_and_analyse(&input, params, &catalog, &NoProgress)?;
+    let catalog = load_catalog(params, templates)?;
+    let (data, plan, _, _) = read_and_analyse(input, params, &catalog, &NoProgress)?;
     let bounds = match tile {
         None => None,
         Some(id) => {
@@ -876,5 +916,44 @@ fn input_summary(
             skip.record = l.ids.get(&skip.id).copied();
         }
     }
+    s.input_id = report::input_id(Path::new(&s.input));
+    relative_to_input(&mut s, input);
     s
+}
+
+/// Names the input's files relative to the input directory in everything the summary says
+/// (layer files, skips, tables, warnings, ledgers): the manifest is published with the
+/// city, and where the user keeps their data is none of its business.
+fn relative_to_input(s: &mut report::InputSummary, input: &Path) {
+    let prefixes: Vec<String> = [input.to_path_buf(), absolute(input)]
+        .iter()
+        .map(|p| format!("{}/", p.display()))
+        .filter(|p| p != "/")
+        .collect();
+    let strip = |text: &mut String| {
+        for p in &prefixes {
+            if text.contains(p.as_str()) {
+                *text = text.replace(p.as_str(), "");
+            }
+        }
+    };
+    for l in &mut s.layers {
+        strip(&mut l.file);
+    }
+    for k in &mut s.skipped {
+        strip(&mut k.file);
+        strip(&mut k.reason);
+    }
+    for t in &mut s.tables {
+        strip(&mut t.file);
+    }
+    for w in &mut s.warnings {
+        strip(&mut w.message);
+        if let Some(f) = &mut w.file {
+            strip(f);
+        }
+    }
+    for l in &mut s.ledgers {
+        strip(&mut l.file);
+    }
 }

@@ -173,8 +173,8 @@ fn merge_checks_every_shard_file_and_writes_nothing_when_one_is_cut_short() {
         "{e}"
     );
 
-    // Restored, the merge works, from another working directory too (the manifests name
-    // the input by its absolute path).
+    // Restored, the merge works, from another working directory too (the shards' manifests
+    // name the input by its absolute path).
     std::fs::write(b.join(&tile), &bytes).unwrap();
     let elsewhere = tempfile::tempdir().unwrap();
     let o = edo_city()
@@ -186,10 +186,16 @@ fn merge_checks_every_shard_file_and_writes_nothing_when_one_is_cut_short() {
         .unwrap();
     assert!(o.status.success(), "{}", stderr_of(&o));
     assert!(a.join("plan.png").exists());
+    // The merged manifest, published with the city, names the input alone (issue 39).
     assert_eq!(
         read_json(&a.join("manifest.json"))["input"]["input"],
-        town.canonicalize().unwrap().display().to_string()
+        town.file_name().unwrap().to_str().unwrap()
     );
+    let abs = town.canonicalize().unwrap().display().to_string();
+    for f in ["manifest.json", "report.json"] {
+        let text = std::fs::read_to_string(a.join(f)).unwrap();
+        assert!(!text.contains(&abs), "{f} names {abs}");
+    }
 }
 
 #[test]

@@ -71,12 +71,35 @@ fn one_tile_at_full_resolution() {
     edo_city()
         .arg("plan")
         .arg(out.path().join("out"))
+        .arg("--input")
+        .arg(fixture("kyoto-small"))
         .arg("-o")
         .arg(&png)
         .arg("--tile")
         .arg("1108_760")
         .assert()
         .success();
+    // The published manifest does not say where the input is: without --input, or with
+    // another directory, `plan` says what to give.
+    for extra in [
+        vec![],
+        vec![
+            "--input".to_string(),
+            fixture("landmark-models").display().to_string(),
+        ],
+    ] {
+        let o = edo_city()
+            .arg("plan")
+            .arg(out.path().join("out"))
+            .args(&extra)
+            .arg("-o")
+            .arg(&png)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2));
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(e.contains("kyoto-small") && e.contains("give"), "{e}");
+    }
     let img = image::open(&png).unwrap();
     assert_eq!(
         (img.width(), img.height()),

@@ -398,6 +398,10 @@ fn the_worked_example_of_docs_templates_md_builds() {
         .args([
             "plan",
             city.to_str().unwrap(),
+            "--input",
+            fixture("kyoto-small").to_str().unwrap(),
+            "--templates",
+            mydir.to_str().unwrap(),
             "--output",
             png.to_str().unwrap(),
         ])

@@ -88,8 +88,12 @@ pub fn check_out_dir(opts: &BuildOptions) -> Result<(), BuildError> {
             .map(|k| format!("the parameter `{k}` differs"))
             .or_else(|| {
                 let old_input = old["input"]["input"].as_str().unwrap_or_default();
-                (super::absolute(Path::new(old_input)) != input)
-                    .then(|| format!("it was built from {old_input}"))
+                // A published manifest holds the input's fingerprint, a shard's its path.
+                let same = match old["input"]["input_id"].as_str() {
+                    Some(id) => id == report::input_id(&input),
+                    None => super::absolute(Path::new(old_input)) == input,
+                };
+                (!same).then(|| format!("it was built from another input ({old_input})"))
             });
         if let Some(why) = diff {
             let name = path.file_name().unwrap_or_default().to_string_lossy();
@@ -224,8 +228,23 @@ fn names(shard: Option<[usize; 2]>) -> (String, String) {
 }
 
 /// Writes the report, then the manifest (last: a manifest always describes complete tiles).
+///
+/// A shard's manifest keeps the input's absolute path (`merge` reads the input again to draw
+/// the whole city's plan, and removes it); the city's own manifest and report name the
+/// input and templates directories alone ([`report::InputSummary::published`]).
 pub fn write_manifest_and_report(out: &Path, manifest: &Manifest) -> Result<Report, BuildError> {
     let (manifest_name, report_name) = names(manifest.shard);
+    let published;
+    let manifest = match manifest.shard {
+        Some(_) => manifest,
+        None => {
+            published = Manifest {
+                input: manifest.input.published(),
+                ..manifest.clone()
+            };
+            &published
+        }
+    };
     let rep = report::assemble_report(manifest);
     write_json(&out.join(report_name), &rep)?;
     write_json(&out.join(manifest_name), manifest)?;
@@ -383,7 +402,10 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     // The whole city's plan, as a full build draws it (shards leave it to the merge); drawn
     // before the manifest, which is written last, so a failing plan leaves no merged manifest.
     if draw_plan {
-        let png = super::draw_plan_from(&merged, None)?;
+        // The shards' manifests hold the input's path (the merged one will not).
+        let input = PathBuf::from(&first.input.input);
+        let templates = first.input.templates.as_ref().map(PathBuf::from);
+        let png = super::draw_plan_from(&merged, None, &input, templates.as_deref())?;
         let path = target.join("plan.png");
         write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
     }

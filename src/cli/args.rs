@@ -67,8 +67,15 @@ pub struct CompareArgs {
 /// The flags of `edo-city plan`.
 #[derive(Args)]
 pub struct PlanArgs {
-    /// The output directory of a build (its manifest names the input and parameters).
+    /// The output directory of a build (its manifest holds the parameters).
     pub out: PathBuf,
+    /// The input directory the build read (its published manifest names it, but not where
+    /// it is); checked against the build's fingerprint of it.
+    #[arg(long)]
+    pub input: Option<PathBuf>,
+    /// The `--templates` directory the build used, if any.
+    #[arg(long)]
+    pub templates: Option<PathBuf>,
     /// Image to write.
     #[arg(short, long, default_value = "plan.png")]
     pub output: PathBuf,

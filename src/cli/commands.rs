@@ -187,8 +187,19 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
 
 /// `edo-city plan`.
 pub fn plan_command(args: PlanArgs) -> Result<()> {
-    let PlanArgs { out, output, tile } = args;
-    let png = edo_city::build::draw_plan_of(&out, tile.as_deref())?;
+    let PlanArgs {
+        out,
+        output,
+        tile,
+        input,
+        templates,
+    } = args;
+    let png = edo_city::build::draw_plan_of(
+        &out,
+        tile.as_deref(),
+        input.as_deref(),
+        templates.as_deref(),
+    )?;
     edo_city::output::atomic::write_atomic(&output, &png)
         .with_context(|| format!("cannot write {}", output.display()))?;
     say!("wrote {}", output.display());

@@ -314,8 +314,13 @@ pub struct TileReport {
 /// The part of the report that comes from reading and analysis, the same for every tile.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct InputSummary {
-    /// The input directory, absolute.
+    /// The input directory: absolute while a build runs and in a shard's manifest (which
+    /// `merge` reads and removes); in the published manifest and report its name only.
     pub input: String,
+    /// A fingerprint of the input directory's absolute path, so that a later build into the
+    /// same output can tell whether it reads the same input without the path published.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub input_id: String,
     /// The `--templates` directory of the build, as typed, so that `edo-city plan` can load
     /// the same types again.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -354,6 +359,29 @@ pub struct InputSummary {
     /// what they hold).
     #[serde(default, skip_serializing_if = "landmarks_empty")]
     pub landmarks: crate::model::LandmarkReport,
+}
+
+/// The fingerprint of an input directory (see [`InputSummary::input_id`]).
+pub fn input_id(absolute: &std::path::Path) -> String {
+    let hex = super::sha256_hex(absolute.as_os_str().as_encoded_bytes());
+    hex[..16].to_string()
+}
+
+impl InputSummary {
+    /// The summary as a published manifest carries it: the input directory and the
+    /// `--templates` directory by their names alone.
+    pub fn published(&self) -> InputSummary {
+        let name = |p: &str| {
+            std::path::Path::new(p)
+                .file_name()
+                .map_or_else(|| ".".to_string(), |n| n.to_string_lossy().into_owned())
+        };
+        InputSummary {
+            input: name(&self.input),
+            templates: self.templates.as_deref().map(name),
+            ..self.clone()
+        }
+    }
 }
 
 /// Whether a build had no landmarks at all (the report then leaves the key out).
