@@ -95,12 +95,39 @@ pub fn texture_library(set: &str) -> Result<Vec<Texture>, String> {
                 TEXTURES.iter().map(|t| t.0).collect::<Vec<_>>().join(", ")
             ));
         };
-        let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let bytes = read_texture(&path)?;
         image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
             .map_err(|e| format!("{}: not a readable PNG: {e}", path.display()))?;
         slot.1 = Cow::Owned(bytes);
     }
     Ok(lib)
+}
+
+/// Bytes of one texture of a texture set.
+pub const MAX_TEXTURE_BYTES: u64 = 32 << 20;
+
+/// A texture set's file, refused before it is opened when it is not a regular file (a FIFO
+/// named `x.png` blocked the build) or larger than [`MAX_TEXTURE_BYTES`].
+fn read_texture(path: &Path) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let shown = path.display();
+    let meta = std::fs::metadata(path).map_err(|e| format!("{shown}: {e}"))?;
+    if !meta.is_file() {
+        return Err(format!(
+            "{shown}: not a regular file (a directory, device or pipe): remove it from the set"
+        ));
+    }
+    if meta.len() > MAX_TEXTURE_BYTES {
+        return Err(format!(
+            "{shown}: {} bytes, more than the {MAX_TEXTURE_BYTES} a texture may have",
+            meta.len()
+        ));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_TEXTURE_BYTES).read_to_end(&mut bytes))
+        .map_err(|e| format!("{shown}: {e}"))?;
+    Ok(bytes)
 }
 
 /// The library with the cut-out materials' masks added (see
@@ -202,4 +229,31 @@ pub fn obj_bytes<'a>(meshes: impl IntoIterator<Item = &'a Mesh>) -> usize {
     obj::write_tile(&mut buf, "x", [0.0, 0.0], meshes)
         .iter()
         .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_texture_set_holding_a_pipe_or_a_huge_file_is_refused_without_reading_it() {
+        let tmp = tempfile::tempdir().unwrap();
+        let name = TEXTURES[0].0;
+        let path = tmp.path().join(name);
+        let made = std::process::Command::new("mkfifo")
+            .arg(&path)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let set = tmp.path().to_str().unwrap();
+        let e = texture_library(set).unwrap_err();
+        assert!(e.contains("not a regular file"), "{e}");
+        std::fs::remove_file(&path).unwrap();
+        std::fs::File::create(&path)
+            .unwrap()
+            .set_len(MAX_TEXTURE_BYTES + 1)
+            .unwrap();
+        let e = texture_library(set).unwrap_err();
+        assert!(e.contains("more than the"), "{e}");
+    }
 }

@@ -8,6 +8,7 @@
 //! describes the format. A user adds a type by dropping a file into a directory given with
 //! `--templates` (or `machiya.templates`) and naming it in `type_mix`.
 
+mod dir;
 pub mod expr;
 pub mod file;
 pub mod species;
@@ -176,19 +177,10 @@ fn load_species(dir: Option<&Path>) -> Result<BTreeMap<String, Species>, Templat
     let Some(dir) = dir.map(|d| d.join("trees")).filter(|d| d.is_dir()) else {
         return Ok(out);
     };
-    let io = |cause| TemplateError::Io {
-        dir: dir.display().to_string(),
-        cause,
-    };
-    let mut paths: Vec<_> = std::fs::read_dir(&dir)
-        .map_err(io)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.is_file() && p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    paths.sort();
+    let paths = dir::toml_files(&dir, "", false)?;
     let mut seen = BTreeMap::new();
     for p in paths {
-        let text = std::fs::read_to_string(&p).map_err(io)?;
+        let text = dir::read(&p)?;
         let file = p.display().to_string();
         let s = species::parse(&file, &text).map_err(TemplateError::Invalid)?;
         if let Some(other) = seen.insert(s.name.clone(), file.clone()) {
@@ -202,26 +194,6 @@ fn load_species(dir: Option<&Path>) -> Result<BTreeMap<String, Species>, Templat
     Ok(out)
 }
 
-/// Every `*.toml` under `dir`, sorted, recursively.
-fn files_under(dir: &Path, out: &mut Vec<std::path::PathBuf>) -> std::io::Result<()> {
-    let mut entries: Vec<_> = std::fs::read_dir(dir)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .collect();
-    entries.sort();
-    for p in entries {
-        // Tree species live in `trees/`, in their own format.
-        if p.is_dir() && p.file_name().is_some_and(|n| n == "trees") {
-            continue;
-        }
-        if p.is_dir() {
-            files_under(&p, out)?;
-        } else if p.extension().is_some_and(|x| x == "toml") {
-            out.push(p);
-        }
-    }
-    Ok(())
-}
-
 impl Catalog {
     /// The shipped templates, then those of `dir` (a file of the same name replaces a shipped
     /// one; any other file adds a template).
@@ -233,15 +205,11 @@ impl Catalog {
             sources.insert(s.name.value.clone(), s);
         }
         if let Some(dir) = dir {
-            let io = |cause| TemplateError::Io {
-                dir: dir.display().to_string(),
-                cause,
-            };
-            let mut paths = Vec::new();
-            files_under(dir, &mut paths).map_err(io)?;
+            // Tree species live in `trees/`, in their own format.
+            let paths = dir::toml_files(dir, "trees", true)?;
             let mut seen = BTreeMap::new();
             for p in paths {
-                let text = std::fs::read_to_string(&p).map_err(io)?;
+                let text = dir::read(&p)?;
                 let file = p.display().to_string();
                 let s = file::parse(&file, &text).map_err(TemplateError::Invalid)?;
                 if let Some(other) = seen.insert(s.name.value.clone(), file.clone()) {
