@@ -28,6 +28,7 @@ use crate::templates::{Catalog, Kind, TemplateError};
 
 pub mod cache;
 pub mod shards;
+mod writing;
 
 /// Progress of the long stages; the CLI draws bars, tests pass [`NoProgress`].
 pub trait Progress: Sync {
@@ -319,7 +320,7 @@ fn run(
     // reading the input and analysing it.
     let cache = match opts.selection {
         Selection::Shard { .. } => None,
-        _ => cache::file_for(&opts.out).map(|file| (file, cache::key(opts))),
+        _ => cache::file_for(&opts.out).and_then(|file| Some((file, cache::key(opts)?))),
     };
     let t = Instant::now();
     let cached = match (&opts.selection, &cache) {
@@ -361,7 +362,9 @@ fn run(
     })?;
     // The plan is cached while the tiles are written (it is the input's, whatever happens
     // to the writing), once the directory is known to be this build's.
-    let checked = shards::check_out_dir(opts).and_then(|()| shards::refuse_empty(opts, &plan));
+    let checked = shards::check_out_dir(opts)
+        .and_then(|()| shards::refuse_empty(opts, &plan))
+        .and_then(|()| writing::begin(opts));
     let written = checked.and_then(|()| {
         std::thread::scope(|s| {
             if let Some((file, key)) = store {
@@ -390,6 +393,9 @@ fn run(
         },
         ..o
     });
+    if written.is_ok() || !existed {
+        writing::end(opts);
+    }
     drop(lock);
     if written.is_err() && !existed {
         // Leave no directory behind that the user did not have before (only empty ones go).

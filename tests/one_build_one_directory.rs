@@ -236,6 +236,76 @@ fn tiles_with_force_never_stamps_new_parameters_on_old_tiles() {
     assert_eq!(all_files(&out), before, "the build is as it was");
 }
 
+/// What a `--force` rebuild with other parameters, killed half way, leaves: the earlier
+/// manifest, some tiles of the new parameters, and the mark a build keeps while it writes.
+fn half_written(out: &Path, other: &Path, tile: &str) {
+    std::fs::write(out.join(".edo-city.writing"), b"").unwrap();
+    let name = format!("tiles/{tile}.obj");
+    std::fs::copy(other.join(&name), out.join(&name)).unwrap();
+}
+
+#[test]
+fn tiles_over_a_directory_a_killed_run_left_half_written_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let other = dir.path().join("other");
+    let p = dir.path().join("p.toml");
+    std::fs::write(&p, "seed = 5\n").unwrap();
+    let none = dir.path().join("none.toml");
+    std::fs::write(&none, "").unwrap();
+    build_ok(&fixture("kyoto-small"), &out, &["--quiet"]);
+    let o = build_with(&fixture("kyoto-small"), &other, &["--quiet"], &p);
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    let ids: Vec<String> = read_json(&out.join("manifest.json"))["tiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["id"].as_str().unwrap().to_string())
+        .collect();
+    assert!(ids.len() >= 2, "two tiles at least: {ids:?}");
+    let (left, asked) = (&ids[0], &ids[1]);
+    let whole = all_files(&out);
+    let differs = whole[&format!("tiles/{left}.obj")]
+        != std::fs::read(other.join(format!("tiles/{left}.obj"))).unwrap();
+    assert!(differs, "seed 5 builds another {left}");
+
+    // A tile of seed 5 under a manifest of seed 1: refused, naming the file, nothing written.
+    half_written(&out, &other, left);
+    let before = all_files(&out);
+    let o = build_with(
+        &fixture("kyoto-small"),
+        &out,
+        &["--quiet", "--tiles", asked],
+        &none,
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr_of(&o));
+    let e = stderr_of(&o);
+    assert!(
+        e.contains("half-written") && e.contains(&format!("tiles/{left}.obj")),
+        "{e}"
+    );
+    assert!(e.contains("without --tiles"), "says what to do: {e}");
+    assert_eq!(all_files(&out), before, "nothing written");
+
+    // The whole city built again: the mark is gone and the build is the first one.
+    let o = build_with(&fixture("kyoto-small"), &out, &["--quiet"], &none);
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    assert!(!out.join(".edo-city.writing").exists());
+    assert_eq!(all_files(&out), whole);
+
+    // A run killed before it changed anything: every file agrees, so --tiles goes on.
+    std::fs::write(out.join(".edo-city.writing"), b"").unwrap();
+    let o = build_with(
+        &fixture("kyoto-small"),
+        &out,
+        &["--quiet", "--tiles", asked],
+        &none,
+    );
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    assert!(!out.join(".edo-city.writing").exists());
+    assert_eq!(all_files(&out), whole);
+}
+
 #[test]
 fn tiles_into_another_hypothesis_are_refused_before_the_input_is_read() {
     let dir = tempfile::tempdir().unwrap();

@@ -39,7 +39,7 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 }
 
 /// A digest in lower-case hex.
-fn hex(digest: &[u8]) -> String {
+pub fn hex(digest: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 

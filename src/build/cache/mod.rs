@@ -17,15 +17,16 @@
 use std::fs;
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
-use std::time::UNIX_EPOCH;
 
 use sha2::{Digest, Sha256};
 
-use super::BuildOptions;
 use crate::model::{Dataset, Plan};
 
+mod key;
+pub use key::key;
+
 /// The first bytes of a cache file; a new layout of the file gets a new number.
-const MAGIC: &[u8; 24] = b"edo-city analysis v2\n\0\0\0";
+const MAGIC: &[u8; 24] = b"edo-city analysis v3\n\0\0\0";
 /// Cache files kept (one per output directory, the most recently written).
 pub const KEEP: usize = 16;
 /// Bytes the kept files may take together (a million-lot city's file is about 480 MB); the
@@ -59,112 +60,6 @@ pub fn file_for(out: &Path) -> Option<PathBuf> {
     Some(dir.join(format!("{}.plan", &name[..24])))
 }
 
-/// The key of a build's analysis: the program (its size and time of writing), the
-/// parameters, and every file of the input, the templates and the textures (path, size,
-/// time of writing), and every file the parameters name outside the input (a DEM or a table
-/// kept elsewhere, with a shapefile's sidecars). Contents are not hashed: a million-lot
-/// input is gigabytes, and an edit changes a file's time.
-pub fn key(opts: &BuildOptions) -> [u8; 32] {
-    let mut h = Sha256::new();
-    h.update(env!("CARGO_PKG_VERSION").as_bytes());
-    if let Ok(exe) = std::env::current_exe() {
-        stamp(&mut h, &exe);
-    }
-    let params = serde_json::to_value(&opts.params).unwrap_or_default();
-    h.update(params.to_string().as_bytes());
-    let skip = super::absolute(&opts.out);
-    let input = super::absolute(&opts.input);
-    let mut named = Vec::new();
-    strings(&params, &mut named);
-    for s in named {
-        let p = super::absolute(&opts.input.join(s));
-        if p.starts_with(&input) || p == skip {
-            continue;
-        }
-        h.update(b"\0named\0");
-        // A folder above the input (a stray "..") would take in the whole disk.
-        if p.is_dir() && !input.starts_with(&p) {
-            walk(&mut h, &p, &skip, 2);
-        } else if p.is_file() {
-            siblings(&mut h, &p);
-        }
-    }
-    let mut dirs = vec![opts.input.clone()];
-    dirs.extend(opts.templates.clone());
-    if !opts.params.textures.is_empty() {
-        dirs.push(PathBuf::from(&opts.params.textures));
-    }
-    for dir in dirs {
-        h.update(b"\0dir\0");
-        walk(&mut h, &dir, &skip, 0);
-    }
-    h.finalize().into()
-}
-
-/// Every string in the parameters (a file a layer, table or DEM names is among them).
-fn strings<'a>(v: &'a serde_json::Value, out: &mut Vec<&'a str>) {
-    match v {
-        serde_json::Value::String(s) if !s.is_empty() => out.push(s),
-        serde_json::Value::Array(a) => a.iter().for_each(|v| strings(v, out)),
-        serde_json::Value::Object(o) => o.values().for_each(|v| strings(v, out)),
-        _ => {}
-    }
-}
-
-/// A named file and the files beside it of the same stem (`lots.dbf` beside `lots.shp`).
-fn siblings(h: &mut Sha256, file: &Path) {
-    let (Some(dir), Some(stem)) = (file.parent(), file.file_stem()) else {
-        return;
-    };
-    let Ok(entries) = fs::read_dir(dir) else {
-        return;
-    };
-    let mut paths: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.file_stem() == Some(stem) && p.is_file())
-        .collect();
-    paths.sort();
-    for p in paths {
-        stamp(h, &p);
-    }
-}
-
-/// A file's path, size and modification time into the key.
-fn stamp(h: &mut Sha256, path: &Path) {
-    h.update(path.as_os_str().as_encoded_bytes());
-    if let Ok(m) = fs::metadata(path) {
-        h.update(m.len().to_le_bytes());
-        let t = m
-            .modified()
-            .ok()
-            .and_then(|t| t.duration_since(UNIX_EPOCH).ok());
-        h.update(t.map_or(0, |t| t.as_nanos()).to_le_bytes());
-    }
-}
-
-/// Every file under `dir` in name order, but not the output directory (an `--out` inside the
-/// input would change the key with every build).
-fn walk(h: &mut Sha256, dir: &Path, skip: &Path, depth: usize) {
-    let Ok(entries) = fs::read_dir(dir) else {
-        return;
-    };
-    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
-    paths.sort();
-    for p in paths {
-        if super::absolute(&p) == skip {
-            continue;
-        }
-        if p.is_dir() {
-            // Deep enough for models/ and tables/ folders; a link loop ends here.
-            if depth < 4 {
-                walk(h, &p, skip, depth + 1);
-            }
-        } else {
-            stamp(h, &p);
-        }
-    }
-}
-
 /// The input and plan cached for `out` under `key`, or `None` (no file, another key,
 /// damaged).
 pub fn load(file: &Path, key: &[u8; 32]) -> Option<(Dataset, Plan)> {
@@ -176,7 +71,13 @@ pub fn load(file: &Path, key: &[u8; 32]) -> Option<(Dataset, Plan)> {
     }
     let mut body = Vec::new();
     r.read_to_end(&mut body).ok()?;
-    let (mut data, plan): (Dataset, Plan) = postcard::from_bytes(&body).ok()?;
+    // The body ends in its own sha256: a flipped bit or a cut file is no plan.
+    let split = body.len().checked_sub(32)?;
+    let (body, digest) = body.split_at(split);
+    if Sha256::digest(body).as_slice() != digest {
+        return None;
+    }
+    let (mut data, plan): (Dataset, Plan) = postcard::from_bytes(body).ok()?;
     data.share_field_names();
     Some((data, plan))
 }
@@ -196,7 +97,13 @@ pub fn store(file: &Path, key: &[u8; 32], data: &Dataset, plan: &Plan) {
         let mut w = BufWriter::new(fs::File::create(&tmp)?);
         w.write_all(MAGIC)?;
         w.write_all(key)?;
-        postcard::to_io(&(data, plan), &mut w).map_err(std::io::Error::other)?;
+        let mut hashed = Hashed {
+            inner: &mut w,
+            h: Sha256::new(),
+        };
+        postcard::to_io(&(data, plan), &mut hashed).map_err(std::io::Error::other)?;
+        let digest = hashed.h.finalize();
+        w.write_all(&digest)?;
         w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
         fs::rename(&tmp, file)
     })();
@@ -207,10 +114,53 @@ pub fn store(file: &Path, key: &[u8; 32], data: &Dataset, plan: &Plan) {
     evict(dir);
 }
 
+/// A writer that hashes what passes through it.
+struct Hashed<W> {
+    inner: W,
+    h: Sha256,
+}
+
+impl<W: Write> Write for Hashed<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.h.update(&buf[..n]);
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
 /// Removes all but the [`KEEP`] most recently written plans, and the older ones beyond
 /// [`KEEP_BYTES`].
 fn evict(dir: &Path) {
+    remove_orphans(dir);
     evict_beyond(dir, KEEP, KEEP_BYTES);
+}
+
+/// Removes the temporaries of builds killed while they wrote the cache
+/// (`<key>.tmp-<pid>` whose process is gone; they were never removed and each holds a whole
+/// plan). Only where `/proc` tells which processes run.
+fn remove_orphans(dir: &Path) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for path in entries.filter_map(|e| e.ok()).map(|e| e.path()) {
+        let pid = path
+            .extension()
+            .and_then(|x| x.to_str())
+            .and_then(|x| x.strip_prefix("tmp-"))
+            .and_then(|p| p.parse::<u32>().ok());
+        if let Some(pid) = pid {
+            if !Path::new(&format!("/proc/{pid}")).exists() {
+                let _ = fs::remove_file(&path);
+            }
+        }
+    }
 }
 
 /// Keeps the newest plans while there are at most `keep` of `keep_bytes` together (the
@@ -313,39 +263,50 @@ mod tests {
 
     /// Sets `f`'s time of writing to `secs` after a fixed day long past.
     fn written_at(f: &Path, secs: u64) {
-        let t = UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + secs);
+        let t = std::time::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + secs);
         let file = fs::File::options().write(true).open(f).unwrap();
         file.set_modified(t).unwrap();
     }
 
     #[test]
-    fn a_file_the_parameters_name_outside_the_input_is_in_the_key() {
+    fn every_flipped_bit_of_a_cache_file_is_refused() {
         let dir = tempfile::tempdir().unwrap();
-        let (input, elsewhere) = (dir.path().join("in"), dir.path().join("elsewhere"));
-        fs::create_dir_all(&input).unwrap();
-        fs::create_dir_all(&elsewhere).unwrap();
-        fs::write(input.join("lots.shp"), "x").unwrap();
-        fs::write(elsewhere.join("dem.asc"), "1").unwrap();
-        fs::write(elsewhere.join("dem.prj"), "p").unwrap();
-        let mut params = crate::params::Params::default();
-        params.layers.lots.file = "../elsewhere/dem.asc".into();
-        let opts = BuildOptions {
-            input: input.clone(),
-            out: dir.path().join("out"),
-            params,
-            templates: None,
-            threads: 1,
-            plan_image: false,
-            selection: crate::build::Selection::All,
-            force: false,
-        };
-        let before = key(&opts);
-        assert_eq!(key(&opts), before, "the same files, the same key");
-        fs::write(elsewhere.join("dem.prj"), "another").unwrap();
-        assert_ne!(key(&opts), before, "a sidecar of the named file changed");
-        let again = key(&opts);
-        fs::write(input.join("lots.shp"), "xy").unwrap();
-        assert_ne!(key(&opts), again, "a file of the input changed");
+        let file = dir.path().join("x.plan");
+        let mut data = Dataset::default();
+        data.warnings.push(crate::model::Warning::new(
+            crate::model::WarningClass::Layer,
+            "a warning long enough to flip bits in",
+        ));
+        let key = [3u8; 32];
+        store(&file, &key, &data, &Plan::default());
+        let bytes = fs::read(&file).unwrap();
+        assert!(load(&file, &key).is_some());
+        for i in 0..bytes.len() {
+            for bit in [0, 3, 7] {
+                let mut b = bytes.clone();
+                b[i] ^= 1 << bit;
+                fs::write(&file, &b).unwrap();
+                assert!(load(&file, &key).is_none(), "byte {i} bit {bit} accepted");
+            }
+        }
+    }
+
+    #[test]
+    fn temporaries_of_killed_builds_are_removed_and_a_running_ones_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        // A pid that no process has: above the kernel's pid_max (at most 2^22).
+        let dead = dir.path().join("k.tmp-4999999");
+        let alive = dir.path().join(format!("k.tmp-{}", std::process::id()));
+        fs::write(&dead, "half").unwrap();
+        fs::write(&alive, "half").unwrap();
+        store(
+            &dir.path().join("new.plan"),
+            &[0u8; 32],
+            &Dataset::default(),
+            &Plan::default(),
+        );
+        assert!(!dead.exists(), "a killed build's temporary went");
+        assert!(alive.exists(), "a running build's stays");
     }
 
     #[test]
