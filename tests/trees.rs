@@ -231,6 +231,11 @@ fn a_colonized_tree_reports_its_groups() {
     let groups = r["groups"].as_array().unwrap();
     let names: Vec<&str> = groups.iter().map(|g| g["name"].as_str().unwrap()).collect();
     assert_eq!(names, ["trunk", "branches", "roots"]);
+    // One tree: one node more than edges (the groups' sum counted shared stem edges twice).
+    assert_eq!(
+        r["nodes"].as_u64().unwrap(),
+        r["edges"].as_u64().unwrap() + 1
+    );
     for g in groups {
         assert_eq!(
             g["nodes"].as_u64().unwrap(),
@@ -483,5 +488,122 @@ fn a_species_field_of_the_points_names_each_trees_species() {
     assert!(warned, "an unknown species is warned about");
     for a in r["accounting"].as_array().unwrap() {
         assert_eq!(a["unaccounted"], 0, "{a}");
+    }
+}
+
+/// A colonized species in `dir/trees/` whose branches fill the hull `file` with `points`.
+fn hull_species(dir: &Path, file: &str, points: usize) {
+    let trees = dir.join("trees");
+    std::fs::create_dir_all(&trees).unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("templates/trees/kusu.toml"),
+    )
+    .unwrap()
+    .replace("name = \"kusu\"", "name = \"shaped\"")
+    .replace(
+        "envelope = { shape = \"ellipsoid\", center = [0.0, 0.0, 12.5], radii = [10.0, 10.0, 7.0] }",
+        &format!("envelope = {{ shape = \"hull\", file = \"{file}\" }}"),
+    )
+    .replace("points = 2000", &format!("points = {points}"));
+    assert!(text.contains("\"hull\""));
+    // Without its roots, whose 12 m spread would hide the crown's width.
+    let roots = text
+        .find("[[colonization.group]]\nname = \"roots\"")
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        &text[..roots],
+        &text[text.find("[roots]").unwrap()..]
+    );
+    std::fs::write(trees.join("shaped.toml"), text).unwrap();
+}
+
+/// An OBJ (y up) of a box from `lo` to `hi`, twelve triangles wound outward.
+fn box_obj(lo: [f64; 3], hi: [f64; 3]) -> String {
+    let mut s = String::new();
+    for i in 0..8 {
+        let c = |k: usize| if i >> k & 1 == 1 { hi[k] } else { lo[k] };
+        s += &format!("v {} {} {}\n", c(0), c(1), c(2));
+    }
+    for f in [
+        "1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6",
+    ] {
+        s += &format!("f {f}\n");
+    }
+    s
+}
+
+#[test]
+fn a_hull_crown_grows_inside_it_and_a_hull_with_no_volume_or_outside_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let templates = dir.path().join("tpl");
+    let trees = templates.join("trees");
+    std::fs::create_dir_all(&trees).unwrap();
+    std::fs::write(
+        trees.join("crown.obj"),
+        box_obj([-4.0, 7.0, -3.0], [4.0, 13.0, 3.0]),
+    )
+    .unwrap();
+    let grow = |extra: &[&str]| {
+        let mut args = vec!["tree", "--species", "shaped", "--templates"];
+        args.push(templates.to_str().unwrap());
+        args.extend(extra);
+        edo_city().args(&args).output().unwrap()
+    };
+    hull_species(&templates, "crown.obj", 3000);
+    let rep = dir.path().join("r.json");
+    let o = grow(&["--report", rep.to_str().unwrap(), "--height", "13"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = read_json(&rep);
+    // Grown to the box's own top (13 m, OBJ y is up), the crown reaches the box's corners
+    // (5 m from the axis) and its leaves' clusters (1.6 m), not kusu's 10 m dome.
+    let width = r["crown_width"].as_f64().unwrap();
+    assert!((8.0..=2.0 * (5.0 + 1.6)).contains(&width), "{r}");
+    assert_eq!(
+        r["nodes"].as_u64().unwrap(),
+        r["edges"].as_u64().unwrap() + 1
+    );
+
+    // 10,001 triangles in one plane, 50,000 points: refused when read (ran for minutes).
+    let mut flat = String::from("v 0 5 0\n");
+    for i in 0..10_002 {
+        flat += &format!(
+            "v {} 5 {}\n",
+            (i as f64 * 0.7).sin() * 5.0,
+            (i as f64 * 1.3).cos() * 5.0
+        );
+    }
+    for i in 2..10_003 {
+        flat += &format!("f 1 {i} {}\n", i + 1);
+    }
+    std::fs::write(trees.join("flat.obj"), flat).unwrap();
+    hull_species(&templates, "flat.obj", 50_000);
+    let e = String::from_utf8(grow(&[]).stderr).unwrap();
+    assert!(e.contains("flat.obj") && e.contains("no volume"), "{e}");
+
+    // Named outside the species' folder, by `..`, absolutely, or as a device: refused, and
+    // nothing is told of what lies outside.
+    std::fs::write(dir.path().join("secret.obj"), box_obj([0.0; 3], [1.0; 3])).unwrap();
+    std::os::unix::fs::symlink(dir.path().join("secret.obj"), trees.join("link.obj")).unwrap();
+    let names = [
+        "link.obj",
+        "../../secret.obj",
+        "../../nothing.obj",
+        "/dev/zero",
+        "/etc/passwd",
+        "nothing.obj",
+    ];
+    for name in names {
+        hull_species(&templates, name, 100);
+        let o = grow(&[]);
+        assert_eq!(o.status.code(), Some(2), "{name}");
+        let e = String::from_utf8(o.stderr).unwrap();
+        assert!(e.contains(name), "{name}: {e}");
+        let want = if name == "nothing.obj" {
+            "does not exist"
+        } else {
+            "outside the folder"
+        };
+        assert!(e.contains(want), "{name}: {e}");
     }
 }

@@ -10,7 +10,7 @@
 
 use std::collections::HashSet;
 use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 use super::TemplateError;
 
@@ -58,6 +58,57 @@ pub fn read(path: &Path) -> Result<String, TemplateError> {
         .map_err(|e| bad(format!("cannot be read as UTF-8 text ({e})")))?;
     if text.len() as u64 > MAX_FILE_BYTES {
         return Err(bad(format!("grew past {MAX_FILE_BYTES} bytes while read")));
+    }
+    Ok(text)
+}
+
+/// The text of the file `name` that the file `by` names beside itself (a species' hull
+/// OBJ): refused when it lies outside `by`'s folder after its links are resolved (`../x`,
+/// `/etc/x`, a link out), is not a regular file (`/dev/zero` read until memory ran out) or
+/// is larger than `cap`. The refusal names the path as written, never what lies outside.
+pub fn read_beside(by: &Path, name: &str, cap: u64) -> Result<String, String> {
+    let folder = by.parent().unwrap_or(Path::new("."));
+    let outside = || {
+        format!(
+            "`{name}` lies outside the folder of {} (after links are resolved): put the file              beside it and name it by a relative path",
+            by.display()
+        )
+    };
+    // As written first, so that whether a path outside exists is never told.
+    let mut depth = 0usize;
+    for c in Path::new(name).components() {
+        match c {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir if depth > 0 => depth -= 1,
+            _ => return Err(outside()),
+        }
+    }
+    let root = std::fs::canonicalize(folder)
+        .map_err(|e| format!("the folder of {} cannot be read ({e})", by.display()))?;
+    let real = std::fs::canonicalize(folder.join(name))
+        .map_err(|_| format!("`{name}` does not exist beside {}", by.display()))?;
+    if !real.starts_with(&root) {
+        return Err(outside());
+    }
+    let meta = std::fs::metadata(&real).map_err(|e| format!("`{name}` cannot be read ({e})"))?;
+    if !meta.is_file() {
+        return Err(format!(
+            "`{name}` is not a regular file (a directory, device or pipe): name a file"
+        ));
+    }
+    if meta.len() > cap {
+        return Err(format!(
+            "`{name}` is {} bytes, more than the {cap} it may have",
+            meta.len()
+        ));
+    }
+    let mut text = String::new();
+    std::fs::File::open(&real)
+        .and_then(|f| f.take(cap + 1).read_to_string(&mut text))
+        .map_err(|e| format!("`{name}` cannot be read as UTF-8 text ({e})"))?;
+    if text.len() as u64 > cap {
+        return Err(format!("`{name}` grew past {cap} bytes while read"));
     }
     Ok(text)
 }

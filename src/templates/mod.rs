@@ -8,7 +8,7 @@
 //! describes the format. A user adds a type by dropping a file into a directory given with
 //! `--templates` (or `machiya.templates`) and naming it in `type_mix`.
 
-mod dir;
+pub(crate) mod dir;
 pub mod expr;
 pub mod file;
 pub mod species;

@@ -6,6 +6,7 @@
 use rand::RngExt;
 use rand_pcg::Pcg64;
 
+use super::hull;
 use crate::growers::v3::{self, V3};
 
 /// A volume to sample attraction points in.
@@ -60,17 +61,7 @@ impl Envelope {
             Envelope::Cone { base, top, radius } | Envelope::Cylinder { base, top, radius } => {
                 ([-radius, -radius, *base], [*radius, *radius, *top])
             }
-            Envelope::Hull { triangles } => {
-                let mut lo = [f64::INFINITY; 3];
-                let mut hi = [f64::NEG_INFINITY; 3];
-                for p in triangles.iter().flatten() {
-                    for k in 0..3 {
-                        lo[k] = lo[k].min(p[k]);
-                        hi[k] = hi[k].max(p[k]);
-                    }
-                }
-                (lo, hi)
-            }
+            Envelope::Hull { triangles } => hull::bounds(triangles),
         }
     }
 
@@ -95,11 +86,8 @@ impl Envelope {
             Envelope::Cylinder { base, top, radius } => {
                 p[2] >= *base && p[2] <= *top && p[0].hypot(p[1]) <= *radius
             }
-            Envelope::Hull { triangles } => {
-                // Parity of crossings of a ray along +x (nudged off axis-aligned edges).
-                let dir = [1.0, 1e-7, 2e-7];
-                triangles.iter().filter(|t| ray_hits(p, dir, t)).count() % 2 == 1
-            }
+            // Parity of crossings of a ray along +x (nudged off axis-aligned edges).
+            Envelope::Hull { triangles } => hull::contains(triangles, p),
         }
     }
 
@@ -131,54 +119,55 @@ impl Envelope {
         v3::unit(n).unwrap_or([0.0, 0.0, 1.0])
     }
 
-    /// `count` points drawn uniformly inside by rejection from the bounding box; `None` when
-    /// the shape is (nearly) empty (fewer than `count` hits in 200 x `count` tries).
-    pub fn sample(&self, count: usize, rng: &mut Pcg64) -> Option<Vec<V3>> {
+    /// `count` points drawn uniformly inside by rejection from the bounding box; an error
+    /// when the shape is (nearly) empty (fewer than `count` hits in 200 x `count` tries) or
+    /// a hull would take more than [`hull::MAX_RAY_TESTS`] ray tests.
+    pub fn sample(&self, count: usize, rng: &mut Pcg64) -> Result<Vec<V3>, String> {
+        let empty = || "its envelope is empty (no points could be placed in it)".to_string();
         let (lo, hi) = self.bounds();
         if !(0..3).all(|k| lo[k].is_finite() && hi[k].is_finite() && hi[k] >= lo[k]) {
-            return None;
+            return Err(empty());
         }
+        let mut index = match self {
+            Envelope::Hull { triangles } => Some(hull::Index::new(triangles)),
+            _ => None,
+        };
         let mut out = Vec::with_capacity(count);
         let mut tries = 0usize;
         while out.len() < count {
             tries += 1;
             if tries > 200 * count.max(1) {
-                return None;
+                return Err(empty());
             }
             let p = [
                 lo[0] + rng.random::<f64>() * (hi[0] - lo[0]),
                 lo[1] + rng.random::<f64>() * (hi[1] - lo[1]),
                 lo[2] + rng.random::<f64>() * (hi[2] - lo[2]),
             ];
-            if self.contains(p) {
+            let inside = match &mut index {
+                Some(index) if index.tests > hull::MAX_RAY_TESTS => {
+                    return Err(format!(
+                        "its hull took {} ray tests for {} of {count} points: make it \
+                         smaller, with fewer or smaller triangles, or ask fewer points",
+                        index.tests,
+                        out.len()
+                    ));
+                }
+                Some(index) => index.contains(p),
+                None => self.contains(p),
+            };
+            if inside {
                 out.push(p);
             }
         }
-        Some(out)
+        Ok(out)
     }
-}
 
-/// Möller-Trumbore: whether the ray from `o` along `d` crosses triangle `t` (t > 0).
-fn ray_hits(o: V3, d: V3, t: &[V3; 3]) -> bool {
-    let e1 = v3::sub(t[1], t[0]);
-    let e2 = v3::sub(t[2], t[0]);
-    let h = v3::cross(d, e2);
-    let a = v3::dot(e1, h);
-    if a.abs() < 1e-12 {
-        return false;
+    /// A hull of a user's triangles, refused when it encloses no volume.
+    pub fn hull(triangles: Vec<[V3; 3]>) -> Result<Envelope, String> {
+        hull::check_volume(&triangles)?;
+        Ok(Envelope::Hull { triangles })
     }
-    let f = 1.0 / a;
-    let s = v3::sub(o, t[0]);
-    let u = f * v3::dot(s, h);
-    if !(0.0..=1.0).contains(&u) {
-        return false;
-    }
-    let q = v3::cross(s, e1);
-    let v = f * v3::dot(d, q);
-    if v < 0.0 || u + v > 1.0 {
-        return false;
-    }
-    f * v3::dot(e2, q) > 1e-12
 }
 
 #[cfg(test)]

@@ -21,6 +21,7 @@
 
 pub mod envelope;
 pub mod field;
+pub mod hull;
 
 use std::collections::HashMap;
 
@@ -28,6 +29,7 @@ use rand_pcg::Pcg64;
 
 pub use envelope::Envelope;
 pub use field::Field;
+pub use hull::MAX_HULL_TRIANGLES;
 
 use super::skeleton::{Node, Skeleton};
 use super::v3::{self, V3};
@@ -185,12 +187,10 @@ pub fn grow(
                 group.name, group.points
             ));
         }
-        let points = group.envelope.sample(group.points, rng).ok_or_else(|| {
-            format!(
-                "group `{}`: its envelope is empty (no points could be placed in it)",
-                group.name
-            )
-        })?;
+        let points = group
+            .envelope
+            .sample(group.points, rng)
+            .map_err(|e| format!("group `{}`: {e}", group.name))?;
         let seeds = match (group.attach, reports.first()) {
             (Attach::Base, _) | (_, None) => vec![0],
             (Attach::Stem(lo, hi), Some(first)) => g.stem(&first.members, lo, hi),
