@@ -309,11 +309,13 @@ fn the_polygons_of_a_gardens_layer_get_gardens_whatever_their_lots_use() {
             ("g1", shrunk),
             ("g2", rect(x0, c.y, 2.0, 2.0)),
             ("g3", rect(x0, c.y + 50.0, 30.0, 20.0)),
+            // Drawn over g3 (a second hypothesis left in the layer): not stacked through it.
+            ("g4", rect(x0 + 10.0, c.y + 55.0, 30.0, 20.0)),
         ],
     );
 
     let data = edo_city::input::read_dataset(&town, &params).expect("reads");
-    assert_eq!(data.gardens.len(), 3);
+    assert_eq!(data.gardens.len(), 4);
     let catalog = edo_city::templates::Catalog::load(None).unwrap();
     let plan = edo_city::analyse::analyse(&data, &params, &catalog, "lots.shp", &|_| {});
     let placed: Vec<_> = plan.gardens.values().flatten().collect();
@@ -374,9 +376,18 @@ fn the_polygons_of_a_gardens_layer_get_gardens_whatever_their_lots_use() {
         .iter()
         .find(|a| a["role"] == "gardens")
         .expect("the gardens layer is accounted for");
-    assert_eq!(ledger["read"], 3);
-    assert_eq!(ledger["unaccounted"], 0, "{ledger}");
+    assert_eq!(ledger["read"], 4);
+    assert_eq!(ledger["built"], 2, "{ledger}");
+    assert_eq!(ledger["skipped"], 2, "{ledger}");
+    assert_eq!(by_area("g4")["placed"], false);
+    let why = by_area("g4")["reason"].as_str().unwrap();
+    assert!(why.contains("overlap") && why.contains("`g3`"), "{why}");
+    assert!(skipped
+        .iter()
+        .any(|s| s["layer"] == "gardens" && s["id"] == "g4" && s["record"] == 3));
     let objects = common::build_objects(&out);
+    assert!(!objects.iter().any(|o| o.name.starts_with("garden_area-g4")));
+    assert_eq!(ledger["unaccounted"], 0, "{ledger}");
     assert!(objects.iter().any(|o| o.name == "garden_area-g1"));
     assert!(
         objects
@@ -385,4 +396,76 @@ fn the_polygons_of_a_gardens_layer_get_gardens_whatever_their_lots_use() {
             .count()
             == 15
     );
+}
+
+/// A garden record of two rings, the second wound as a hole but lying outside the first:
+/// read as a polygon of its own (as GDAL and QGIS read it, with a warning), too small for a
+/// garden and skipped, and the record counted as built in part.
+#[test]
+fn a_hole_outside_its_ring_is_a_part_of_its_own_and_the_record_built_in_part() {
+    let dir = tempfile::tempdir().unwrap();
+    let town = dir.path().join("town");
+    common::synth(&town, 300, 4);
+    let params = edo_city::params::Params::default();
+    let before = edo_city::input::read_dataset(&town, &params).expect("reads");
+    let corners = before
+        .lots
+        .iter()
+        .flat_map(|l| l.outline.exterior().0.iter());
+    let x0 = corners.map(|q| q.x).fold(f64::INFINITY, f64::min) - 200.0;
+    let y0 = before.lots[0].outline.exterior().0[0].y;
+    let name = |n: &str| dbase::FieldName::try_from(n).unwrap();
+    let table = dbase::TableWriterBuilder::new().add_character_field(name("id"), 10);
+    let mut w = shapefile::Writer::from_path(town.join("gardens.shp"), table).unwrap();
+    let mut rec = dbase::Record::default();
+    rec.insert("id".into(), dbase::FieldValue::Character(Some("r".into())));
+    let ring = |x: f64, w: f64, d: f64| {
+        let p = |x: f64, y: f64| shapefile::Point::new(x, y);
+        vec![
+            p(x, y0),
+            p(x, y0 + d),
+            p(x + w, y0 + d),
+            p(x + w, y0),
+            p(x, y0),
+        ]
+    };
+    let mut hole = ring(x0 + 50.0, 10.0, 5.0);
+    hole.reverse();
+    let poly = shapefile::Polygon::with_rings(vec![
+        shapefile::PolygonRing::Outer(ring(x0, 30.0, 20.0)),
+        shapefile::PolygonRing::Inner(hole),
+    ]);
+    w.write_shape_and_record(&poly, &rec).unwrap();
+    drop(w);
+    let report = common::build_ok(&town, &dir.path().join("out"), &[]);
+    let warned = report["warnings"].as_array().unwrap().iter().any(|w| {
+        w["file"] == "gardens.shp" && w["message"].as_str().unwrap().contains("wound against")
+    });
+    assert!(warned, "{}", report["warnings"]);
+    let skipped = report["skipped"].as_array().unwrap();
+    assert!(
+        skipped
+            .iter()
+            .any(|s| s["id"] == "r-2" && s["record"] == 0 && s["layer"] == "gardens"),
+        "{skipped:?}"
+    );
+    let gardens = report["gardens"].as_array().unwrap();
+    assert!(gardens
+        .iter()
+        .any(|g| g["area"] == "r-1" && g["placed"] == true));
+    let ledger = report["accounting"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["role"] == "gardens")
+        .unwrap();
+    for (key, n) in [
+        ("read", 1),
+        ("built", 1),
+        ("skipped", 1),
+        ("partly", 1),
+        ("unaccounted", 0),
+    ] {
+        assert_eq!(ledger[key], n, "{key}: {ledger}");
+    }
 }

@@ -204,9 +204,10 @@ fn a_killed_build_loses_nothing() {
         let _ = child.kill(); // SIGKILL
         let _ = child.wait();
         for (name, bytes) in all_files(&out) {
-            if name.contains(".tmp-") || name == ".edo-city.lock" {
-                // A killed run's temporary (never read, swept by the next run) or its lock
-                // (a dead holder's, taken over by the next run).
+            if name.contains(".tmp-") || name == ".edo-city.lock" || name == ".edo-city.writing" {
+                // A killed run's temporary (never read, swept by the next run), its lock
+                // (a dead holder's, taken over by the next run) or its mark of a directory
+                // being written (which makes a later --tiles check every file).
                 continue;
             }
             let whole =
@@ -291,7 +292,11 @@ fn a_full_disk_loses_nothing() {
         1,
         "said once: {stderr}"
     );
-    let left = all_files(&out);
+    let mut left = all_files(&out);
+    assert!(
+        left.remove(".edo-city.writing").is_some(),
+        "the directory is marked as half-written, so --tiles checks it"
+    );
     let (mut old_kept, mut new_written) = (0, 0);
     for (name, bytes) in &left {
         assert!(!name.contains(".tmp-"), "{name}: a temporary was left");

@@ -119,10 +119,11 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, para
             });
         }
     }
-    let results: Vec<(GardenStat, Option<PlannedGarden>)> = sites
+    let mut results: Vec<(GardenStat, Option<PlannedGarden>)> = sites
         .par_iter()
         .map(|site| design(site, obstacles, params))
         .collect();
+    drop_overlaps(&mut results, &sites);
     for ((stat, garden), site) in results.into_iter().zip(&sites) {
         if let (false, Some((id, record))) = (stat.placed, &site.area) {
             plan.skipped.push(Skipped {
@@ -137,6 +138,85 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, para
         if let Some(gd) = garden {
             plan.tiles.insert(gd.tile.clone());
             plan.gardens.entry(gd.tile.clone()).or_default().push(gd);
+        }
+    }
+}
+
+/// Drops a garden placed through one before it. Sites are planned each on its own, so two
+/// overlapping polygons of the gardens layer (or a drawn polygon reaching into a temple lot
+/// with a garden of its own) gave gardens stacked through each other without a word. The
+/// first in site order (the layer's records, then the lots) keeps its place; a later one
+/// whose rectangle overlaps it (more than touching: each is shrunk by a centimetre) is not
+/// built, and its report names the other.
+fn drop_overlaps(results: &mut [(GardenStat, Option<PlannedGarden>)], sites: &[Site]) {
+    use geo::{BoundingRect, Intersects};
+    use rstar::primitives::{GeomWithData, Rectangle};
+    use rstar::{RTree, AABB};
+    let mut kept: RTree<GeomWithData<Rectangle<[f64; 2]>, usize>> = RTree::new();
+    let mut plots: Vec<Option<Polygon<f64>>> = vec![None; results.len()];
+    for i in 0..results.len() {
+        let Some(garden) = &results[i].1 else {
+            continue;
+        };
+        let plot = shrunk(&garden.outline(), 0.01);
+        let Some(b) = plot.bounding_rect() else {
+            continue;
+        };
+        let (lo, hi) = ([b.min().x, b.min().y], [b.max().x, b.max().y]);
+        let under = kept
+            .locate_in_envelope_intersecting(&AABB::from_corners(lo, hi))
+            .map(|k| k.data)
+            .filter(|&j| plots[j].as_ref().is_some_and(|p| p.intersects(&plot)))
+            .min();
+        match under {
+            Some(j) => {
+                let stat = &mut results[i].0;
+                stat.placed = false;
+                stat.reason = format!(
+                    "its garden would overlap the one of {}, planned first: draw the gardens \
+                     apart, or as one polygon",
+                    sites[j].name()
+                );
+                stat.size = [0.0; 2];
+                stat.fitness = 0.0;
+                stat.stones = 0;
+                results[i].1 = None;
+            }
+            None => {
+                kept.insert(GeomWithData::new(Rectangle::from_corners(lo, hi), i));
+                plots[i] = Some(plot);
+            }
+        }
+    }
+}
+
+/// A convex outline moved `by` metres in toward its centre (along each corner's diagonal).
+fn shrunk(ring: &[Coord<f64>], by: f64) -> Polygon<f64> {
+    let n = ring.len().max(1) as f64;
+    let c = ring.iter().fold(Coord { x: 0.0, y: 0.0 }, |s, q| Coord {
+        x: s.x + q.x / n,
+        y: s.y + q.y / n,
+    });
+    let moved = ring
+        .iter()
+        .map(|&q| {
+            let d = (q.x - c.x).hypot(q.y - c.y);
+            let k = if d > by { (d - by) / d } else { 0.0 };
+            Coord {
+                x: c.x + (q.x - c.x) * k,
+                y: c.y + (q.y - c.y) * k,
+            }
+        })
+        .collect();
+    Polygon::new(geo_types::LineString(moved), vec![])
+}
+
+impl Site<'_> {
+    /// How a report names the site: the gardens layer's polygon, else the lot.
+    fn name(&self) -> String {
+        match &self.area {
+            Some((id, _)) => format!("garden polygon `{id}`"),
+            None => format!("lot `{}`", self.lot),
         }
     }
 }

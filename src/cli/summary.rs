@@ -60,6 +60,14 @@ pub fn print_check(r: &edo_city::output::report::Report) -> std::io::Result<()> 
             l.file
         );
     }
+    for a in r.accounting.iter().filter(|a| a.partly > 0) {
+        say!(
+            "{}: {} record(s) built in part (some parts built, others skipped: counted in \
+             both; report.json `skipped` says which)",
+            a.file,
+            a.partly
+        );
+    }
     let c = &r.counts;
     say!(
         "\nlots {} ({}), machiya {}, footprints {} of {}, tiles {}, frontage fallback {}",
