@@ -195,13 +195,20 @@ fn tiles_reuse_the_cached_analysis_only_for_the_same_input_and_parameters() {
     assert!(reused(&run(&out, &tiles, &cache)), "same input: reused");
     assert_same_tree(&full, &out);
 
-    // An edited input (its time changed) is analysed again, and that analysis cached.
+    // A file only touched is the same input (the key is the content) ...
     let dbf = std::fs::File::options()
         .write(true)
         .open(input.join("lots.dbf"))
         .unwrap();
     dbf.set_modified(std::time::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000_000))
         .unwrap();
+    assert!(reused(&run(&out, &tiles, &cache)), "touched input: reused");
+    assert_same_tree(&full, &out);
+    // ... an edited one (the DBF header's date of last update, which changes no tile) is
+    // analysed again, and that analysis cached.
+    let mut bytes = std::fs::read(input.join("lots.dbf")).unwrap();
+    bytes[1] = bytes[1].wrapping_add(1);
+    std::fs::write(input.join("lots.dbf"), bytes).unwrap();
     std::fs::write(&tile, "damaged").unwrap();
     assert!(
         !reused(&run(&out, &tiles, &cache)),

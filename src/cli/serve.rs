@@ -1,6 +1,6 @@
 //! `edo-city serve <out> [<more outs>]`: the web viewer and one or more builds of the same
 //! place (hypotheses, eras) on 127.0.0.1, with the right MIME types (the HTTP side in
-//! `serve/http.rs`: a thread per connection on `std::net`; it says why not a server crate).
+//! `serve/http.rs`: hyper and tower-http, with bounds on connections and time).
 //!
 //! Routes: `/` the viewer page; `/viewer/<file>` its scripts; `/node_modules/<pkg>/...` the
 //! npm packages it imports (three.js, 3d-tiles-renderer), from `viewer/node_modules`;
@@ -200,28 +200,25 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
         let _ = std::process::Command::new("xdg-open").arg(&url).spawn();
     }
     let handler: http::Handler =
-        std::sync::Arc::new(move |req: &http::Request| answer(&req.url, &viewer, &builds, &list));
-    http::serve(listener, handler);
-    Ok(())
+        std::sync::Arc::new(move |url: &str| answer(url, &viewer, &builds, &list));
+    http::serve(listener, handler, http::Limits::default()).context("the server stopped")
 }
 
 /// The answer to a GET of `url`: a file, the hypotheses list, or 404.
-fn answer(url: &str, viewer: &Path, builds: &[Hypothesis], list: &[u8]) -> http::Response {
-    let no_cache = ("Cache-Control", "no-cache".to_string());
+fn answer(url: &str, viewer: &Path, builds: &[Hypothesis], list: &[u8]) -> http::Answer {
     if url.split('?').next() == Some("/hypotheses.json") {
-        return http::Response {
+        return http::Answer::Bytes {
             status: 200,
-            headers: vec![("Content-Type", "application/json".into()), no_cache],
-            body: http::Body::Bytes(list.to_vec()),
+            content_type: "application/json",
+            body: list.to_vec(),
         };
     }
-    match route(url, viewer, builds).and_then(|p| Some((std::fs::File::open(&p).ok()?, p))) {
-        Some((file, path)) => http::Response {
-            status: 200,
-            headers: vec![("Content-Type", mime(&path).into()), no_cache],
-            body: http::Body::File(file),
+    match route(url, viewer, builds) {
+        Some(path) => http::Answer::File {
+            content_type: mime(&path),
+            path,
         },
-        None => http::Response::text(404, format!("not found: {url}")),
+        None => http::Answer::text(404, format!("not found: {url}")),
     }
 }
 

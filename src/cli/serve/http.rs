@@ -1,287 +1,450 @@
-//! The HTTP/1.1 side of `edo-city serve`, on `std::net` alone: one thread per connection, one
-//! request per connection (`Connection: close`), GET and HEAD.
+//! The HTTP side of `edo-city serve`: hyper's HTTP/1.1 on a tokio runtime, files sent by
+//! tower-http's `ServeFile` (HEAD, ranges, conditional requests), with a bound on the
+//! connections held and a time limit on every way a client can hold one.
 //!
-//! Why not a server crate: `tiny_http` 0.12 (used before) hands each connection to a pool
-//! thread for the connection's whole life, and its pool can queue a new connection while every
-//! thread sits on a keep-alive one (two connections accepted before the one idle thread wakes
-//! both count on it). Chromium opens six connections at once for the viewer's modules, so now
-//! and then a module never came and the page never loaded (a 120 s `page.goto` timeout in CI;
-//! eight concurrent keep-alive clients left 1 request of 240 unanswered). A thread per
-//! connection and no keep-alive cannot queue anything; on 127.0.0.1 the reconnects cost
-//! nothing, and an async runtime for a static file server would be out of proportion.
+//! The server before this one gave each connection a thread and two file descriptors with no
+//! limit: with `ulimit -n 1024`, about 680 idle local connections made a real request time
+//! out while the accept loop spun on "too many open files", and a client sending a byte every
+//! 20 s was held forever. Here a connection costs a task and one descriptor, and:
+//! - at most [`Limits::max_connections`] are held (by default half the process's descriptor
+//!   limit); a new one past it closes the connection that has been idle longest, so idle
+//!   connections can never keep a request out; when every one is answering, the new one is
+//!   closed (the browser retries);
+//! - a request head must arrive whole within [`Limits::head`] however slowly it trickles;
+//! - a connection with no request in flight and no byte either way for [`Limits::idle`], or
+//!   answering one with no byte moved for [`Limits::stall`] (a client that stopped reading),
+//!   is closed;
+//! - an accept error (out of descriptors) closes the longest-idle connection and waits a
+//!   moment instead of spinning.
 
-use std::fs::File;
-use std::io::{self, BufRead, BufReader, Read, Write};
-use std::net::{Shutdown, TcpListener, TcpStream};
-use std::sync::Arc;
-use std::time::Duration;
+use std::collections::BTreeMap;
+use std::convert::Infallible;
+use std::io;
+use std::path::PathBuf;
+use std::pin::Pin;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::task::{Context, Poll};
+use std::time::{Duration, Instant};
 
-/// The longest request head read (request line and headers); longer is refused with 431.
+use http::header::{HeaderValue, ALLOW, CACHE_CONTROL, CONTENT_TYPE};
+use http::{Method, Request, Response, StatusCode};
+use http_body_util::combinators::UnsyncBoxBody;
+use http_body_util::{BodyExt, Full};
+use hyper::body::{Bytes, Incoming};
+use hyper_util::rt::{TokioIo, TokioTimer};
+use tokio::io::{AsyncRead, AsyncWrite, ReadBuf};
+use tokio::net::{TcpListener, TcpStream};
+use tokio::sync::Notify;
+use tower::ServiceExt;
+use tower_http::services::ServeFile;
+
+/// What `serve` answers a GET or HEAD of a URL with.
+pub enum Answer {
+    /// Bytes made in memory (`/hypotheses.json`, a 404's text).
+    Bytes {
+        status: u16,
+        content_type: &'static str,
+        body: Vec<u8>,
+    },
+    /// A file, already checked to lie inside a served directory, with its MIME type.
+    File {
+        path: PathBuf,
+        content_type: &'static str,
+    },
+}
+
+impl Answer {
+    /// A plain-text answer with a status.
+    pub fn text(status: u16, text: String) -> Answer {
+        Answer::Bytes {
+            status,
+            content_type: "text/plain; charset=utf-8",
+            body: text.into_bytes(),
+        }
+    }
+}
+
+/// The handler `serve` calls for every GET and HEAD, with the request target as sent
+/// (`/h/0/tileset.json?x=1`).
+pub type Handler = Arc<dyn Fn(&str) -> Answer + Send + Sync>;
+
+/// The bounds of the server.
+#[derive(Debug, Clone, Copy)]
+pub struct Limits {
+    /// Connections held at once.
+    pub max_connections: usize,
+    /// Time for a whole request head.
+    pub head: Duration,
+    /// Time a connection may stay silent with no request in flight.
+    pub idle: Duration,
+    /// Time an answer may go without a byte moved.
+    pub stall: Duration,
+}
+
+/// The longest request head (request line and headers); longer is refused with 431.
 const MAX_HEAD: usize = 64 * 1024;
 
-/// How long a connection may stay silent: a browser's speculative connection that never sends
-/// a request frees its thread after this.
-const IDLE: Duration = Duration::from_secs(30);
-
-/// A request: what the handler needs of it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Request {
-    /// `GET`, `HEAD`, ...
-    pub method: String,
-    /// The request target as sent (`/h/0/tileset.json?x=1`).
-    pub url: String,
-}
-
-/// What a response carries.
-pub enum Body {
-    Bytes(Vec<u8>),
-    File(File),
-}
-
-/// A response: status, extra headers (Content-Length and Connection are added), body.
-pub struct Response {
-    pub status: u16,
-    pub headers: Vec<(&'static str, String)>,
-    pub body: Body,
-}
-
-impl Response {
-    /// A plain-text response with a status.
-    pub fn text(status: u16, text: String) -> Response {
-        Response {
-            status,
-            headers: vec![("Content-Type", "text/plain; charset=utf-8".into())],
-            body: Body::Bytes(text.into_bytes()),
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_connections: (open_files_limit() / 2).clamp(16, 10_000),
+            head: Duration::from_secs(10),
+            idle: Duration::from_secs(30),
+            stall: Duration::from_secs(60),
         }
     }
 }
 
-/// The handler `serve` calls for every request.
-pub type Handler = Arc<dyn Fn(&Request) -> Response + Send + Sync>;
-
-/// Answers every connection of `listener` until the process ends. A connection that cannot get
-/// a thread is closed (the browser retries); an accept error is skipped.
-pub fn serve(listener: TcpListener, handler: Handler) {
-    for stream in listener.incoming() {
-        let Ok(stream) = stream else { continue };
-        let handler = handler.clone();
-        // A failed spawn drops the connection: nothing else to do with it.
-        let _ = std::thread::Builder::new()
-            .name("edo-city-http".into())
-            .spawn(move || {
-                let _ = connection(stream, &*handler);
-            });
-    }
+/// The process's soft limit of open files (1024 when it has none or cannot be read).
+fn open_files_limit() -> usize {
+    let limit = rustix::process::getrlimit(rustix::process::Resource::Nofile);
+    limit
+        .current
+        .map_or(1024, |n| usize::try_from(n).unwrap_or(usize::MAX))
 }
 
-/// One connection: read a request, answer it, close.
-fn connection(
-    stream: TcpStream,
-    handler: &(dyn Fn(&Request) -> Response + Send + Sync),
-) -> io::Result<()> {
-    stream.set_read_timeout(Some(IDLE))?;
-    stream.set_write_timeout(Some(IDLE))?;
-    let _ = stream.set_nodelay(true);
-    let mut reader = BufReader::new(stream.try_clone()?);
-    let (response, head_only) = match read_head(&mut reader)? {
-        Head::Request(req) if req.method == "GET" || req.method == "HEAD" => {
-            (handler(&req), req.method == "HEAD")
-        }
-        Head::Request(_) => (Response::text(405, "only GET and HEAD\n".into()), false),
-        Head::TooLong => (Response::text(431, "request head too long\n".into()), false),
-        Head::Malformed => (Response::text(400, "not an HTTP request\n".into()), false),
-        Head::Closed => return Ok(()),
-    };
-    let mut out = io::BufWriter::new(&stream);
-    write_response(&mut out, response, head_only)?;
-    out.flush()?;
-    drop(out);
-    stream.shutdown(Shutdown::Write)
-}
-
-/// What the start of a connection held.
-#[derive(Debug, PartialEq, Eq)]
-enum Head {
-    Request(Request),
-    /// Over `MAX_HEAD` bytes without the blank line.
-    TooLong,
-    /// No request line of three words.
-    Malformed,
-    /// The client closed (or stayed silent past `IDLE`) before a request.
-    Closed,
-}
-
-/// Reads the request line and skips the headers up to the blank line.
-fn read_head(reader: &mut impl BufRead) -> io::Result<Head> {
-    let mut line = Vec::new();
-    let mut first: Option<Vec<u8>> = None;
-    let mut read = 0usize;
-    loop {
-        line.clear();
-        let n = match reader
-            .by_ref()
-            .take((MAX_HEAD - read + 1) as u64)
-            .read_until(b'\n', &mut line)
-        {
-            Ok(n) => n,
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
-                ) =>
-            {
-                return Ok(Head::Closed)
+/// Answers every connection of `listener` until the process ends.
+pub fn serve(listener: std::net::TcpListener, handler: Handler, limits: Limits) -> io::Result<()> {
+    listener.set_nonblocking(true)?;
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    runtime.block_on(async move {
+        let listener = TcpListener::from_std(listener)?;
+        let held = Arc::new(Held::default());
+        tokio::spawn(sweep(held.clone(), limits));
+        loop {
+            let stream = match listener.accept().await {
+                Ok((stream, _)) => stream,
+                Err(_) => {
+                    // Out of descriptors, most likely: free one, and do not spin.
+                    held.close_longest_idle();
+                    tokio::time::sleep(Duration::from_millis(10)).await;
+                    continue;
+                }
+            };
+            if held.len() >= limits.max_connections && !held.close_longest_idle() {
+                drop(stream);
+                continue;
             }
-            Err(e) => return Err(e),
-        };
-        if n == 0 {
-            return Ok(if first.is_none() {
-                Head::Closed
-            } else {
-                Head::Malformed
+            let _ = stream.set_nodelay(true);
+            let (id, conn) = held.add();
+            let (handler, held) = (handler.clone(), held.clone());
+            tokio::spawn(async move {
+                connection(stream, conn, handler, limits).await;
+                held.remove(id);
             });
         }
-        read += n;
-        if read > MAX_HEAD {
-            return Ok(Head::TooLong);
-        }
-        let trimmed = line.strip_suffix(b"\n").unwrap_or(&line);
-        let trimmed = trimmed.strip_suffix(b"\r").unwrap_or(trimmed);
-        match &first {
-            // Blank lines before the request line are allowed (RFC 9112 2.2).
-            None if trimmed.is_empty() => {}
-            None => first = Some(trimmed.to_vec()),
-            Some(_) if trimmed.is_empty() => break,
-            Some(_) => {}
-        }
-    }
-    let first = String::from_utf8_lossy(first.as_deref().unwrap_or_default()).into_owned();
-    let mut words = first.split(' ');
-    match (words.next(), words.next(), words.next(), words.next()) {
-        (Some(method), Some(url), Some(version), None)
-            if !method.is_empty() && url.starts_with('/') && version.starts_with("HTTP/1.") =>
-        {
-            Ok(Head::Request(Request {
-                method: method.to_string(),
-                url: url.to_string(),
-            }))
-        }
-        _ => Ok(Head::Malformed),
+    })
+}
+
+/// One connection's requests, until the client closes, a limit is passed, or it is closed
+/// to make room.
+async fn connection(stream: TcpStream, conn: Arc<Conn>, handler: Handler, limits: Limits) {
+    let io = TokioIo::new(Watched {
+        inner: stream,
+        conn: conn.clone(),
+    });
+    let service = hyper::service::service_fn({
+        let conn = conn.clone();
+        move |req| respond(req, handler.clone(), conn.clone())
+    });
+    let mut builder = hyper::server::conn::http1::Builder::new();
+    builder
+        .timer(TokioTimer::new())
+        .header_read_timeout(limits.head)
+        .max_buf_size(MAX_HEAD);
+    let served = builder.serve_connection(io, service);
+    tokio::select! {
+        _ = served => {}
+        _ = conn.close.notified() => {}
     }
 }
 
-/// The reason phrase of the statuses we send.
-fn reason(status: u16) -> &'static str {
-    match status {
-        200 => "OK",
-        400 => "Bad Request",
-        404 => "Not Found",
-        405 => "Method Not Allowed",
-        431 => "Request Header Fields Too Large",
-        _ => "Internal Server Error",
-    }
-}
+type Body = UnsyncBoxBody<Bytes, io::Error>;
 
-/// Status line, headers, and the body unless `head_only`.
-fn write_response(out: &mut impl Write, r: Response, head_only: bool) -> io::Result<()> {
-    let (len, body): (u64, Box<dyn Read>) = match r.body {
-        Body::Bytes(b) => (b.len() as u64, Box::new(io::Cursor::new(b))),
-        Body::File(f) => (f.metadata()?.len(), Box::new(f)),
+/// The response to one request; the connection counts as answering until its body is sent
+/// (or dropped).
+async fn respond(
+    req: Request<Incoming>,
+    handler: Handler,
+    conn: Arc<Conn>,
+) -> Result<Response<Body>, Infallible> {
+    let busy = Busy::new(conn);
+    if req.method() != Method::GET && req.method() != Method::HEAD {
+        let mut r = bytes(
+            405,
+            "text/plain; charset=utf-8",
+            b"only GET and HEAD\n".to_vec(),
+        );
+        r.headers_mut()
+            .insert(ALLOW, HeaderValue::from_static("GET, HEAD"));
+        return Ok(r.map(|b| busy.keep(b)));
+    }
+    let target = req
+        .uri()
+        .path_and_query()
+        .map_or("/", |p| p.as_str())
+        .to_string();
+    let handler_ = handler.clone();
+    // The handler looks at the file system (links resolved): off the runtime's thread.
+    let answer = tokio::task::spawn_blocking(move || handler_(&target))
+        .await
+        .unwrap_or_else(|_| Answer::text(500, "internal error\n".into()));
+    let response = match answer {
+        Answer::Bytes {
+            status,
+            content_type,
+            body,
+        } => bytes(status, content_type, body),
+        Answer::File { path, content_type } => file(req, path, content_type).await,
     };
-    write!(out, "HTTP/1.1 {} {}\r\n", r.status, reason(r.status))?;
-    for (k, v) in &r.headers {
-        write!(out, "{k}: {v}\r\n")?;
+    Ok(response.map(|b| busy.keep(b)))
+}
+
+/// A response of bytes in memory.
+fn bytes(status: u16, content_type: &'static str, body: Vec<u8>) -> Response<Body> {
+    let mut r = Response::new(
+        Full::new(Bytes::from(body))
+            .map_err(|never| match never {})
+            .boxed_unsync(),
+    );
+    *r.status_mut() = StatusCode::from_u16(status).unwrap_or(StatusCode::INTERNAL_SERVER_ERROR);
+    let h = r.headers_mut();
+    h.insert(CONTENT_TYPE, HeaderValue::from_static(content_type));
+    h.insert(CACHE_CONTROL, HeaderValue::from_static("no-cache"));
+    r
+}
+
+/// A file by tower-http, with our MIME type (tower-http guesses by extension, and has none
+/// for `.mtl`) and no caching without asking (a rebuilt city shows at once).
+async fn file(req: Request<Incoming>, path: PathBuf, content_type: &'static str) -> Response<Body> {
+    match ServeFile::new(path).oneshot(req).await {
+        Ok(r) => {
+            let ok = r.status().is_success();
+            let mut r = r.map(|b| b.boxed_unsync());
+            let h = r.headers_mut();
+            if ok {
+                h.insert(CONTENT_TYPE, HeaderValue::from_static(content_type));
+            }
+            h.insert(CACHE_CONTROL, HeaderValue::from_static("no-cache"));
+            r
+        }
+        Err(never) => match never {},
     }
-    if r.status == 405 {
-        write!(out, "Allow: GET, HEAD\r\n")?;
+}
+
+/// One connection as the server holds it.
+struct Conn {
+    /// Requests being answered (their bodies not yet sent).
+    busy: AtomicUsize,
+    /// Milliseconds since `Held::start` of the last byte read or written.
+    last: AtomicU64,
+    /// Closes the connection (its task stops serving it and drops the socket).
+    close: Notify,
+    start: Instant,
+}
+
+impl Conn {
+    fn touch(&self) {
+        self.last
+            .store(self.start.elapsed().as_millis() as u64, Ordering::Relaxed);
     }
-    write!(out, "Content-Length: {len}\r\nConnection: close\r\n\r\n")?;
-    if !head_only {
-        // Exactly the length announced, even if the file grew meanwhile.
-        io::copy(&mut body.take(len), out)?;
+}
+
+/// Marks its connection as answering while it lives: it travels inside the response body.
+struct Busy(Arc<Conn>);
+
+impl Busy {
+    fn new(conn: Arc<Conn>) -> Busy {
+        conn.busy.fetch_add(1, Ordering::Relaxed);
+        conn.touch();
+        Busy(conn)
     }
-    Ok(())
+
+    /// `body`, carrying this mark until it is sent or dropped.
+    fn keep(self, body: Body) -> Body {
+        Kept { body, _busy: self }.boxed_unsync()
+    }
+}
+
+/// A body with its connection's [`Busy`] mark; its length still known (a `Content-Length`,
+/// not chunks).
+struct Kept {
+    body: Body,
+    _busy: Busy,
+}
+
+impl hyper::body::Body for Kept {
+    type Data = Bytes;
+    type Error = io::Error;
+
+    fn poll_frame(
+        mut self: Pin<&mut Self>,
+        cx: &mut Context<'_>,
+    ) -> Poll<Option<Result<hyper::body::Frame<Bytes>, io::Error>>> {
+        Pin::new(&mut self.body).poll_frame(cx)
+    }
+
+    fn is_end_stream(&self) -> bool {
+        self.body.is_end_stream()
+    }
+
+    fn size_hint(&self) -> hyper::body::SizeHint {
+        self.body.size_hint()
+    }
+}
+
+impl Drop for Busy {
+    fn drop(&mut self) {
+        self.0.busy.fetch_sub(1, Ordering::Relaxed);
+        self.0.touch();
+    }
+}
+
+/// The connections held.
+struct Held {
+    start: Instant,
+    next: AtomicU64,
+    conns: Mutex<BTreeMap<u64, Arc<Conn>>>,
+}
+
+impl Default for Held {
+    fn default() -> Self {
+        Held {
+            start: Instant::now(),
+            next: AtomicU64::new(0),
+            conns: Mutex::new(BTreeMap::new()),
+        }
+    }
+}
+
+impl Held {
+    fn conns(&self) -> std::sync::MutexGuard<'_, BTreeMap<u64, Arc<Conn>>> {
+        // A panic while holding the lock leaves the map as it was: still usable.
+        self.conns.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn len(&self) -> usize {
+        self.conns().len()
+    }
+
+    fn add(&self) -> (u64, Arc<Conn>) {
+        let id = self.next.fetch_add(1, Ordering::Relaxed);
+        let conn = Arc::new(Conn {
+            busy: AtomicUsize::new(0),
+            last: AtomicU64::new(0),
+            close: Notify::new(),
+            start: self.start,
+        });
+        conn.touch();
+        self.conns().insert(id, conn.clone());
+        (id, conn)
+    }
+
+    fn remove(&self, id: u64) {
+        self.conns().remove(&id);
+    }
+
+    /// Closes the connection idle longest (none answering a request); whether there was one.
+    fn close_longest_idle(&self) -> bool {
+        let mut conns = self.conns();
+        let idle = conns
+            .iter()
+            .filter(|(_, c)| c.busy.load(Ordering::Relaxed) == 0)
+            .min_by_key(|(id, c)| (c.last.load(Ordering::Relaxed), **id))
+            .map(|(id, _)| *id);
+        match idle.and_then(|id| conns.remove(&id)) {
+            Some(c) => {
+                c.close.notify_one();
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// Closes, every quarter of the shortest limit, the connections past theirs.
+async fn sweep(held: Arc<Held>, limits: Limits) {
+    let every = (limits.idle.min(limits.stall) / 4).max(Duration::from_millis(50));
+    loop {
+        tokio::time::sleep(every).await;
+        let now = held.start.elapsed().as_millis() as u64;
+        let mut conns = held.conns();
+        conns.retain(|_, c| {
+            let quiet = Duration::from_millis(now.saturating_sub(c.last.load(Ordering::Relaxed)));
+            let limit = match c.busy.load(Ordering::Relaxed) {
+                0 => limits.idle,
+                _ => limits.stall,
+            };
+            let keep = quiet <= limit;
+            if !keep {
+                c.close.notify_one();
+            }
+            keep
+        });
+    }
+}
+
+/// A socket that notes in its connection when a byte last moved.
+struct Watched {
+    inner: TcpStream,
+    conn: Arc<Conn>,
+}
+
+impl AsyncRead for Watched {
+    fn poll_read(
+        mut self: Pin<&mut Self>,
+        cx: &mut Context<'_>,
+        buf: &mut ReadBuf<'_>,
+    ) -> Poll<io::Result<()>> {
+        let before = buf.filled().len();
+        let r = Pin::new(&mut self.inner).poll_read(cx, buf);
+        if buf.filled().len() > before {
+            self.conn.touch();
+        }
+        r
+    }
+}
+
+impl AsyncWrite for Watched {
+    fn poll_write(
+        mut self: Pin<&mut Self>,
+        cx: &mut Context<'_>,
+        buf: &[u8],
+    ) -> Poll<io::Result<usize>> {
+        let r = Pin::new(&mut self.inner).poll_write(cx, buf);
+        if matches!(r, Poll::Ready(Ok(n)) if n > 0) {
+            self.conn.touch();
+        }
+        r
+    }
+
+    fn poll_write_vectored(
+        mut self: Pin<&mut Self>,
+        cx: &mut Context<'_>,
+        bufs: &[io::IoSlice<'_>],
+    ) -> Poll<io::Result<usize>> {
+        let r = Pin::new(&mut self.inner).poll_write_vectored(cx, bufs);
+        if matches!(r, Poll::Ready(Ok(n)) if n > 0) {
+            self.conn.touch();
+        }
+        r
+    }
+
+    fn is_write_vectored(&self) -> bool {
+        self.inner.is_write_vectored()
+    }
+
+    fn poll_flush(mut self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<io::Result<()>> {
+        Pin::new(&mut self.inner).poll_flush(cx)
+    }
+
+    fn poll_shutdown(mut self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<io::Result<()>> {
+        Pin::new(&mut self.inner).poll_shutdown(cx)
+    }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn head(text: &str) -> Head {
-        read_head(&mut io::Cursor::new(text.as_bytes().to_vec())).unwrap()
-    }
-
-    #[test]
-    fn request_lines_are_read_and_bad_ones_named() {
-        assert_eq!(
-            head("GET /h/0/a.glb?x=1 HTTP/1.1\r\nHost: x\r\n\r\n"),
-            Head::Request(Request {
-                method: "GET".into(),
-                url: "/h/0/a.glb?x=1".into()
-            })
-        );
-        assert_eq!(
-            head("\r\nHEAD / HTTP/1.0\n\n"),
-            Head::Request(Request {
-                method: "HEAD".into(),
-                url: "/".into()
-            })
-        );
-        assert_eq!(head(""), Head::Closed);
-        assert_eq!(head("GET / HTTP/1.1\r\nHost: x\r\n"), Head::Malformed);
-        assert_eq!(head("hello\r\n\r\n"), Head::Malformed);
-        assert_eq!(head("GET x HTTP/1.1\r\n\r\n"), Head::Malformed);
-        let long = format!("GET / HTTP/1.1\r\nX: {}\r\n\r\n", "a".repeat(MAX_HEAD));
-        assert_eq!(head(&long), Head::TooLong);
-    }
-
-    #[test]
-    fn responses_carry_their_length_and_close() {
-        let mut out = Vec::new();
-        write_response(
-            &mut out,
-            Response::text(404, "not found: /x\n".into()),
-            false,
-        )
-        .unwrap();
-        let text = String::from_utf8(out).unwrap();
-        assert!(text.starts_with("HTTP/1.1 404 Not Found\r\n"), "{text}");
-        assert!(text.contains("Content-Length: 14\r\nConnection: close\r\n\r\nnot found: /x\n"));
-        let mut out = Vec::new();
-        write_response(&mut out, Response::text(200, "abc".into()), true).unwrap();
-        let text = String::from_utf8(out).unwrap();
-        assert!(
-            text.ends_with("Content-Length: 3\r\nConnection: close\r\n\r\n"),
-            "{text}"
-        );
-    }
-
-    /// Many clients at once, each holding its connection open until all are answered: with a
-    /// pooled server some would wait on the others; here every one is answered.
-    #[test]
-    fn concurrent_connections_are_all_answered() {
-        let listener = TcpListener::bind(("127.0.0.1", 0)).unwrap();
-        let port = listener.local_addr().unwrap().port();
-        let handler: Handler = Arc::new(|r: &Request| Response::text(200, r.url.clone()));
-        std::thread::spawn(move || serve(listener, handler));
-        for round in 0..5 {
-            let mut socks: Vec<TcpStream> = (0..12)
-                .map(|_| TcpStream::connect(("127.0.0.1", port)).unwrap())
-                .collect();
-            for (i, s) in socks.iter_mut().enumerate() {
-                s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
-                write!(
-                    s,
-                    "GET /{round}/{i} HTTP/1.1\r\nConnection: keep-alive\r\n\r\n"
-                )
-                .unwrap();
-            }
-            for (i, s) in socks.iter_mut().enumerate() {
-                let mut text = String::new();
-                s.read_to_string(&mut text).unwrap();
-                assert!(text.starts_with("HTTP/1.1 200 OK"), "{text}");
-                assert!(text.ends_with(&format!("\r\n\r\n/{round}/{i}")), "{text}");
-            }
-        }
-    }
-}
+mod tests;
