@@ -6,21 +6,10 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 
 use common::{build_ok, fixture, read_json};
-
-/// Stops the server however the test ends.
-struct Server(Child);
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 #[test]
 fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
@@ -65,25 +54,9 @@ fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
     )
     .unwrap();
 
-    let mut child = Command::new(assert_cmd::cargo::cargo_bin("edo-city"))
-        .args(["serve", "--port", "0"])
-        .arg(&a)
-        .arg(&b)
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let stdout = child.stdout.take().unwrap();
-    let server = Server(child);
-    let mut first = String::new();
-    let mut reader = BufReader::new(stdout);
-    reader.read_line(&mut first).unwrap();
-    // The rest of what it prints is read (and dropped) as it comes.
-    std::thread::spawn(move || std::io::copy(&mut reader, &mut std::io::sink()));
-    let url = first
-        .split_whitespace()
-        .find(|w| w.starts_with("http://127.0.0.1:"))
-        .unwrap_or_else(|| panic!("no URL in {first:?}"))
-        .to_string();
+    let mut serve = Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
+    serve.args(["serve", "--port", "0"]).arg(&a).arg(&b);
+    let (server, url) = common::start_server(serve);
 
     let o = Command::new("node")
         .current_dir(&viewer)

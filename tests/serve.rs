@@ -5,27 +5,17 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use std::time::Duration;
 
 use common::{build_ok, fixture};
 
-/// Stops the server however the test ends.
-struct Server(Child);
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
 /// `edo-city serve` of `out` with a viewer of a few files, under `ulimit -n 1024`; the
 /// server and its port.
-fn serve(dir: &Path, out: &Path) -> (Server, u16) {
+fn serve(dir: &Path, out: &Path) -> (common::Server, u16) {
     let viewer = dir.join("viewer");
     std::fs::create_dir_all(viewer.join("node_modules/three/build")).unwrap();
     std::fs::write(
@@ -41,27 +31,18 @@ fn serve(dir: &Path, out: &Path) -> (Server, u16) {
     .unwrap();
     std::fs::write(dir.join("secret.txt"), "not to be served").unwrap();
     std::os::unix::fs::symlink(dir.join("secret.txt"), out.join("link.txt")).unwrap();
-    let bin = assert_cmd::cargo::cargo_bin("edo-city");
-    let mut child = Command::new("sh")
-        .arg("-c")
+    let mut cmd = Command::new("sh");
+    cmd.arg("-c")
         .arg("ulimit -n 1024 && exec \"$0\" serve --port 0 --viewer \"$1\" \"$2\"")
-        .arg(bin)
+        .arg(assert_cmd::cargo::cargo_bin("edo-city"))
         .arg(&viewer)
-        .arg(out)
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let stdout = child.stdout.take().unwrap();
-    let server = Server(child);
-    let mut first = String::new();
-    let mut reader = BufReader::new(stdout);
-    reader.read_line(&mut first).unwrap();
-    std::thread::spawn(move || std::io::copy(&mut reader, &mut std::io::sink()));
-    let port = first
-        .split_whitespace()
-        .find_map(|w| w.strip_prefix("http://127.0.0.1:"))
-        .and_then(|w| w.trim_end_matches('/').parse().ok())
-        .unwrap_or_else(|| panic!("no URL in {first:?}"));
+        .arg(out);
+    let (server, url) = common::start_server(cmd);
+    let port = url
+        .trim_start_matches("http://127.0.0.1:")
+        .trim_end_matches('/')
+        .parse()
+        .unwrap_or_else(|_| panic!("no port in {url}"));
     (server, port)
 }
 

@@ -311,3 +311,32 @@ pub fn rezip(good: &[u8], entry: &str, f: impl FnOnce(&[u8]) -> Vec<u8>) -> Vec<
     }
     out.finish().unwrap().into_inner()
 }
+
+/// An `edo-city serve` process, stopped however the test ends.
+pub struct Server(pub std::process::Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Starts `cmd` (an `edo-city serve`, stdout piped) and reads the URL it prints first; what
+/// it prints later is read and dropped as it comes.
+pub fn start_server(mut cmd: std::process::Command) -> (Server, String) {
+    use std::io::BufRead;
+    let mut child = cmd.stdout(std::process::Stdio::piped()).spawn().unwrap();
+    let stdout = child.stdout.take().unwrap();
+    let server = Server(child);
+    let mut first = String::new();
+    let mut reader = std::io::BufReader::new(stdout);
+    reader.read_line(&mut first).unwrap();
+    std::thread::spawn(move || std::io::copy(&mut reader, &mut std::io::sink()));
+    let url = first
+        .split_whitespace()
+        .find(|w| w.starts_with("http://127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no URL in {first:?}"))
+        .to_string();
+    (server, url)
+}
