@@ -10,10 +10,12 @@
 //!   limit); a new one past it closes the connection that has been idle longest, so idle
 //!   connections can never keep a request out; when every one is answering, the new one is
 //!   closed (the browser retries);
-//! - a request head must arrive whole within [`Limits::head`] however slowly it trickles;
-//! - a connection with no request in flight and no byte either way for [`Limits::idle`], or
-//!   answering one with no byte moved for [`Limits::stall`] (a client that stopped reading),
-//!   is closed;
+//! - a request head must arrive whole within [`Limits::head`] of the connection's opening or
+//!   its last answer, however slowly it trickles (hyper's header timer: an idle keep-alive
+//!   connection goes then too);
+//! - a connection with no request in flight and no byte either way for [`Limits::idle`] (a
+//!   backstop to hyper's timer), or answering one with no byte moved for [`Limits::stall`]
+//!   (a client that stopped reading), is closed;
 //! - an accept error (out of descriptors) closes the longest-idle connection and waits a
 //!   moment instead of spinning.
 
