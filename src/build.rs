@@ -702,8 +702,10 @@ pub fn draw_plan_of(
     tile: Option<&str>,
     input: Option<&Path>,
     templates: Option<&Path>,
+    params: Option<&Params>,
 ) -> Result<Vec<u8>, BuildError> {
-    let manifest = shards::previous_manifest(out, "`edo-city plan` draws a finished build")?;
+    let mut manifest = shards::previous_manifest(out, "`edo-city plan` draws a finished build")?;
+    manifest.params = plan_params(&manifest.params, params)?;
     let recorded = PathBuf::from(&manifest.input.input);
     let input = match input {
         Some(i) => i.to_path_buf(),
@@ -739,6 +741,34 @@ pub fn draw_plan_of(
         }
     };
     draw_plan_from(&manifest, tile, &input, templates.as_deref())
+}
+
+/// The parameters to read the input again with: the manifest's, or the file given when the
+/// published manifest left out paths outside the input (refused when it is not the one
+/// the build used).
+fn plan_params(recorded: &Params, given: Option<&Params>) -> Result<Params, BuildError> {
+    let mut left_out = Vec::new();
+    let published = serde_json::to_value(recorded).expect("parameters serialise");
+    report::unpublished_keys(&published, "", &mut left_out);
+    let Some(given) = given else {
+        return match left_out.first() {
+            None => Ok(recorded.clone()),
+            Some(key) => Err(BuildError::Config(format!(
+                "the build's parameter `{key}` names a path outside the input, which its \
+                 published manifest leaves out: give the build's parameter file with --params"
+            ))),
+        };
+    };
+    let mut theirs = serde_json::to_value(given).expect("parameters serialise");
+    report::publish_paths(&mut theirs);
+    let mut ours = published;
+    report::publish_paths(&mut ours);
+    match shards::first_difference(&ours, &theirs, "") {
+        None => Ok(given.clone()),
+        Some(key) => Err(BuildError::Config(format!(
+            "--params is not the parameter file of this build: `{key}` differs"
+        ))),
+    }
 }
 
 /// Draws the plan of the build a manifest describes, reading `input` again (see

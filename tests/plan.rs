@@ -107,3 +107,67 @@ fn one_tile_at_full_resolution() {
         "one 250 m tile on 2400 px"
     );
 }
+
+/// A parameter naming a place outside the input by its path is published as a name and a
+/// fingerprint; `--tiles` still knows the build's parameters, and `plan` asks for the file.
+#[test]
+fn paths_outside_the_input_are_not_published_and_plan_asks_for_the_parameters() {
+    let dir = tempfile::tempdir().unwrap();
+    let secret = dir.path().join("alice-private");
+    std::fs::create_dir_all(secret.join("models")).unwrap();
+    let params = dir.path().join("p.toml");
+    let models = secret.join("models");
+    std::fs::write(
+        &params,
+        format!("[landmarks]\nmodels_dir = \"{}\"\n", models.display()),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let p = params.to_str().unwrap();
+    build_ok(&fixture("kyoto-small"), &out, &["--quiet", "--params", p]);
+    for file in ["manifest.json", "report.json"] {
+        let text = std::fs::read_to_string(out.join(file)).unwrap();
+        assert!(!text.contains("alice-private"), "{file} publishes the path");
+    }
+    let m = read_json(&out.join("manifest.json"));
+    let published = m["params"]["landmarks"]["models_dir"].as_str().unwrap();
+    assert!(
+        published.starts_with("(not published) models#"),
+        "{published}"
+    );
+    let tile = m["tiles"][0]["id"].as_str().unwrap().to_string();
+    build_ok(
+        &fixture("kyoto-small"),
+        &out,
+        &["--quiet", "--params", p, "--tiles", &tile],
+    );
+
+    let png = dir.path().join("plan.png");
+    let plan = |extra: &[&str]| {
+        edo_city()
+            .arg("plan")
+            .arg(&out)
+            .arg("--input")
+            .arg(fixture("kyoto-small"))
+            .arg("-o")
+            .arg(&png)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = plan(&[]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("landmarks.models_dir") && e.contains("--params"),
+        "{e}"
+    );
+    let other = dir.path().join("other.toml");
+    std::fs::write(&other, "[landmarks]\nmodels_dir = \"/elsewhere/models\"\n").unwrap();
+    let o = plan(&["--params", other.to_str().unwrap()]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("`landmarks.models_dir` differs"), "{e}");
+    let o = plan(&["--params", p]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(png.exists());
+}

@@ -43,7 +43,11 @@ fn read_manifest(path: &Path) -> Result<Manifest, BuildError> {
 }
 
 /// The first key where two JSON values differ, as a dotted path.
-fn first_difference(a: &serde_json::Value, b: &serde_json::Value, path: &str) -> Option<String> {
+pub(crate) fn first_difference(
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+    path: &str,
+) -> Option<String> {
     use serde_json::Value as V;
     match (a, b) {
         (V::Object(x), V::Object(y)) => {
@@ -77,13 +81,19 @@ pub fn check_out_dir(opts: &BuildOptions) -> Result<(), BuildError> {
     if opts.force && !tiles {
         return Ok(());
     }
-    let current = serde_json::to_value(&opts.params).expect("parameters serialise");
+    // Compared as published: a published manifest names paths outside the input by their
+    // fingerprints only.
+    let mut current = serde_json::to_value(&opts.params).expect("parameters serialise");
+    report::publish_paths(&mut current);
     let input = super::absolute(&opts.input);
     for path in manifests_in(&opts.out) {
         let Ok(bytes) = std::fs::read(&path) else {
             continue;
         };
-        let old: serde_json::Value = serde_json::from_slice(&bytes).unwrap_or_default();
+        let mut old: serde_json::Value = serde_json::from_slice(&bytes).unwrap_or_default();
+        if let Some(params) = old.get_mut("params") {
+            report::publish_paths(params);
+        }
         let diff = first_difference(&old["params"], &current, "")
             .map(|k| format!("the parameter `{k}` differs"))
             .or_else(|| {
@@ -240,6 +250,7 @@ pub fn write_manifest_and_report(out: &Path, manifest: &Manifest) -> Result<Repo
         None => {
             published = Manifest {
                 input: manifest.input.published(),
+                params: report::published_params(&manifest.params),
                 ..manifest.clone()
             };
             &published

@@ -76,6 +76,10 @@ pub struct PlanArgs {
     /// The `--templates` directory the build used, if any.
     #[arg(long)]
     pub templates: Option<PathBuf>,
+    /// The build's parameter file: needed when it named files outside the input by path
+    /// (the published manifest leaves those out); checked against the build's.
+    #[arg(short, long)]
+    pub params: Option<PathBuf>,
     /// Image to write.
     #[arg(short, long, default_value = "plan.png")]
     pub output: PathBuf,

@@ -193,12 +193,15 @@ pub fn plan_command(args: PlanArgs) -> Result<()> {
         tile,
         input,
         templates,
+        params,
     } = args;
+    let params = params.map(|p| load_params(Some(&p))).transpose()?;
     let png = edo_city::build::draw_plan_of(
         &out,
         tile.as_deref(),
         input.as_deref(),
         templates.as_deref(),
+        params.as_ref(),
     )?;
     edo_city::output::atomic::write_atomic(&output, &png)
         .with_context(|| format!("cannot write {}", output.display()))?;

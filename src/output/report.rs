@@ -367,6 +367,69 @@ pub fn input_id(absolute: &std::path::Path) -> String {
     hex[..16].to_string()
 }
 
+/// What stands in a published manifest for a parameter's path outside the input.
+pub const UNPUBLISHED: &str = "(not published) ";
+
+/// The parameters as a published manifest carries them: a path that names a place outside
+/// the input directory (absolute, from `~`, or climbing out with `..`: `models_dir =
+/// "/home/alice/models"`) by its last name and a fingerprint of the whole path, after
+/// [`UNPUBLISHED`]. Paths inside the input (`lots.shp`) stay; applied twice, the same.
+pub fn publish_paths(params: &mut serde_json::Value) {
+    use serde_json::Value as V;
+    match params {
+        V::Object(map) => map.values_mut().for_each(publish_paths),
+        V::Array(items) => items.iter_mut().for_each(publish_paths),
+        V::String(s) if leaves_the_input(s) => {
+            let name = std::path::Path::new(s.as_str())
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+            let hex = super::sha256_hex(s.as_bytes());
+            *s = format!("{UNPUBLISHED}{name}#{}", &hex[..16]);
+        }
+        _ => {}
+    }
+}
+
+/// Whether a parameter's string is a path to a place outside the input directory.
+fn leaves_the_input(s: &str) -> bool {
+    let path = std::path::Path::new(s);
+    !s.starts_with(UNPUBLISHED)
+        && (path.is_absolute()
+            || s.starts_with('~')
+            || s.starts_with('\\')
+            || s.get(1..3).is_some_and(|d| d == ":\\" || d == ":/")
+            || path
+                .components()
+                .any(|c| c == std::path::Component::ParentDir))
+}
+
+/// The keys of published parameters whose paths were left out (see [`publish_paths`]).
+pub fn unpublished_keys(params: &serde_json::Value, at: &str, out: &mut Vec<String>) {
+    use serde_json::Value as V;
+    let key = |k: &str| match at {
+        "" => k.to_string(),
+        _ => format!("{at}.{k}"),
+    };
+    match params {
+        V::Object(map) => map
+            .iter()
+            .for_each(|(k, v)| unpublished_keys(v, &key(k), out)),
+        V::Array(items) => items
+            .iter()
+            .enumerate()
+            .for_each(|(i, v)| unpublished_keys(v, &key(&i.to_string()), out)),
+        V::String(s) if s.starts_with(UNPUBLISHED) => out.push(at.to_string()),
+        _ => {}
+    }
+}
+
+/// [`publish_paths`] of typed parameters (strings stay strings, so they read back).
+pub fn published_params(params: &Params) -> Params {
+    let mut v = serde_json::to_value(params).expect("parameters serialise");
+    publish_paths(&mut v);
+    serde_json::from_value(v).unwrap_or_else(|_| params.clone())
+}
+
 impl InputSummary {
     /// The summary as a published manifest carries it: the input directory and the
     /// `--templates` directory by their names alone.
@@ -617,5 +680,33 @@ mod tests {
             "the lot is"
         );
         assert_eq!(reason_class("duplicate id: record 7"), "duplicate id");
+    }
+
+    #[test]
+    fn paths_outside_the_input_are_published_by_name_and_fingerprint() {
+        let mut v = serde_json::json!({
+            "layers": {"lots": {"file": "lots.shp"}, "dem": {"file": "../dem/kyoto.tif"}},
+            "models": ["/home/alice/m", "~/x", "C:\\Users\\a\\y", "sub/ok.obj"],
+            "name": "machiya",
+        });
+        publish_paths(&mut v);
+        let once = v.clone();
+        publish_paths(&mut v);
+        assert_eq!(v, once, "the same when applied twice");
+        assert_eq!(v["layers"]["lots"]["file"], "lots.shp");
+        assert_eq!(v["models"][3], "sub/ok.obj");
+        assert_eq!(v["name"], "machiya");
+        let dem = v["layers"]["dem"]["file"].as_str().unwrap();
+        assert!(dem.starts_with("(not published) kyoto.tif#"), "{dem}");
+        for i in 0..3 {
+            let s = v["models"][i].as_str().unwrap();
+            assert!(s.starts_with(UNPUBLISHED) && !s.contains("alice"), "{s}");
+        }
+        let mut keys = Vec::new();
+        unpublished_keys(&v, "", &mut keys);
+        assert_eq!(
+            keys,
+            ["layers.dem.file", "models.0", "models.1", "models.2"]
+        );
     }
 }
