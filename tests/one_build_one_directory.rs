@@ -212,6 +212,27 @@ fn merge_of_two_builds_names_the_parameter_that_differs() {
     let o = edo_city().arg("merge").arg(&a).arg(&b).output().unwrap();
     let e = stderr_of(&o);
     assert!(e.contains("the parameter `seed` differs"), "{e}");
+    // Shards of one seed in two formats (OBJ here, GLB there) are two builds too.
+    let none = dir.path().join("none.toml");
+    std::fs::write(&none, "").unwrap();
+    let o = build_with(
+        &town,
+        &b,
+        &["--quiet", "--shard", "2/2", "--force", "--format", "glb"],
+        &none,
+    );
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    let o = build_with(
+        &town,
+        &a,
+        &["--quiet", "--shard", "1/2", "--force", "--format", "obj"],
+        &none,
+    );
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    let o = edo_city().arg("merge").arg(&a).arg(&b).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr_of(&o);
+    assert!(e.contains("`output.formats` differs"), "{e}");
 }
 
 #[test]
