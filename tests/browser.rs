@@ -9,7 +9,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{build_ok, fixture, read_json};
+use common::{build_ok, read_json};
 
 #[test]
 fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
@@ -21,11 +21,16 @@ fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
     );
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("edo"), dir.path().join("other-seed"));
-    build_ok(&fixture("kyoto-small"), &a, &["--quiet", "--no-plan"]);
+    // The example town with HTML in its lots' district and its links' titles: the viewer
+    // shows both as text (browser.mjs looks for the elements they would make).
+    let town = dir.path().join("town");
+    common::copy_fixture("kyoto-small", &town);
+    with_html_in_attributes(&town);
+    build_ok(&town, &a, &["--quiet", "--no-plan"]);
     let params = dir.path().join("seed.toml");
     std::fs::write(&params, "seed = 7\n").unwrap();
     build_ok(
-        &fixture("kyoto-small"),
+        &town,
         &b,
         &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
     );
@@ -91,4 +96,33 @@ fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
     );
     assert!((eye - g - 1.6).abs() < 0.05, "{text}");
     assert_eq!(out["hypotheses"], serde_json::json!(["edo", "other-seed"]));
+}
+
+/// Writes `<b id=inj>x</b>` into every lot's `district` (the DBF's fourth field, 20 bytes
+/// from byte 41 of a record) and an `<img>` into every link's title.
+fn with_html_in_attributes(town: &Path) {
+    let dbf = town.join("lots.dbf");
+    let mut b = std::fs::read(&dbf).unwrap();
+    let count = u32::from_le_bytes(b[4..8].try_into().unwrap()) as usize;
+    let header = u16::from_le_bytes([b[8], b[9]]) as usize;
+    let len = u16::from_le_bytes([b[10], b[11]]) as usize;
+    assert_eq!(
+        &b[32 + 3 * 32..32 + 3 * 32 + 8],
+        b"district",
+        "the field's place"
+    );
+    for r in 0..count {
+        let at = header + r * len + 41;
+        b[at..at + 20].copy_from_slice(format!("{:<20}", "<b id=inj>x</b>").as_bytes());
+    }
+    std::fs::write(&dbf, b).unwrap();
+    let links = town.join("links.csv");
+    let text = std::fs::read_to_string(&links).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    for line in lines.iter_mut().skip(1) {
+        if let Some((id, rest)) = line.split_once(',') {
+            *line = format!("{id},<img id=inj2 src=x onerror=window.pwned=1>{rest}");
+        }
+    }
+    std::fs::write(&links, lines.join("\n") + "\n").unwrap();
 }

@@ -105,6 +105,9 @@ try {
     await page.waitForFunction((lot) => window.edoCity.info && window.edoCity.info.lot === lot, house.lot, { timeout: 10000 });
     const text = await page.textContent('#info');
     if (!text.includes(`lot: ${house.lot}`)) fail(`the info panel does not show lot ${house.lot}: ${text}`);
+    // The test's town has HTML in its districts: shown as text, never made into elements.
+    if (!text.includes('district: <b id=inj>x</b>')) fail(`the district is not shown as text: ${text}`);
+    if (await page.evaluate(() => document.getElementById('inj') !== null)) fail('a district became HTML');
     out.clicked = await page.evaluate(() => window.edoCity.info);
   } catch {
     fail(`clicking house ${house.lot} at ${JSON.stringify(at)} showed ${JSON.stringify(await page.evaluate(() => window.edoCity.info))}`);
@@ -149,6 +152,11 @@ try {
     await page.mouse.click(p.x, p.y);
     const info = await page.evaluate(() => window.edoCity.info);
     if (!info || info.link !== l.title) fail(`clicking link ${l.title} showed ${JSON.stringify(info)}`);
+    // Its title holds an <img> with an onerror script: text in the link, no element, no run.
+    await page.waitForTimeout(200);
+    const made = await page.evaluate(() => document.getElementById('inj2') !== null || window.pwned === 1);
+    if (made) fail(`a link title became HTML: ${l.title}`);
+    if (!(await page.textContent('#info')).includes('<img id=inj2')) fail('the link title is not shown as text');
     out.link = info;
   }
 
