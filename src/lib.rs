@@ -12,6 +12,7 @@
 
 pub mod analyse;
 pub mod author;
+pub mod bounded;
 pub mod build;
 pub mod compare;
 pub mod generate;

@@ -24,11 +24,16 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("geom", &[]),
     ("materials", &[]),
     ("rng", &[]),
+    // Reading a file a user named within bounds: for every module that reads one.
+    ("bounded", &[]),
     // The procedural growers know nothing of GIS: plane geometry and the RNG only.
     ("growers", &["geom", "rng"]),
     ("params", &["model", "growers"]),
-    ("templates", &["materials", "geom", "model", "growers"]),
-    ("input", &["model", "geom", "params"]),
+    (
+        "templates",
+        &["materials", "geom", "model", "growers", "bounded"],
+    ),
+    ("input", &["model", "geom", "params", "bounded"]),
     ("analyse", STAGE),
     ("generate", STAGE),
     (
@@ -42,6 +47,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "growers",
             "templates",
             "rng",
+            "bounded",
         ],
     ),
     ("synth", &["rng", "model", "geom"]),
@@ -80,6 +86,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
 /// edge, and the modules whose input is itself a file (parameter and template files, the
 /// synthetic town's shapefiles, `init`'s walk, `author`'s template preview).
 const FILE_SYSTEM: &[&str] = &[
+    "bounded",
     "input",
     "output",
     "build",

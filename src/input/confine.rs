@@ -10,8 +10,9 @@
 //! reading. A refusal names the path as written, never what lies outside: whether an
 //! outside file exists is not told.
 
-use std::io::Read;
 use std::path::{Component, Path, PathBuf};
+
+use crate::bounded::Refusal;
 
 /// Directories a build may read named files from.
 #[derive(Debug, Clone, Default)]
@@ -39,29 +40,14 @@ impl Confined {
     /// directories, anything but a regular file, and anything over `cap` bytes.
     pub fn read(&self, path: &Path, shown: &str, cap: u64) -> Result<Vec<u8>, String> {
         let real = self.resolve(path, shown)?;
-        let meta = std::fs::metadata(&real).map_err(|e| format!("{shown} cannot be read ({e})"))?;
-        if !meta.is_file() {
-            return Err(format!(
-                "{shown} is not a regular file (a directory, device or pipe): name a file"
-            ));
-        }
-        if meta.len() > cap {
-            return Err(format!(
-                "{shown} is {} bytes, more than the {cap} a build reads: make it smaller",
-                meta.len()
-            ));
-        }
-        let file =
-            std::fs::File::open(&real).map_err(|e| format!("{shown} cannot be read ({e})"))?;
-        let mut bytes = Vec::with_capacity(meta.len() as usize);
-        // A file that grows while it is read is cut at the cap, and refused.
-        file.take(cap + 1)
-            .read_to_end(&mut bytes)
-            .map_err(|e| format!("{shown} cannot be read ({e})"))?;
-        if bytes.len() as u64 > cap {
-            return Err(format!("{shown} grew past {cap} bytes while read"));
-        }
-        Ok(bytes)
+        crate::bounded::read(&real, cap).map_err(|e| {
+            let hint = match e {
+                Refusal::NotRegular => ": name a file",
+                Refusal::TooLarge { .. } => ": make it smaller",
+                Refusal::Grew { .. } | Refusal::Io(_) => "",
+            };
+            format!("{shown} {e}{hint}")
+        })
     }
 
     /// `path` with its links resolved, if it lies inside an allowed directory both as written

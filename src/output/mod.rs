@@ -109,25 +109,13 @@ pub const MAX_TEXTURE_BYTES: u64 = 32 << 20;
 /// A texture set's file, refused before it is opened when it is not a regular file (a FIFO
 /// named `x.png` blocked the build) or larger than [`MAX_TEXTURE_BYTES`].
 fn read_texture(path: &Path) -> Result<Vec<u8>, String> {
-    use std::io::Read;
-    let shown = path.display();
-    let meta = std::fs::metadata(path).map_err(|e| format!("{shown}: {e}"))?;
-    if !meta.is_file() {
-        return Err(format!(
-            "{shown}: not a regular file (a directory, device or pipe): remove it from the set"
-        ));
-    }
-    if meta.len() > MAX_TEXTURE_BYTES {
-        return Err(format!(
-            "{shown}: {} bytes, more than the {MAX_TEXTURE_BYTES} a texture may have",
-            meta.len()
-        ));
-    }
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_TEXTURE_BYTES).read_to_end(&mut bytes))
-        .map_err(|e| format!("{shown}: {e}"))?;
-    Ok(bytes)
+    crate::bounded::read(path, MAX_TEXTURE_BYTES).map_err(|e| {
+        let hint = match e {
+            crate::bounded::Refusal::NotRegular => ": remove it from the set",
+            _ => "",
+        };
+        format!("{} {e}{hint}", path.display())
+    })
 }
 
 /// The library with the cut-out materials' masks added (see

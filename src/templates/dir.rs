@@ -9,10 +9,10 @@
 //! an error naming the directory and the bound: a template folder that large is a mistake.
 
 use std::collections::HashSet;
-use std::io::Read;
 use std::path::{Component, Path, PathBuf};
 
 use super::TemplateError;
+use crate::bounded::Refusal;
 
 /// Folders below the template directory that are searched.
 pub const MAX_DEPTH: usize = 8;
@@ -39,27 +39,13 @@ pub fn toml_files(dir: &Path, skip: &str, recurse: bool) -> Result<Vec<PathBuf>,
 /// The text of one template or species file, refused when it is not a regular file or larger
 /// than [`MAX_FILE_BYTES`].
 pub fn read(path: &Path) -> Result<String, TemplateError> {
-    let bad = |why: String| TemplateError::Invalid(format!("{}: {why}", path.display()));
-    let meta = std::fs::metadata(path).map_err(|e| bad(format!("cannot be read ({e})")))?;
-    if !meta.is_file() {
-        return Err(bad(
-            "is not a regular file (a device or pipe): remove it".into()
-        ));
-    }
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(bad(format!(
-            "is {} bytes, more than the {MAX_FILE_BYTES} a template file may have",
-            meta.len()
-        )));
-    }
-    let mut text = String::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_string(&mut text))
-        .map_err(|e| bad(format!("cannot be read as UTF-8 text ({e})")))?;
-    if text.len() as u64 > MAX_FILE_BYTES {
-        return Err(bad(format!("grew past {MAX_FILE_BYTES} bytes while read")));
-    }
-    Ok(text)
+    crate::bounded::read_text(path, MAX_FILE_BYTES).map_err(|e| {
+        let hint = match e {
+            Refusal::NotRegular | Refusal::TooLarge { .. } => ": remove it",
+            Refusal::Grew { .. } | Refusal::Io(_) => "",
+        };
+        TemplateError::Invalid(format!("{} {e}{hint}", path.display()))
+    })
 }
 
 /// The text of the file `name` that the file `by` names beside itself (a species' hull
@@ -91,26 +77,7 @@ pub fn read_beside(by: &Path, name: &str, cap: u64) -> Result<String, String> {
     if !real.starts_with(&root) {
         return Err(outside());
     }
-    let meta = std::fs::metadata(&real).map_err(|e| format!("`{name}` cannot be read ({e})"))?;
-    if !meta.is_file() {
-        return Err(format!(
-            "`{name}` is not a regular file (a directory, device or pipe): name a file"
-        ));
-    }
-    if meta.len() > cap {
-        return Err(format!(
-            "`{name}` is {} bytes, more than the {cap} it may have",
-            meta.len()
-        ));
-    }
-    let mut text = String::new();
-    std::fs::File::open(&real)
-        .and_then(|f| f.take(cap + 1).read_to_string(&mut text))
-        .map_err(|e| format!("`{name}` cannot be read as UTF-8 text ({e})"))?;
-    if text.len() as u64 > cap {
-        return Err(format!("`{name}` grew past {cap} bytes while read"));
-    }
-    Ok(text)
+    crate::bounded::read_text(&real, cap).map_err(|e| format!("`{name}` {e}"))
 }
 
 struct Walk<'a> {
