@@ -203,7 +203,10 @@ fn finish(dir: &Path, params: &Params, file: &str, raws: Vec<Raw>, data: &mut Da
     let models_dir = models_dir(dir, params);
     // Model files, and every file they name, are read only inside the input directory and
     // the models directory the parameter file names.
-    let confined = super::confine::Confined::new([dir, models_dir.as_path()]);
+    let confined = crate::bounded::Confined::new(
+        [dir, models_dir.as_path()],
+        "the directories a build reads (the input directory, or landmarks.models_dir)",
+    );
     let mut loaded: BTreeMap<String, Result<Arc<Model>, String>> = BTreeMap::new();
     let mut seen = std::collections::HashSet::new();
     let city = data.city_box();

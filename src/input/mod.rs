@@ -19,7 +19,6 @@ pub mod table;
 pub mod widths;
 
 mod areas;
-pub mod confine;
 mod landmarks;
 mod lines;
 mod links;

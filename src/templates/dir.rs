@@ -9,10 +9,10 @@
 //! an error naming the directory and the bound: a template folder that large is a mistake.
 
 use std::collections::HashSet;
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
 use super::TemplateError;
-use crate::bounded::Refusal;
+use crate::bounded::{Confined, Refusal};
 
 /// Folders below the template directory that are searched.
 pub const MAX_DEPTH: usize = 8;
@@ -49,35 +49,19 @@ pub fn read(path: &Path) -> Result<String, TemplateError> {
 }
 
 /// The text of the file `name` that the file `by` names beside itself (a species' hull
-/// OBJ): refused when it lies outside `by`'s folder after its links are resolved (`../x`,
-/// `/etc/x`, a link out), is not a regular file (`/dev/zero` read until memory ran out) or
-/// is larger than `cap`. The refusal names the path as written, never what lies outside.
+/// OBJ), read only inside `by`'s folder after its links are resolved ([`Confined`]: not
+/// `../x`, `/etc/x` or a link out; `/dev/zero` used to be read until memory ran out), a
+/// regular file of at most `cap` bytes. A refusal names the path as written, never what
+/// lies outside.
 pub fn read_beside(by: &Path, name: &str, cap: u64) -> Result<String, String> {
-    let folder = by.parent().unwrap_or(Path::new("."));
-    let outside = || {
-        format!(
-            "`{name}` lies outside the folder of {} (after links are resolved): put the file              beside it and name it by a relative path",
-            by.display()
-        )
-    };
-    // As written first, so that whether a path outside exists is never told.
-    let mut depth = 0usize;
-    for c in Path::new(name).components() {
-        match c {
-            Component::Normal(_) => depth += 1,
-            Component::CurDir => {}
-            Component::ParentDir if depth > 0 => depth -= 1,
-            _ => return Err(outside()),
-        }
-    }
-    let root = std::fs::canonicalize(folder)
-        .map_err(|e| format!("the folder of {} cannot be read ({e})", by.display()))?;
-    let real = std::fs::canonicalize(folder.join(name))
-        .map_err(|_| format!("`{name}` does not exist beside {}", by.display()))?;
-    if !real.starts_with(&root) {
-        return Err(outside());
-    }
-    crate::bounded::read_text(&real, cap).map_err(|e| format!("`{name}` {e}"))
+    let folder = by
+        .parent()
+        .filter(|f| !f.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let places = format!("the folder of {}", by.display());
+    let bytes =
+        Confined::new([folder], &places).read(&folder.join(name), &format!("`{name}`"), cap)?;
+    String::from_utf8(bytes).map_err(|_| format!("`{name}` is not UTF-8 text"))
 }
 
 struct Walk<'a> {

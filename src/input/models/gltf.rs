@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use super::{excerpt, grey_material, image_kind, stem_of, texture, too_many};
 use super::{MAX_MODEL_BYTES, MAX_TRIANGLES};
-use crate::input::confine::Confined;
+use crate::bounded::Confined;
 use crate::model::landmark::{Model, ModelMaterial, ModelTriangle};
 
 /// The most nodes a scene may place (a node reached twice through a DAG counts twice): a

@@ -13,7 +13,7 @@ use std::cell::RefCell;
 use std::path::Path;
 use std::sync::Arc;
 
-use super::confine::Confined;
+use crate::bounded::Confined;
 use crate::model::landmark::{Model, ModelMaterial, ModelTriangle};
 
 /// The most triangles a model may have: a landmark is one building, and a scan of a city

@@ -1,18 +1,19 @@
 //! Reading a file that a user's data names (a landmark's model, its MTL, a texture, a glTF
-//! buffer) only inside the directories the user gave for it.
+//! buffer, a species' hull) only inside the directories the user gave for it.
 //!
 //! A model file comes from anywhere (a download, a colleague's export) and names further
 //! files by paths of its own: `map_Kd /home/me/.ssh/id.png`, a buffer `../../x` or
 //! `file:///dev/zero`. Whatever such a file names ends up in the published tiles, so a build
-//! reads it only when it lies inside an allowed directory (the input directory, or the
-//! `landmarks.models_dir` the parameter file names) after every link is resolved, is a
+//! reads it only when it lies inside an allowed directory (for a landmark the input directory
+//! or the `landmarks.models_dir` the parameter file names; for a hull its species file's
+//! folder) after every link is resolved, is a
 //! regular file (no device, FIFO or directory), and is no larger than a cap checked before
 //! reading. A refusal names the path as written, never what lies outside: whether an
 //! outside file exists is not told.
 
 use std::path::{Component, Path, PathBuf};
 
-use crate::bounded::Refusal;
+use super::Refusal;
 
 /// Directories a build may read named files from.
 #[derive(Debug, Clone, Default)]
@@ -21,12 +22,17 @@ pub struct Confined {
     lexical: Vec<PathBuf>,
     /// ... and with its links resolved (when it exists).
     canonical: Vec<PathBuf>,
+    /// The directories in words, for a refusal ("the input directory, or ...").
+    places: String,
 }
 
 impl Confined {
-    /// Allows reading inside each of `roots`.
-    pub fn new<'a>(roots: impl IntoIterator<Item = &'a Path>) -> Self {
-        let mut c = Confined::default();
+    /// Allows reading inside each of `roots`, which a refusal names as `places`.
+    pub fn new<'a>(roots: impl IntoIterator<Item = &'a Path>, places: &str) -> Self {
+        let mut c = Confined {
+            places: places.to_string(),
+            ..Confined::default()
+        };
         for root in roots {
             c.lexical.push(normalise(root));
             if let Ok(r) = std::fs::canonicalize(root) {
@@ -40,7 +46,7 @@ impl Confined {
     /// directories, anything but a regular file, and anything over `cap` bytes.
     pub fn read(&self, path: &Path, shown: &str, cap: u64) -> Result<Vec<u8>, String> {
         let real = self.resolve(path, shown)?;
-        crate::bounded::read(&real, cap).map_err(|e| {
+        super::read(&real, cap).map_err(|e| {
             let hint = match e {
                 Refusal::NotRegular => ": name a file",
                 Refusal::TooLarge { .. } => ": make it smaller",
@@ -55,8 +61,8 @@ impl Confined {
     pub fn resolve(&self, path: &Path, shown: &str) -> Result<PathBuf, String> {
         let outside = || {
             format!(
-                "{shown} lies outside the directories a build reads (the input directory, or \
-                 landmarks.models_dir): copy the file there and name it by a relative path"
+                "{shown} lies outside {}: copy the file there and name it by a relative path",
+                self.places
             )
         };
         let lexical = normalise(path);
@@ -75,7 +81,7 @@ impl Confined {
 
 /// `path` made absolute with `.` and `..` taken out as written (no file system access, so
 /// nothing is learnt of paths outside).
-pub fn normalise(path: &Path) -> PathBuf {
+fn normalise(path: &Path) -> PathBuf {
     let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
     let mut out = PathBuf::new();
     for c in abs.components() {
@@ -101,7 +107,7 @@ mod tests {
         std::fs::create_dir(&inside).unwrap();
         std::fs::write(inside.join("a.png"), b"abc").unwrap();
         std::fs::write(top.path().join("secret.png"), b"secret").unwrap();
-        let c = Confined::new([inside.as_path()]);
+        let c = Confined::new([inside.as_path()], "the directory");
         assert_eq!(c.read(&inside.join("a.png"), "a.png", 10).unwrap(), b"abc");
         let up = c.read(&inside.join("../secret.png"), "../secret.png", 10);
         assert!(up.unwrap_err().contains("outside"));
@@ -123,7 +129,7 @@ mod tests {
                 .read(&inside.join("z.png"), "z", 10)
                 .unwrap_err()
                 .contains("outside"));
-            let dev = Confined::new([Path::new("/dev")]);
+            let dev = Confined::new([Path::new("/dev")], "/dev");
             let e = dev.read(Path::new("/dev/zero"), "zero", 10).unwrap_err();
             assert!(e.contains("not a regular file"), "{e}");
         }

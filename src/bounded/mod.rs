@@ -6,11 +6,16 @@
 //! a file far larger than any real one. [`read`] opens only a regular file, checks its size
 //! against a cap before it opens it, and reads at most one byte past the cap, so a file that
 //! grows while it is read is refused too. Callers say what the file is and what to do.
+//! [`Confined`] adds where: a file a user's file names is read only inside the directories
+//! given for it, after its links are resolved.
 
 use std::io::Read;
 use std::path::Path;
 
 use thiserror::Error;
+
+mod confine;
+pub use confine::Confined;
 
 /// Why a file was not read.
 #[derive(Debug, Error)]
