@@ -244,6 +244,12 @@ fn temples_get_gardens_clear_of_buildings_with_trees_and_people_kept_out() {
     }
 }
 
+/// 200 m west of the town's westmost lot corner: open ground in no lot.
+fn west_of_town(data: &edo_city::model::Dataset) -> f64 {
+    let corners = data.lots.iter().flat_map(|l| l.outline.exterior().0.iter());
+    corners.map(|q| q.x).fold(f64::INFINITY, f64::min) - 200.0
+}
+
 /// Writes a polygon layer with an `id` field (no `.prj`: the town's CRS is assumed).
 fn write_areas(path: &std::path::Path, areas: &[(&str, Vec<geo_types::Coord<f64>>)]) {
     let name = |n: &str| dbase::FieldName::try_from(n).unwrap();
@@ -290,11 +296,7 @@ fn the_polygons_of_a_gardens_layer_get_gardens_whatever_their_lots_use() {
             y: c.y + (q.y - c.y) * 0.8,
         })
         .collect();
-    let corners = before
-        .lots
-        .iter()
-        .flat_map(|l| l.outline.exterior().0.iter());
-    let x0 = corners.map(|q| q.x).fold(f64::INFINITY, f64::min) - 200.0;
+    let x0 = west_of_town(&before);
     let rect = |x: f64, y: f64, w: f64, d: f64| {
         vec![
             geo_types::Coord { x, y },
@@ -408,11 +410,7 @@ fn a_hole_outside_its_ring_is_a_part_of_its_own_and_the_record_built_in_part() {
     common::synth(&town, 300, 4);
     let params = edo_city::params::Params::default();
     let before = edo_city::input::read_dataset(&town, &params).expect("reads");
-    let corners = before
-        .lots
-        .iter()
-        .flat_map(|l| l.outline.exterior().0.iter());
-    let x0 = corners.map(|q| q.x).fold(f64::INFINITY, f64::min) - 200.0;
+    let x0 = west_of_town(&before);
     let y0 = before.lots[0].outline.exterior().0[0].y;
     let name = |n: &str| dbase::FieldName::try_from(n).unwrap();
     let table = dbase::TableWriterBuilder::new().add_character_field(name("id"), 10);

@@ -4,9 +4,10 @@
 //! The key used to take each file's size and time of writing: a `lots.dbf` rewritten with the
 //! same size and `touch -r` reused a stale analysis, and `models_dir` and
 //! `machiya.templates` (which the build resolves against the current directory) were looked
-//! for under the input directory. Now each file's bytes go into the key (sha256, which runs
-//! at about 1.5 GB/s with the CPU's SHA instructions: a million-lot input of 300 MB adds a
-//! fifth of a second to a `--tiles` run that saves minutes of analysis).
+//! for under the input directory. Now each file's bytes go into the key (sha256, with the
+//! CPU's SHA instructions where it has them: at a million lots, hashing the 198 MB input and
+//! checking the cache file's own sha256 made a cached tile 4.3 s instead of 3.5 s, against
+//! 16.3 s without the cache).
 //!
 //! What is hashed: the input directory (but not an `--out` inside it); the template
 //! directory `load_catalog` reads (`--templates`, else `machiya.templates`); the top level of
@@ -226,6 +227,7 @@ impl Keyer {
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::written_at;
     use super::*;
 
     fn opts(input: &Path, out: &Path) -> BuildOptions {
@@ -239,17 +241,6 @@ mod tests {
             selection: crate::build::Selection::All,
             force: false,
         }
-    }
-
-    /// Sets `f`'s time of writing back to a fixed second (as `touch -r` does).
-    fn written_at(f: &Path, secs: u64) {
-        let t = std::time::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + secs);
-        fs::File::options()
-            .write(true)
-            .open(f)
-            .unwrap()
-            .set_modified(t)
-            .unwrap();
     }
 
     #[test]

@@ -261,8 +261,9 @@ mod tests {
         assert!(load(&file, &key).is_none());
     }
 
-    /// Sets `f`'s time of writing to `secs` after a fixed day long past.
-    fn written_at(f: &Path, secs: u64) {
+    /// Sets `f`'s time of writing to `secs` after a fixed day long past (as `touch -r`
+    /// does); the key's tests use it too.
+    pub(super) fn written_at(f: &Path, secs: u64) {
         let t = std::time::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + secs);
         let file = fs::File::options().write(true).open(f).unwrap();
         file.set_modified(t).unwrap();

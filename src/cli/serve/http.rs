@@ -189,9 +189,8 @@ async fn respond(
         .path_and_query()
         .map_or("/", |p| p.as_str())
         .to_string();
-    let handler_ = handler.clone();
     // The handler looks at the file system (links resolved): off the runtime's thread.
-    let answer = tokio::task::spawn_blocking(move || handler_(&target))
+    let answer = tokio::task::spawn_blocking(move || handler(&target))
         .await
         .unwrap_or_else(|_| Answer::text(500, "internal error\n".into()));
     let response = match answer {
