@@ -227,8 +227,8 @@ impl Keyer {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::written_at;
     use super::*;
+    use crate::build::cache::tests::written_at;
 
     fn opts(input: &Path, out: &Path) -> BuildOptions {
         BuildOptions {
