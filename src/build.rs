@@ -286,6 +286,12 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcom
     })
 }
 
+/// A GeoPackage that could not be written, as any other file.
+fn gpkg_err(e: output::gpkg::GpkgError) -> BuildError {
+    let (path, cause) = e.into_io();
+    write_err(&path, cause)
+}
+
 fn write_err(path: &Path, cause: std::io::Error) -> BuildError {
     let full = cause.raw_os_error() == Some(28) || cause.kind() == std::io::ErrorKind::StorageFull;
     let hint = if full {
@@ -379,6 +385,7 @@ fn run(
                 &plan,
                 timings,
                 t0,
+                reused,
             )
         })
     });
@@ -422,6 +429,7 @@ fn write_city(
     plan: &Plan,
     mut timings: Timings,
     t0: Instant,
+    reused: bool,
 ) -> Result<BuildOutcome, BuildError> {
     let params = &opts.params;
 
@@ -562,7 +570,19 @@ fn write_city(
             })
             .collect()
     };
-    let ((image, plan_time), results) = rayon::join(draw_plan, make_tiles);
+    // plan.gpkg: the layers analysis alone decides are written while the tiles are made,
+    // the rest once their manifest is known. A `--tiles` run whose analysis came from the
+    // cache leaves the full build's file as it is: the same analysis wrote it.
+    let gpkg_path = opts.out.join(output::PLAN_GPKG);
+    let sources = output::gpkg::PlanSources { data, plan, params };
+    let want_gpkg = params.output.formats.iter().any(|f| f == "gpkg")
+        && !opts.selection.is_shard()
+        && !(reused && gpkg_path.is_file());
+    let start_gpkg = || {
+        want_gpkg.then(|| output::gpkg::PlanWriter::start(&gpkg_path, &sources).map_err(gpkg_err))
+    };
+    let (((image, plan_time), gpkg), results) =
+        rayon::join(|| rayon::join(draw_plan, start_gpkg), make_tiles);
     progress.finish();
     timings.generate_cpu = Duration::from_nanos(gen_ns.into_inner());
     timings.write_cpu = Duration::from_nanos(write_ns.into_inner());
@@ -618,6 +638,9 @@ fn write_city(
     // A shard's tiles are only part of the city: `merge` writes the tileset.
     if manifest.shard.is_none() {
         shards::finish_formats(&opts.out, &mut manifest)?;
+    }
+    if let Some(writer) = gpkg {
+        writer?.finish(&sources, &manifest).map_err(gpkg_err)?;
     }
     timings.generate_and_write = t.elapsed();
     let t = Instant::now();
@@ -782,10 +805,21 @@ pub fn draw_plan_from(
     let params = &manifest.params;
     let catalog = load_catalog(params, templates)?;
     let (data, plan, _, _) = read_and_analyse(input, params, &catalog, &NoProgress)?;
+    draw_analysed(&data, &plan, params, tile, input)
+}
+
+/// The plan image of an analysed city, or of one of its tiles.
+fn draw_analysed(
+    data: &Dataset,
+    plan: &Plan,
+    params: &Params,
+    tile: Option<&str>,
+    input: &Path,
+) -> Result<Vec<u8>, BuildError> {
     let bounds = match tile {
         None => None,
         Some(id) => {
-            let tiles = shards::list_tiles(&plan, params.tile_size, params.tile_origin);
+            let tiles = shards::list_tiles(plan, params.tile_size, params.tile_origin);
             let t = tiles.iter().find(|t| t.id == id).ok_or_else(|| {
                 BuildError::Config(format!(
                     "no tile {id} in this build; `edo-city tiles {}` lists them",
@@ -796,9 +830,43 @@ pub fn draw_plan_from(
         }
     };
     let grid = (params.tile_size, params.tile_origin);
-    output::plan::View::fit(&data, bounds)
-        .and_then(|view| output::plan::draw_plan(&data, &plan, &view, grid, kura_view(params)))
+    output::plan::View::fit(data, bounds)
+        .and_then(|view| output::plan::draw_plan(data, plan, &view, grid, kura_view(params)))
         .ok_or_else(|| BuildError::Config("nothing to draw: no lots or footprints".into()))
+}
+
+/// What `merge` writes from the input read again, as a full build writes it beside its
+/// tiles: `plan.png` (with `draw_plan`) and `plan.gpkg` (when the formats name gpkg). The
+/// input and parameters are the shards' (`manifest` is the merged one).
+pub fn merge_plan_files(
+    manifest: &report::Manifest,
+    input: &Path,
+    templates: Option<&Path>,
+    draw_plan: bool,
+    out: &Path,
+) -> Result<(), BuildError> {
+    let params = &manifest.params;
+    let gpkg = params.output.formats.iter().any(|f| f == "gpkg");
+    if !draw_plan && !gpkg {
+        return Ok(());
+    }
+    let catalog = load_catalog(params, templates)?;
+    let (data, plan, _, _) = read_and_analyse(input, params, &catalog, &NoProgress)?;
+    if draw_plan {
+        let png = draw_analysed(&data, &plan, params, None, input)?;
+        let path = out.join("plan.png");
+        output::atomic::write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
+    }
+    if gpkg {
+        let sources = output::gpkg::PlanSources {
+            data: &data,
+            plan: &plan,
+            params,
+        };
+        output::gpkg::write_plan(&out.join(output::PLAN_GPKG), &sources, manifest)
+            .map_err(gpkg_err)?;
+    }
+    Ok(())
 }
 
 /// The DEM and a tile's bounds, when `terrain = true` and there is a DEM.

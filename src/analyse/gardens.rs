@@ -12,7 +12,7 @@
 //! hall's veranda, as Ryoanji's from its hojo. Runs before the billboards, which keep out of
 //! the gardens.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 
 use geo::{Centroid, Contains, Point};
 use geo_types::{Coord, Polygon};
@@ -232,6 +232,7 @@ fn design(site: &Site, obstacles: &Obstacles, p: &Params) -> (GardenStat, Option
         size,
         fitness,
         stones,
+        scores: BTreeMap::new(),
     };
     let Some((corner, angle, size)) = place(site, obstacles, p) else {
         let reason = format!(
@@ -272,8 +273,16 @@ fn design(site: &Site, obstacles: &Obstacles, p: &Params) -> (GardenStat, Option
         stones,
     };
     let n = best.layout.stones.len();
+    let scores = crate::growers::garden::rules::WEIGHTS
+        .iter()
+        .zip(best.scores)
+        .map(|((rule, _), v)| (rule.to_string(), v))
+        .collect();
     (
-        stat(true, String::new(), size, best.fitness, n),
+        GardenStat {
+            scores,
+            ..stat(true, String::new(), size, best.fitness, n)
+        },
         Some(garden),
     )
 }

@@ -289,8 +289,8 @@ pub fn remove_stale_tiles(out: &Path, tiles: &[report::ManifestTile]) {
 }
 
 /// Merges the shard outputs in `dirs` into the first: tiles of the others are copied over,
-/// then `manifest.json`, `report.json` and (with `draw_plan`) `plan.png` are written for the
-/// whole city, byte-identical to a full build's, and the shard manifests are removed.
+/// then `manifest.json`, `report.json`, `plan.gpkg` (when the formats name it) and (with
+/// `draw_plan`) `plan.png` are written for the whole city, byte-identical to a full build's, and the shard manifests are removed.
 pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     let Some(target) = dirs.first() else {
         return Err(BuildError::Config(
@@ -412,14 +412,10 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     finish_formats(target, &mut merged)?;
     // The whole city's plan, as a full build draws it (shards leave it to the merge); drawn
     // before the manifest, which is written last, so a failing plan leaves no merged manifest.
-    if draw_plan {
-        // The shards' manifests hold the input's path (the merged one will not).
-        let input = PathBuf::from(&first.input.input);
-        let templates = first.input.templates.as_ref().map(PathBuf::from);
-        let png = super::draw_plan_from(&merged, None, &input, templates.as_deref())?;
-        let path = target.join("plan.png");
-        write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
-    }
+    // The shards' manifests hold the input's path (the merged one will not).
+    let input = PathBuf::from(&first.input.input);
+    let templates = first.input.templates.as_ref().map(PathBuf::from);
+    super::merge_plan_files(&merged, &input, templates.as_deref(), draw_plan, target)?;
     // The first shard wrote the texture set its parameters chose into `target/textures`.
     let rep = write_manifest_and_report(target, &merged)?;
     for (_, path, m) in &shards {

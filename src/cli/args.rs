@@ -45,8 +45,9 @@ pub struct BuildArgs {
     /// Replace an output directory that holds a build of other parameters or input.
     #[arg(long)]
     pub force: bool,
-    /// The tile formats, comma-separated: obj (OBJ + MTL), glb (binary glTF + tileset.json);
-    /// wins over `output.formats` of the parameter file (default: both).
+    /// The formats, comma-separated: obj (OBJ + MTL), glb (binary glTF + tileset.json), gpkg
+    /// (plan.gpkg, the decisions as GIS layers); wins over `output.formats` of the parameter
+    /// file (default: all three).
     #[arg(long, value_delimiter = ',')]
     pub format: Option<Vec<String>>,
 }

@@ -78,7 +78,7 @@ fn read_areas(
             &id,
             f.record,
             &mut seen,
-            &mut data.skipped,
+            (&mut data.skipped, &mut data.skipped_shapes),
         );
         for (id, outline) in parts {
             out.push(GardenArea {

@@ -9,7 +9,7 @@ use super::fields::AttributeRule;
 use super::geometry::{check_polygon, map_polygon, polygons_of};
 use super::target::to_target;
 use super::{join, rule, shp, table, InputError, Opened};
-use crate::model::{Dataset, Footprint, Lot, LotUse, Skipped};
+use crate::model::{Dataset, Footprint, Lot, LotUse, Skipped, SkippedShape};
 use crate::params::Params;
 
 pub(super) fn read_lots(
@@ -66,7 +66,7 @@ pub(super) fn read_lots(
             &base_id,
             f.record,
             &mut seen,
-            &mut data.skipped,
+            (&mut data.skipped, &mut data.skipped_shapes),
         );
         let count = parts.len();
         let mut record_attrs = Some(f.attrs);
@@ -112,6 +112,12 @@ pub(super) fn read_lots(
     lots.retain(|lot| match ground_problem(lot.ground) {
         None => true,
         Some(reason) => {
+            data.skipped_shapes.push(SkippedShape {
+                layer: o.role.into(),
+                record: lot.record,
+                id: lot.id.clone(),
+                shape: lot.outline.clone(),
+            });
             data.skipped.push(Skipped {
                 layer: o.role.into(),
                 file: o.file.clone(),
@@ -213,7 +219,7 @@ pub(super) fn read_footprints(
             &base_id,
             f.record,
             &mut seen,
-            &mut data.skipped,
+            (&mut data.skipped, &mut data.skipped_shapes),
         ) {
             if let Some(reason) = ground_problem(g) {
                 data.skipped.push(Skipped {
@@ -393,7 +399,7 @@ pub(super) fn checked_parts(
     base_id: &str,
     record: usize,
     seen: &mut HashSet<String>,
-    skipped: &mut Vec<Skipped>,
+    (skipped, shapes): (&mut Vec<Skipped>, &mut Vec<SkippedShape>),
 ) -> Vec<(String, geo_types::Polygon<f64>)> {
     let multi = polys.len() > 1;
     let mut out = Vec::with_capacity(polys.len());
@@ -403,7 +409,9 @@ pub(super) fn checked_parts(
         } else {
             base_id.to_string()
         };
-        let reason = map_polygon(&mut poly, &mut |c| to_target(o, target, c))
+        let mapped = map_polygon(&mut poly, &mut |c| to_target(o, target, c));
+        let reason = mapped
+            .clone()
             .and_then(|_| check_polygon(&poly))
             .err()
             .or_else(|| {
@@ -413,6 +421,14 @@ pub(super) fn checked_parts(
                         .to_string()
                 })
             });
+        if reason.is_some() && mapped.is_ok() && near_origin(&poly) {
+            shapes.push(SkippedShape {
+                layer: o.role.into(),
+                record,
+                id: id.clone(),
+                shape: poly.clone(),
+            });
+        }
         match reason {
             Some(reason) => skipped.push(Skipped {
                 layer: o.role.into(),
@@ -425,4 +441,13 @@ pub(super) fn checked_parts(
         }
     }
     out
+}
+
+/// Whether every vertex of a polygon is a usable coordinate (finite, nearer than
+/// [`crate::model::FAR`]): only those are kept to draw a skipped record.
+fn near_origin(poly: &geo_types::Polygon<f64>) -> bool {
+    std::iter::once(poly.exterior())
+        .chain(poly.interiors())
+        .flat_map(|r| r.0.iter())
+        .all(|c| crate::model::sane(*c))
 }

@@ -237,6 +237,20 @@ pub struct Skipped {
     pub reason: String,
 }
 
+/// The outline of a record skipped while reading, where it had a usable one (a repeated id,
+/// a ground out of range): `plan.gpkg` and `check --gpkg` draw the skip there.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SkippedShape {
+    /// The layer's role, as in its [`Skipped`].
+    pub layer: String,
+    /// The record, as in its [`Skipped`].
+    pub record: usize,
+    /// The feature's id, as in its [`Skipped`].
+    pub id: String,
+    /// Its outline, in the output CRS.
+    pub shape: Polygon<f64>,
+}
+
 /// Everything read from the input directory, in input order. (Serialized only into the
 /// analysis cache, `build::cache`, with the plan made from it.)
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
@@ -277,6 +291,8 @@ pub struct Dataset {
     /// Features left out while reading, with their reasons.
     #[serde(with = "as_json")]
     pub skipped: Vec<Skipped>,
+    /// The outlines of skipped records that had one.
+    pub skipped_shapes: Vec<SkippedShape>,
     /// What reading noticed.
     #[serde(with = "as_json")]
     pub warnings: Vec<Warning>,
@@ -875,6 +891,10 @@ pub struct GardenStat {
     /// Its stones.
     #[serde(default)]
     pub stones: usize,
+    /// The best layout's degree of violation of each of seed 000's five rules, by rule name
+    /// (0: the rule is kept).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub scores: BTreeMap<String, f64>,
 }
 
 /// What generation found in one tile.

@@ -42,11 +42,7 @@ fn write_pieces<'a>(
     count: usize,
     mut piece: impl FnMut(usize) -> &'a [u8],
 ) -> std::io::Result<()> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", run_token()));
+    let tmp = temporary_for(path);
     let result = (|| {
         let mut f = fs::File::create(&tmp)?;
         for i in 0..count {
@@ -84,6 +80,16 @@ pub fn write_atomic_hashed(path: &Path, parts: &[&[u8]]) -> std::io::Result<Stri
         pieces[i]
     })?;
     Ok(super::hex(&h.finalize()))
+}
+
+/// The temporary name `path` is written under before its rename: beside it, hidden, and
+/// swept by [`remove_leftover_temporaries`] when a killed run leaves it.
+pub fn temporary_for(path: &Path) -> std::path::PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.tmp-{}", run_token()))
 }
 
 /// This process's part of a temporary name: its pid and a random number drawn once, so the

@@ -9,6 +9,10 @@ pub mod atomic;
 pub mod chart;
 pub mod features;
 pub mod gltf;
+pub mod gpkg;
+
+/// The build's decisions as GIS layers, beside the tiles.
+pub const PLAN_GPKG: &str = "plan.gpkg";
 pub mod links;
 pub mod lock;
 pub mod obj;

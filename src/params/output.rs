@@ -3,14 +3,16 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The formats a build can write, as `--format` and `output.formats` spell them.
-pub const FORMATS: &[&str] = &["obj", "glb"];
+/// The formats a build can write, as `--format` and `output.formats` spell them: two of
+/// tiles, and `gpkg`, the build's decisions as GIS layers (`plan.gpkg`).
+pub const FORMATS: &[&str] = &["obj", "glb", "gpkg"];
 
 /// The output's settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputParams {
-    /// The tile formats: `obj` (OBJ + MTL), `glb` (binary glTF, with `tileset.json`).
+    /// The formats: `obj` (OBJ + MTL), `glb` (binary glTF, with `tileset.json`), `gpkg`
+    /// (`plan.gpkg`, the decisions as GIS layers).
     pub formats: Vec<String>,
     /// OBJ objects: `"each"` (one per house, kura, wall..., named by its lot: pick a house in
     /// Blender by name) or `"kind"` (one per kind with one run per material: a few dozen
@@ -45,6 +47,9 @@ pub fn check_formats(formats: &[String]) -> Result<(), String> {
             "unknown format `{f}`: the formats are {}",
             FORMATS.join(", ")
         )),
+        None if formats.iter().all(|f| f == "gpkg") => {
+            Err("name a tile format (obj or glb) beside gpkg: plan.gpkg describes the tiles".into())
+        }
         None => Ok(()),
     }
 }

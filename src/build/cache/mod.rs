@@ -211,6 +211,7 @@ mod tests {
             size: [1.0 / 3.0, 2.0],
             fitness: 0.7,
             stones: 0,
+            scores: [("axis".to_string(), 0.1 + 0.2)].into_iter().collect(),
         });
         let mut data = Dataset::default();
         let mut names = crate::model::FieldNames::default();

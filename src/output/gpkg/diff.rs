@@ -1,0 +1,266 @@
+//! `compare A B --gpkg diff.gpkg`: the lots two hypotheses disagree on (type, kura, house,
+//! trees), with both values, and the tiles that differ, read from the two builds'
+//! `plan.gpkg` and written as a GeoPackage of their own.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use rusqlite::{Connection, OpenFlags};
+
+use super::layers::{opt, t};
+use super::styles::{self, Look, Shape};
+use super::{int, text, GeoPackage, GeomKind, GpkgError, Srs, Value};
+
+/// Why a difference layer could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum DiffError {
+    /// A build has no `plan.gpkg` (made before it existed, or without `gpkg` in `--format`).
+    #[error(
+        "{0} does not exist: build that hypothesis again with gpkg among its formats (the \
+         default), then compare"
+    )]
+    Missing(PathBuf),
+    /// A `plan.gpkg` is not one a build wrote.
+    #[error("{path} cannot be read as a build's plan.gpkg ({why}): build that hypothesis again")]
+    Unreadable {
+        /// The file.
+        path: PathBuf,
+        /// SQLite's words.
+        why: String,
+    },
+    /// Writing the result failed.
+    #[error(transparent)]
+    Write(#[from] GpkgError),
+}
+
+/// One lot of a build, as its `lots` layer has it.
+#[derive(Debug, Clone, PartialEq)]
+struct LotRow {
+    record: Option<i64>,
+    geom: Option<Vec<u8>>,
+    mtype: Option<String>,
+    kura: Option<String>,
+    status: Option<String>,
+    trees: Option<i64>,
+}
+
+/// What is compared of a lot, by name.
+const ASPECTS: [&str; 4] = ["type", "kura", "house", "trees"];
+
+/// The `lots` layer of a difference: each aspect in A, then in B.
+const LOT_COLUMNS: [super::Column; 11] = [
+    text("id"),
+    int("record"),
+    text("differs"),
+    text("type_a"),
+    text("type_b"),
+    text("kura_a"),
+    text("kura_b"),
+    text("house_a"),
+    text("house_b"),
+    int("trees_a"),
+    int("trees_b"),
+];
+
+impl LotRow {
+    fn values(&self) -> [Value; 4] {
+        [
+            opt(self.mtype.as_deref()),
+            opt(self.kura.as_deref()),
+            opt(self.status.as_deref()),
+            self.trees.map_or(Value::Null, Value::Integer),
+        ]
+    }
+}
+
+struct Build {
+    conn: Connection,
+    path: PathBuf,
+}
+
+impl Build {
+    fn open(dir: &Path) -> Result<Build, DiffError> {
+        let path = dir.join("plan.gpkg");
+        if !path.is_file() {
+            return Err(DiffError::Missing(path));
+        }
+        let conn = Connection::open_with_flags(&path, OpenFlags::SQLITE_OPEN_READ_ONLY)
+            .map_err(|e| unreadable(&path, e))?;
+        Ok(Build { conn, path })
+    }
+
+    fn lots(&self) -> Result<BTreeMap<String, LotRow>, DiffError> {
+        let read = || -> rusqlite::Result<BTreeMap<String, LotRow>> {
+            let mut q = self.conn.prepare(
+                "SELECT id, record, geom, type, kura, status, trees FROM lots ORDER BY fid",
+            )?;
+            let rows = q.query_map([], |r| {
+                Ok((
+                    r.get::<_, Option<String>>(0)?.unwrap_or_default(),
+                    LotRow {
+                        record: r.get(1)?,
+                        geom: r.get(2)?,
+                        mtype: r.get(3)?,
+                        kura: r.get(4)?,
+                        status: r.get(5)?,
+                        trees: r.get(6)?,
+                    },
+                ))
+            })?;
+            let mut out = BTreeMap::new();
+            for row in rows {
+                let (id, lot) = row?;
+                // A repeated id (a skipped duplicate) keeps the first: the one built.
+                out.entry(id).or_insert(lot);
+            }
+            Ok(out)
+        };
+        read().map_err(|e| unreadable(&self.path, e))
+    }
+
+    fn tiles(&self) -> Result<BTreeMap<String, Option<Vec<u8>>>, DiffError> {
+        let read = || -> rusqlite::Result<BTreeMap<String, Option<Vec<u8>>>> {
+            let mut q = self
+                .conn
+                .prepare("SELECT id, geom FROM tiles ORDER BY fid")?;
+            let rows = q.query_map([], |r| {
+                Ok((
+                    r.get::<_, Option<String>>(0)?.unwrap_or_default(),
+                    r.get(1)?,
+                ))
+            })?;
+            rows.collect()
+        };
+        read().map_err(|e| unreadable(&self.path, e))
+    }
+
+    fn srs(&self) -> Result<Srs, DiffError> {
+        let read = || -> rusqlite::Result<Srs> {
+            self.conn.query_row(
+                "SELECT s.srs_id, s.srs_name, s.organization, s.organization_coordsys_id, \
+                 s.definition, s.description FROM gpkg_spatial_ref_sys s JOIN \
+                 gpkg_geometry_columns c ON c.srs_id = s.srs_id WHERE c.table_name = 'lots'",
+                [],
+                |r| {
+                    Ok(Srs {
+                        id: r.get(0)?,
+                        name: r.get(1)?,
+                        organization: r.get(2)?,
+                        code: r.get(3)?,
+                        definition: r.get(4)?,
+                        description: r.get::<_, Option<String>>(5)?.unwrap_or_default(),
+                    })
+                },
+            )
+        };
+        read().map_err(|e| unreadable(&self.path, e))
+    }
+}
+
+fn unreadable(path: &Path, e: rusqlite::Error) -> DiffError {
+    DiffError::Unreadable {
+        path: path.to_path_buf(),
+        why: e.to_string(),
+    }
+}
+
+/// Writes `out`: layer `lots` (each lot whose type, kura, house or trees differ between the
+/// builds in `a` and `b`, or that only one has) and layer `tiles` (the tiles `differ`,
+/// `only_a` and `only_b` name). Returns the number of lots that differ.
+pub fn write_diff(
+    a: &Path,
+    b: &Path,
+    differ: &[String],
+    only_a: &[String],
+    only_b: &[String],
+    out: &Path,
+) -> Result<usize, DiffError> {
+    let (ba, bb) = (Build::open(a)?, Build::open(b)?);
+    let (la, lb) = (ba.lots()?, bb.lots()?);
+    let mut g = GeoPackage::create(out, ba.srs()?)?;
+    let style = styles::categorized(
+        Shape::Fill,
+        "CASE WHEN \"differs\" LIKE 'only%' THEN 'only in one' WHEN \"differs\" LIKE \
+         '%house%' THEN 'house' WHEN \"differs\" LIKE '%type%' THEN 'type' WHEN \"differs\" \
+         LIKE '%kura%' THEN 'kura' ELSE 'trees' END",
+        &[
+            ("house".into(), Look::of([200, 60, 60])),
+            ("type".into(), Look::of([230, 160, 60])),
+            ("kura".into(), Look::of([110, 110, 200]).hatched()),
+            ("trees".into(), Look::of([70, 150, 70])),
+            ("only in one".into(), Look::of([150, 150, 150]).hatched()),
+        ],
+        None,
+    );
+    let mut w = g.layer(
+        "lots",
+        Some(GeomKind::Polygon),
+        &LOT_COLUMNS,
+        "Lots whose type, kura, house or trees differ between A and B, with both values",
+        Some(style),
+    )?;
+    let mut count = 0;
+    let ids: std::collections::BTreeSet<&String> = la.keys().chain(lb.keys()).collect();
+    for id in ids {
+        let (x, y) = (la.get(id), lb.get(id));
+        let differs = match (x, y) {
+            (Some(x), Some(y)) => {
+                let (vx, vy) = (x.values(), y.values());
+                let d: Vec<&str> = ASPECTS
+                    .iter()
+                    .zip(vx.iter().zip(vy.iter()))
+                    .filter(|(_, (p, q))| p != q)
+                    .map(|(name, _)| *name)
+                    .collect();
+                d.join(", ")
+            }
+            (Some(_), None) => "only in A".into(),
+            (None, _) => "only in B".into(),
+        };
+        if differs.is_empty() {
+            continue;
+        }
+        count += 1;
+        let first = y.or(x).expect("an id of either build");
+        let mut row = vec![
+            t(id),
+            first.record.map_or(Value::Null, Value::Integer),
+            t(&differs),
+        ];
+        let none = [Value::Null, Value::Null, Value::Null, Value::Null];
+        let (vx, vy) = (
+            x.map_or(none.clone(), LotRow::values),
+            y.map_or(none, LotRow::values),
+        );
+        for (p, q) in vx.into_iter().zip(vy) {
+            row.push(p);
+            row.push(q);
+        }
+        w.add_blob(first.geom.as_deref(), &row)?;
+    }
+    w.end()?;
+    let (ta, tb) = (ba.tiles()?, bb.tiles()?);
+    let mut w = g.layer(
+        "tiles",
+        Some(GeomKind::Polygon),
+        &[text("id"), text("difference")],
+        "Tiles whose files differ between A and B, or that only one has",
+        Some(styles::single(
+            Shape::Fill,
+            Look::of([230, 120, 40]).hatched(),
+        )),
+    )?;
+    for (ids, what) in [
+        (differ, "differ"),
+        (only_a, "only in A"),
+        (only_b, "only in B"),
+    ] {
+        for id in ids {
+            let geom = ta.get(id).or_else(|| tb.get(id)).cloned().flatten();
+            w.add_blob(geom.as_deref(), &[t(id), t(what)])?;
+        }
+    }
+    w.end()?;
+    g.finish()?;
+    Ok(count)
+}
