@@ -639,8 +639,13 @@ fn write_city(
     if manifest.shard.is_none() {
         shards::finish_formats(&opts.out, &mut manifest)?;
     }
-    if let Some(writer) = gpkg {
-        writer?.finish(&sources, &manifest).map_err(gpkg_err)?;
+    match gpkg {
+        Some(writer) => writer?.finish(&sources, &manifest).map_err(gpkg_err)?,
+        // A whole build without gpkg leaves no plan.gpkg of an earlier one beside its tiles.
+        None if opts.selection == Selection::All => {
+            let _ = std::fs::remove_file(&gpkg_path);
+        }
+        None => {}
     }
     timings.generate_and_write = t.elapsed();
     let t = Instant::now();
@@ -665,11 +670,13 @@ fn write_city(
     })
 }
 
-/// What `edo-city check` found: the build's report, as it would be, with nothing written.
+/// What `edo-city check` found: the build's report, as it would be, with nothing written
+/// but, with `gpkg`, its problems as GIS layers (`problems` where they are, `warnings`).
 pub fn check(
     input: &Path,
     params: &Params,
     templates: Option<&Path>,
+    gpkg: Option<&Path>,
 ) -> Result<report::Report, BuildError> {
     let catalog = load_catalog(params, templates)?;
     let (data, plan, _, _) = read_and_analyse(input, params, &catalog, &NoProgress)?;
@@ -713,7 +720,12 @@ pub fn check(
         textures: Vec::new(),
         species: Vec::new(),
     };
-    Ok(report::assemble_report(&manifest))
+    let report = report::assemble_report(&manifest);
+    if let Some(path) = gpkg {
+        output::gpkg::write_problems(path, &data, params, &report.skipped, &report.warnings)
+            .map_err(gpkg_err)?;
+    }
+    Ok(report)
 }
 
 /// Draws the plan of an earlier build from its parameters and the input read again: `input`
@@ -848,6 +860,7 @@ pub fn merge_plan_files(
     let params = &manifest.params;
     let gpkg = params.output.formats.iter().any(|f| f == "gpkg");
     if !draw_plan && !gpkg {
+        let _ = std::fs::remove_file(out.join(output::PLAN_GPKG));
         return Ok(());
     }
     let catalog = load_catalog(params, templates)?;
@@ -857,14 +870,16 @@ pub fn merge_plan_files(
         let path = out.join("plan.png");
         output::atomic::write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
     }
-    if gpkg {
+    let path = out.join(output::PLAN_GPKG);
+    if !gpkg {
+        let _ = std::fs::remove_file(&path);
+    } else {
         let sources = output::gpkg::PlanSources {
             data: &data,
             plan: &plan,
             params,
         };
-        output::gpkg::write_plan(&out.join(output::PLAN_GPKG), &sources, manifest)
-            .map_err(gpkg_err)?;
+        output::gpkg::write_plan(&path, &sources, manifest).map_err(gpkg_err)?;
     }
     Ok(())
 }

@@ -353,6 +353,26 @@ pub fn render(c: &Comparison) -> String {
     s
 }
 
+/// Writes `path`: the lots and tiles that differ between the builds in `dir_a` and
+/// `dir_b`, as GeoPackage layers (`output::gpkg::write_diff`); returns how many lots differ.
+pub fn write_gpkg(
+    c: &Comparison,
+    dir_a: &Path,
+    dir_b: &Path,
+    path: &Path,
+) -> Result<usize, BuildError> {
+    let t = &c.tiles;
+    crate::output::gpkg::write_diff(dir_a, dir_b, &t.differ, &t.only_a, &t.only_b, path).map_err(
+        |e| match e {
+            crate::output::gpkg::DiffError::Write(w) => {
+                let (file, cause) = w.into_io();
+                BuildError::Config(format!("cannot write {}: {cause}", file.display()))
+            }
+            other => BuildError::Config(other.to_string()),
+        },
+    )
+}
+
 /// The widest difference map, in tiles a side (8 pixels each at most: 12,000 pixels).
 const MAX_MAP_CELLS: i64 = 1500;
 

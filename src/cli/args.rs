@@ -63,6 +63,11 @@ pub struct CompareArgs {
     /// Also draw a map of the tiles that changed.
     #[arg(long)]
     pub plan: Option<PathBuf>,
+    /// Also write the differences as a GeoPackage for QGIS, from the two builds'
+    /// plan.gpkg: layer `lots` (type, kura, house or trees differ, with both values) and
+    /// `tiles` (the tiles that differ).
+    #[arg(long, value_name = "FILE")]
+    pub gpkg: Option<PathBuf>,
 }
 
 /// The flags of `edo-city plan`.
@@ -100,6 +105,10 @@ pub struct CheckArgs {
     /// Machine-readable output (the report a build would write).
     #[arg(long)]
     pub json: bool,
+    /// Also write the problems as a GeoPackage for QGIS: layer `problems` (each record a
+    /// build would skip, where it is) and `warnings`.
+    #[arg(long, value_name = "FILE")]
+    pub gpkg: Option<PathBuf>,
 }
 
 /// The flags of `edo-city tiles`.

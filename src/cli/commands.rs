@@ -150,13 +150,22 @@ pub fn check_command(args: CheckArgs) -> Result<()> {
         params,
         templates,
         json,
+        gpkg,
     } = args;
     let params = load_params(params.as_deref())?;
-    let r = edo_city::build::check(&input, &params, templates.as_deref())?;
+    let r = edo_city::build::check(&input, &params, templates.as_deref(), gpkg.as_deref())?;
     if json {
         say!("{}", serde_json::to_string_pretty(&r)?);
     } else {
         print_check(&r)?;
+        if let Some(path) = &gpkg {
+            say!(
+                "wrote {} ({} problem(s) at their places, {} warning(s)): open it in QGIS",
+                path.display(),
+                r.skipped.len(),
+                r.warnings.len()
+            );
+        }
     }
     let problems = r.counts.skipped + r.warnings.len();
     if problems > 0 {
@@ -167,7 +176,13 @@ pub fn check_command(args: CheckArgs) -> Result<()> {
 
 /// `edo-city compare`.
 pub fn compare_command(args: CompareArgs) -> Result<()> {
-    let CompareArgs { a, b, json, plan } = args;
+    let CompareArgs {
+        a,
+        b,
+        json,
+        plan,
+        gpkg,
+    } = args;
     let c = edo_city::compare::compare(&a, &b)?;
     if json {
         say!("{}", serde_json::to_string_pretty(&c)?);
@@ -180,6 +195,16 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
             .with_context(|| format!("cannot write {}", path.display()))?;
         if !json {
             say!("wrote {}", path.display());
+        }
+    }
+    if let Some(path) = gpkg {
+        let lots = edo_city::compare::write_gpkg(&c, &a, &b, &path)?;
+        if !json {
+            say!(
+                "wrote {}: {lots} lots and {} tiles differ",
+                path.display(),
+                c.tiles.differ.len() + c.tiles.only_a.len() + c.tiles.only_b.len()
+            );
         }
     }
     Ok(())
