@@ -574,7 +574,13 @@ fn write_city(
     // the rest once their manifest is known. A `--tiles` run whose analysis came from the
     // cache leaves the full build's file as it is: the same analysis wrote it.
     let gpkg_path = opts.out.join(output::PLAN_GPKG);
-    let sources = output::gpkg::PlanSources { data, plan, params };
+    let band = |m: &crate::model::PlannedHouse| analyse::house::house_band(m, catalog, params);
+    let sources = output::gpkg::PlanSources {
+        data,
+        plan,
+        params,
+        band: &band,
+    };
     let want_gpkg = params.output.formats.iter().any(|f| f == "gpkg")
         && !opts.selection.is_shard()
         && !(reused && gpkg_path.is_file());
@@ -874,10 +880,12 @@ pub fn merge_plan_files(
     if !gpkg {
         let _ = std::fs::remove_file(&path);
     } else {
+        let band = |m: &crate::model::PlannedHouse| analyse::house::house_band(m, &catalog, params);
         let sources = output::gpkg::PlanSources {
             data: &data,
             plan: &plan,
             params,
+            band: &band,
         };
         output::gpkg::write_plan(&path, &sources, manifest).map_err(gpkg_err)?;
     }

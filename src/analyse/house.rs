@@ -28,8 +28,18 @@ pub fn local_ring(m: &PlannedHouse, f: Frame) -> Vec<[f64; 2]> {
 /// Where the house ends behind the frontage: its type's `setback` + `depth` (else
 /// `machiya.depth`), at most the lot; a footprint building is its whole outline.
 pub fn house_end(m: &PlannedHouse, lot_depth: f64, catalog: &Catalog, params: &Params) -> f64 {
+    match house_band(m, catalog, params) {
+        Some((_, end)) => end.min(lot_depth),
+        None => lot_depth,
+    }
+}
+
+/// The band behind the frontage a machiya's body fills: from its type's `setback` to
+/// `setback` + `depth` (else `machiya.depth`), metres along the frontage frame's v axis
+/// (the lot may end sooner); `None` for a footprint building, which is its whole outline.
+pub fn house_band(m: &PlannedHouse, catalog: &Catalog, params: &Params) -> Option<(f64, f64)> {
     if m.is_footprint() {
-        return lot_depth;
+        return None;
     }
     let (mut setback, mut depth) = (0.0, 0.0);
     if let Some(t) = catalog.machiya(&m.mtype) {
@@ -40,5 +50,5 @@ pub fn house_end(m: &PlannedHouse, lot_depth: f64, catalog: &Catalog, params: &P
     if depth <= 0.0 {
         depth = params.machiya.depth;
     }
-    (setback + depth).min(lot_depth)
+    Some((setback, setback + depth))
 }

@@ -26,6 +26,9 @@ pub struct PlanSources<'a> {
     pub plan: &'a Plan,
     /// The build's parameters.
     pub params: &'a Params,
+    /// The band behind its frontage a machiya's body fills (`analyse::house::house_band`:
+    /// its template decides it); `None` for a footprint building.
+    pub band: &'a (dyn Fn(&PlannedHouse) -> Option<(f64, f64)> + Sync),
 }
 
 /// A `plan.gpkg` being written: the layers analysis alone decides are written by
@@ -416,8 +419,8 @@ fn source(h: &PlannedHouse) -> &'static str {
     }
 }
 
-/// `houses`: every house planned, on the outline it is built on (a machiya fills its lot's
-/// frontage band; a footprint building its outline), with its template; generation's skips
+/// `houses`: every house planned, on the ground it covers (a machiya its lot's band behind
+/// the frontage, a footprint building its outline), with its template; generation's skips
 /// are marked.
 fn houses(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgError> {
     let colours = crate::output::plan::type_colours(s.plan);
@@ -434,7 +437,7 @@ fn houses(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), Gpkg
     );
     let mut w = g.layer(
         "houses",
-        Some(GeomKind::Polygon),
+        Some(GeomKind::MultiPolygon),
         &[
             text("id"),
             int("record"),
@@ -447,13 +450,14 @@ fn houses(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), Gpkg
             int("built"),
             text("reason"),
         ],
-        "Each house planned: the lot (or footprint) it stands on and its template",
+        "Each house planned: the ground it covers (a machiya the band of its lot behind the \
+         frontage its template fills, a footprint building its outline) and its template",
         Some(style),
     )?;
     for h in planned(s.plan) {
         let skip = index.skips.get(&(source(h), h.id.as_str()));
         w.add(
-            Some(&Geometry::Polygon(h.outline.clone())),
+            Some(&footprint(h, (s.band)(h))),
             &[
                 t(&h.id),
                 n(h.record),
@@ -469,6 +473,46 @@ fn houses(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), Gpkg
         )?;
     }
     w.end()
+}
+
+/// The ground a house covers: the lot clipped to its band behind the frontage (in the
+/// frontage frame, as generation clips it), or its whole outline.
+fn footprint(h: &PlannedHouse, band: Option<(f64, f64)>) -> Geometry<f64> {
+    use crate::generate::clip::{clip_band, LocalPoly};
+    let whole = || Geometry::MultiPolygon(vec![h.outline.clone()].into());
+    let Some((lo, hi)) = band else {
+        return whole();
+    };
+    let frame = Frame {
+        a: h.frontage.a,
+        u: h.frontage.u_axis(),
+        v: h.frontage.v_axis(),
+    };
+    let local = |r: &LineString<f64>| -> Vec<[f64; 2]> {
+        crate::geom::ring::open(r)
+            .iter()
+            .map(|c| frame.local(*c))
+            .collect()
+    };
+    let poly = LocalPoly {
+        exterior: local(h.outline.exterior()),
+        holes: h.outline.interiors().iter().map(local).collect(),
+    };
+    let parts: Vec<Polygon<f64>> = clip_band(&poly, lo, hi)
+        .iter()
+        .map(|p| {
+            let ring = |r: &Vec<[f64; 2]>| {
+                let mut c: Vec<Coord<f64>> = r.iter().map(|q| frame.map(*q)).collect();
+                c.extend(c.first().copied());
+                LineString::from(c)
+            };
+            Polygon::new(ring(&p.exterior), p.holes.iter().map(ring).collect())
+        })
+        .collect();
+    match parts.is_empty() {
+        true => whole(),
+        false => Geometry::MultiPolygon(parts.into()),
+    }
 }
 
 /// `kura`: every kura plot section 4.2 found room for, placed or refused (hatched).

@@ -108,6 +108,8 @@ pub enum GeomKind {
     LineString,
     /// Polygons (with holes).
     Polygon,
+    /// Polygons of several parts (a house on a lot of a bent shape).
+    MultiPolygon,
 }
 
 impl GeomKind {
@@ -116,6 +118,7 @@ impl GeomKind {
             GeomKind::Point => "POINT",
             GeomKind::LineString => "LINESTRING",
             GeomKind::Polygon => "POLYGON",
+            GeomKind::MultiPolygon => "MULTIPOLYGON",
         }
     }
 }
