@@ -142,6 +142,8 @@ pub struct Timings {
     pub generate_and_write: Duration,
     /// Drawing plan.png.
     pub plan: Duration,
+    /// Writing plan.gpkg: its layers written beside the tiles, then the ones after them.
+    pub gpkg: [Duration; 2],
     /// Time spent generating meshes and formatting + writing files, summed over threads.
     pub generate_cpu: Duration,
     /// Formatting and writing the files, summed over threads.
@@ -585,9 +587,12 @@ fn write_city(
         && !opts.selection.is_shard()
         && !(reused && gpkg_path.is_file());
     let start_gpkg = || {
-        want_gpkg.then(|| output::gpkg::PlanWriter::start(&gpkg_path, &sources).map_err(gpkg_err))
+        let t = Instant::now();
+        let started = want_gpkg
+            .then(|| output::gpkg::PlanWriter::start(&gpkg_path, &sources).map_err(gpkg_err));
+        (started, t.elapsed())
     };
-    let (((image, plan_time), gpkg), results) =
+    let (((image, plan_time), (gpkg, gpkg_time)), results) =
         rayon::join(|| rayon::join(draw_plan, start_gpkg), make_tiles);
     progress.finish();
     timings.generate_cpu = Duration::from_nanos(gen_ns.into_inner());
@@ -645,6 +650,7 @@ fn write_city(
     if manifest.shard.is_none() {
         shards::finish_formats(&opts.out, &mut manifest)?;
     }
+    let t_gpkg = Instant::now();
     match gpkg {
         Some(writer) => writer?.finish(&sources, &manifest).map_err(gpkg_err)?,
         // A whole build without gpkg leaves no plan.gpkg of an earlier one beside its tiles.
@@ -653,6 +659,7 @@ fn write_city(
         }
         None => {}
     }
+    timings.gpkg = [gpkg_time, t_gpkg.elapsed()];
     timings.generate_and_write = t.elapsed();
     let t = Instant::now();
     if let Some(png) = image {

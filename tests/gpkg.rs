@@ -147,6 +147,34 @@ fn every_layer_opens_in_gdal_with_the_reports_counts() {
         "SELECT count(*) AS n FROM kura WHERE status = 'placed'",
     );
     assert_eq!(placed[0]["n"].parse::<usize>().unwrap(), get("kura"));
+    // Every spatial index is whole (SQLite's own check), and a box query through it finds
+    // what a scan of the geometries finds.
+    for layer in n.keys().filter(|l| *l != "layer_styles") {
+        let sql = format!("SELECT rtreecheck('rtree_{layer}_geom') AS c");
+        assert_eq!(rows(&gpkg, &sql)[0]["c"], "ok", "{layer}");
+    }
+    let spat = gdal(
+        "ogrinfo",
+        &[
+            "-ro",
+            "-q",
+            gpkg.to_str().unwrap(),
+            "lots",
+            "-spat",
+            "-22950",
+            "-109900",
+            "-22900",
+            "-109850",
+        ],
+    );
+    let scan = rows(
+        &gpkg,
+        "SELECT count(*) AS n FROM lots WHERE ST_MaxX(geom) >= -22950 AND ST_MinX(geom) <= -22900 \
+         AND ST_MaxY(geom) >= -109900 AND ST_MinY(geom) <= -109850",
+    );
+    let found = spat.matches("OGRFeature(lots)").count();
+    assert!(found > 10, "{found}");
+    assert_eq!(found.to_string(), scan[0]["n"]);
     // Each of the twelve spatial layers styled, as QGIS stores styles.
     assert_eq!(n["layer_styles"], 13);
     // A placed garden carries its fitness and the five rule scores.
@@ -359,4 +387,62 @@ fn compare_writes_the_lots_and_tiles_two_hypotheses_disagree_on() {
         "{err}"
     );
     assert!(!none.exists());
+}
+
+#[test]
+fn houses_generation_could_not_build_are_marked_in_lots_and_houses() {
+    let dir = tempfile::tempdir().unwrap();
+    let mydir = dir.path().join("t");
+    std::fs::create_dir(&mydir).unwrap();
+    // As tests/templates.rs: NaN on narrow lots, an upside-down part on wide ones; both
+    // found only when the tiles are made.
+    std::fs::write(
+        mydir.join("odd.toml"),
+        "name = \"odd\"\nextends = \"machiya\"\n[derived]\nodd_w = \"sqrt(width - 5.0)\"\n\
+         [[part]]\nname = \"upside_down\"\nwhen = \"odd_w > 1\"\nv0 = \"1\"\nv1 = \"2\"\n\
+         bottom = \"3\"\ntop = \"2\"\n",
+    )
+    .unwrap();
+    let params = dir.path().join("p.toml");
+    std::fs::write(&params, "[type_mix]\nodd = 1.0\n").unwrap();
+    let input = dir.path().join("in");
+    common::copy_fixture("kyoto-small", &input);
+    std::fs::remove_file(input.join("lots.csv")).unwrap();
+    let out = dir.path().join("out");
+    let r = build_ok(
+        &input,
+        &out,
+        &[
+            "--quiet",
+            "--no-plan",
+            "--templates",
+            mydir.to_str().unwrap(),
+            "--params",
+            params.to_str().unwrap(),
+        ],
+    );
+    let gpkg = out.join("plan.gpkg");
+    let failed = r["skipped"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|k| k["layer"] == "lots" && !k["reason"].as_str().unwrap().starts_with("its "))
+        .count();
+    assert!(failed > 0);
+    let one = |sql: &str| rows(&gpkg, sql)[0]["n"].parse::<usize>().unwrap();
+    assert_eq!(
+        one("SELECT count(*) AS n FROM lots WHERE status = 'skipped'"),
+        failed
+    );
+    assert_eq!(
+        one("SELECT count(*) AS n FROM houses WHERE built = 0"),
+        failed
+    );
+    assert_eq!(
+        one("SELECT count(*) AS n FROM lots WHERE status = 'built'"),
+        r["counts"]["machiya"].as_u64().unwrap() as usize
+    );
+    let nan = one("SELECT count(*) AS n FROM houses WHERE built = 0 AND reason LIKE '%is NaN%'");
+    assert!(nan > 0 && nan < failed, "{nan} of {failed}");
+    validate(&gpkg);
 }

@@ -71,11 +71,13 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
             ),
         };
         tell!(
-            "timings: {read_and_analyse}, generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, total {:.3} s",
+            "timings: {read_and_analyse}, generate+write {:.3} s (cpu: generate {:.3} s, format+write {:.3} s), plan {:.3} s, plan.gpkg {:.3} s beside the tiles + {:.3} s after, total {:.3} s",
             t.generate_and_write.as_secs_f64(),
             t.generate_cpu.as_secs_f64(),
             t.write_cpu.as_secs_f64(),
             t.plan.as_secs_f64(),
+            t.gpkg[0].as_secs_f64(),
+            t.gpkg[1].as_secs_f64(),
             t.total.as_secs_f64()
         );
         // "people and trees" above is every step after the fences; here each of them.

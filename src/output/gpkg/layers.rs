@@ -39,11 +39,11 @@ pub struct PlanWriter {
 }
 
 impl PlanWriter {
-    /// Creates the file and writes the frontages, kura, walls, gates, halls, gardens, trees,
-    /// people and landmarks.
+    /// Creates the file and writes every layer analysis decides: frontages, kura, walls,
+    /// gates, halls, gardens, trees, people, landmarks, lots and houses.
     pub fn start(path: &Path, s: &PlanSources) -> Result<PlanWriter, GpkgError> {
         let mut g = GeoPackage::create(path, srs_of(s.data, s.params))?;
-        let index = Index::default_for(s.data, s.plan);
+        let index = Index::of(s, s.data.skipped.iter().chain(&s.plan.skipped));
         frontages(&mut g, s, &index)?;
         kura(&mut g, s)?;
         places::fences(&mut g, s)?;
@@ -51,20 +51,72 @@ impl PlanWriter {
         places::gardens(&mut g, s, &index)?;
         places::billboards(&mut g, s)?;
         places::landmarks(&mut g, s)?;
+        lots(&mut g, s, &index)?;
+        houses(&mut g, s, &index)?;
         Ok(PlanWriter { g })
     }
 
-    /// Writes the lots, houses, tiles and skipped records once every tile is in `manifest`,
-    /// and renames the file into place.
-    pub fn finish(mut self, s: &PlanSources, manifest: &Manifest) -> Result<(), GpkgError> {
+    /// Once every tile is in `manifest`: marks the houses generation could not build, writes
+    /// the tiles and every skipped record, and renames the file into place.
+    pub fn finish(self, s: &PlanSources, manifest: &Manifest) -> Result<(), GpkgError> {
         let report = crate::output::report::assemble_report(manifest);
-        let index = Index::of(s, &report.skipped);
-        lots(&mut self.g, s, &index)?;
-        houses(&mut self.g, s, &index)?;
-        places::tiles(&mut self.g, s, manifest)?;
-        places::skipped(&mut self.g, s.data, &report.skipped, &index)?;
-        self.g.finish()
+        let generated: Vec<&Skipped> = manifest
+            .tiles
+            .iter()
+            .flat_map(|t| &t.stats.skipped)
+            .collect();
+        mark_generated(&self.g, s, &generated)?;
+        let mut g = self.g;
+        let index = Index::of(s, report.skipped.iter());
+        places::tiles(&mut g, s, manifest)?;
+        places::skipped(&mut g, s.data, &report.skipped, &index)?;
+        g.finish()
     }
+}
+
+/// Marks in `lots` and `houses` what generation found of the planned houses. A layer's
+/// fids run from 1 in the order its features were added (nothing is deleted): a lot's is its
+/// place in the dataset, a house's its place in the plan, so no map of a million ids is
+/// kept for the few skips there are.
+fn mark_generated(g: &GeoPackage, s: &PlanSources, skips: &[&Skipped]) -> Result<(), GpkgError> {
+    if skips.is_empty() {
+        return Ok(());
+    }
+    let mut by_key: HashMap<(&str, &str), Vec<&Skipped>> = HashMap::new();
+    for k in skips {
+        by_key
+            .entry((k.layer.as_str(), k.id.as_str()))
+            .or_default()
+            .push(k);
+    }
+    let lot_fid: HashMap<&str, i64> = s
+        .data
+        .lots
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| by_key.contains_key(&("lots", l.id.as_str())))
+        .map(|(i, l)| (l.id.as_str(), i as i64 + 1))
+        .collect();
+    for (i, h) in planned(s.plan).enumerate() {
+        let Some(found) = by_key.get(&(source(h), h.id.as_str())) else {
+            continue;
+        };
+        let lot = match h.is_footprint() {
+            false => lot_fid.get(h.id.as_str()).copied(),
+            true => None,
+        };
+        for k in found {
+            // "its kura: ...", "its fence: ...", "its <hall>: ...": a part of the lot; the
+            // house stands.
+            mark(
+                g,
+                (lot, i as i64 + 1),
+                &k.reason,
+                k.reason.starts_with("its "),
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// Writes a whole `plan.gpkg` at once (`merge`, which has the manifest before it starts).
@@ -140,8 +192,8 @@ impl<'a> Index<'a> {
         index
     }
 
-    /// Every lookup, with the skips of the whole build.
-    fn of(s: &'a PlanSources, skipped: &'a [Skipped]) -> Index<'a> {
+    /// Every lookup, with `skipped` (the first skip of a layer and id counts).
+    fn of(s: &'a PlanSources, skipped: impl Iterator<Item = &'a Skipped>) -> Index<'a> {
         let mut index = Index::default_for(s.data, s.plan);
         for k in skipped {
             index
@@ -336,6 +388,40 @@ fn lots(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgEr
         )?;
     }
     w.end()
+}
+
+/// Marks what generation found of a planned house: its lot skipped and the house not built
+/// (`part` false), or a part of it left out, in their `reason`s.
+fn mark(
+    g: &GeoPackage,
+    (lot, house): (Option<i64>, i64),
+    reason: &str,
+    part: bool,
+) -> Result<(), GpkgError> {
+    let sql = |source| GpkgError::Sqlite {
+        path: g.target.clone(),
+        source,
+    };
+    let add = "reason = coalesce(reason || '; ', '') || ?1";
+    let (lots, houses) = match part {
+        false => (
+            "UPDATE lots SET status = 'skipped', reason = ?1 WHERE fid = ?2".to_string(),
+            "UPDATE houses SET built = 0, reason = ?1 WHERE fid = ?2".to_string(),
+        ),
+        true => (
+            format!("UPDATE lots SET {add} WHERE fid = ?2"),
+            format!("UPDATE houses SET {add} WHERE fid = ?2"),
+        ),
+    };
+    if let Some(lot) = lot {
+        g.conn
+            .execute(&lots, rusqlite::params![reason, lot])
+            .map_err(sql)?;
+    }
+    g.conn
+        .execute(&houses, rusqlite::params![reason, house])
+        .map_err(sql)?;
+    Ok(())
 }
 
 /// The outlines reading kept of skipped records, by (layer, record, id).

@@ -15,6 +15,7 @@ mod diff;
 mod geometry;
 mod layers;
 mod places;
+mod rtree;
 mod styles;
 
 use std::path::{Path, PathBuf};
@@ -256,6 +257,7 @@ impl GeoPackage {
             "PRAGMA journal_mode = OFF;
              PRAGMA synchronous = OFF;
              PRAGMA page_size = 4096;
+             PRAGMA cache_size = -65536;
              PRAGMA application_id = 1196444487;
              PRAGMA user_version = 10200;
              BEGIN;
@@ -340,30 +342,23 @@ impl GeoPackage {
             cols.join(", "),
             marks.join(", ")
         );
-        let index = format!(
-            "INSERT INTO {} VALUES (last_insert_rowid(), ?1, ?2, ?3, ?4)",
-            quoted(&format!("rtree_{name}_geom"))
-        );
         let target = self.target.clone();
         let sql = |source| GpkgError::Sqlite {
             path: target.clone(),
             source,
         };
         let insert = self.conn.prepare(&insert).map_err(sql)?;
-        let index = match geometry {
-            Some(_) => Some(self.conn.prepare(&index).map_err(sql)?),
-            None => None,
-        };
         Ok(LayerWriter {
             name: name.to_string(),
             conn: &self.conn,
             insert,
-            index,
+            spatial: geometry.is_some(),
             srs: self.srs.id,
             columns: columns.len(),
             extent: None,
             target,
             buffer: Vec::new(),
+            cells: Vec::new(),
         })
     }
 
@@ -464,24 +459,30 @@ pub struct LayerWriter<'c> {
     name: String,
     conn: &'c Connection,
     insert: rusqlite::Statement<'c>,
-    index: Option<rusqlite::Statement<'c>>,
+    spatial: bool,
     srs: i32,
     columns: usize,
     extent: Option<[f64; 4]>,
     target: PathBuf,
     buffer: Vec<u8>,
+    /// Each feature's box, packed into the spatial index when the layer ends.
+    cells: Vec<rtree::Cell>,
 }
 
 impl LayerWriter<'_> {
     /// Adds one feature: its geometry (`None`: a feature without one) and its values, one
-    /// per column in the layer's order.
-    pub fn add(&mut self, geom: Option<&Geometry<f64>>, values: &[Value]) -> Result<(), GpkgError> {
+    /// per column in the layer's order. Returns its fid.
+    pub fn add(
+        &mut self,
+        geom: Option<&Geometry<f64>>,
+        values: &[Value],
+    ) -> Result<i64, GpkgError> {
         debug_assert_eq!(values.len(), self.columns, "{}", self.name);
         let sql = |source| GpkgError::Sqlite {
             path: self.target.clone(),
             source,
         };
-        let spatial = self.index.is_some();
+        let spatial = self.spatial;
         let envelope = match (spatial, geom) {
             (true, Some(g)) => geometry::encode(g, self.srs, &mut self.buffer),
             _ => None,
@@ -493,13 +494,12 @@ impl LayerWriter<'_> {
         }
         all.extend(values.iter().map(|v| v as &dyn rusqlite::ToSql));
         self.insert.execute(&all[..]).map_err(sql)?;
-        if let (Some(index), Some(e)) = (&mut self.index, envelope) {
-            index
-                .execute(params![e[0], e[1], e[2], e[3]])
-                .map_err(sql)?;
+        let fid = self.conn.last_insert_rowid();
+        if let Some(e) = envelope.filter(|_| spatial) {
+            self.cells.push((fid, rtree::cell_box(e)));
             self.grow(e);
         }
-        Ok(())
+        Ok(fid)
     }
 
     /// Adds one feature whose geometry is a GeoPackage blob already (copied from another
@@ -514,10 +514,9 @@ impl LayerWriter<'_> {
         all.extend(values.iter().map(|v| v as &dyn rusqlite::ToSql));
         self.insert.execute(&all[..]).map_err(sql)?;
         let envelope = blob.and_then(geometry::envelope_of);
-        if let (Some(index), Some(e)) = (&mut self.index, envelope) {
-            index
-                .execute(params![e[0], e[1], e[2], e[3]])
-                .map_err(sql)?;
+        let fid = self.conn.last_insert_rowid();
+        if let Some(e) = envelope.filter(|_| self.spatial) {
+            self.cells.push((fid, rtree::cell_box(e)));
             self.grow(e);
         }
         Ok(())
@@ -535,8 +534,18 @@ impl LayerWriter<'_> {
         });
     }
 
-    /// Ends the layer: its extent in `gpkg_contents`.
-    pub fn end(self) -> Result<(), GpkgError> {
+    /// Ends the layer: its spatial index, packed (`rtree.rs`), and its extent in
+    /// `gpkg_contents`.
+    pub fn end(mut self) -> Result<(), GpkgError> {
+        if self.spatial {
+            let table = format!("rtree_{}_geom", self.name);
+            rtree::write(self.conn, &table, &mut self.cells).map_err(|source| {
+                GpkgError::Sqlite {
+                    path: self.target.clone(),
+                    source,
+                }
+            })?;
+        }
         if let Some(e) = self.extent {
             self.conn
                 .execute(
@@ -559,7 +568,7 @@ fn quoted(name: &str) -> String {
 }
 
 /// The spatial index's triggers, as the standard gives them (Annex F.3), for a layer whose
-/// index was filled while its features were added. They call `ST_*` functions that GDAL and
+/// index was written when its features were. They call `ST_*` functions that GDAL and
 /// QGIS register when they edit the file; this writer never fires them.
 fn triggers(t: &str) -> String {
     let (tq, r) = (quoted(t), quoted(&format!("rtree_{t}_geom")));
