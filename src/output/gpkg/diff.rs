@@ -186,7 +186,7 @@ pub fn write_diff(
         &[
             ("house".into(), Look::of([200, 60, 60])),
             ("type".into(), Look::of([230, 160, 60])),
-            ("kura".into(), Look::of([110, 110, 200]).hatched()),
+            ("kura".into(), Look::of([70, 90, 210]).faded()),
             ("trees".into(), Look::of([70, 150, 70])),
             ("only in one".into(), Look::of([150, 150, 150]).hatched()),
         ],
@@ -247,7 +247,7 @@ pub fn write_diff(
         "Tiles whose files differ between A and B, or that only one has",
         Some(styles::single(
             Shape::Fill,
-            Look::of([230, 120, 40]).hatched(),
+            Look::of([230, 120, 40]).outline().sized(0.8),
         )),
     )?;
     for (ids, what) in [

@@ -443,12 +443,13 @@ fn mid(a: Coord<f64>, b: Coord<f64>) -> Coord<f64> {
 /// pale, skipped red.
 fn lot_style(plan: &Plan) -> String {
     use crate::output::plan as png;
+    // Faded: the houses over them, in the same colours, show how far each house reaches.
     let mut categories: Vec<(String, Look)> = png::type_colours(plan)
         .into_iter()
-        .map(|(ty, rgb)| (ty, Look::of(rgb)))
+        .map(|(ty, rgb)| (ty, Look::of(rgb).faded()))
         .collect();
     categories.push(("skipped".into(), Look::of(png::SKIPPED)));
-    categories.push(("displaced".into(), Look::of(png::FOOTPRINT)));
+    categories.push(("displaced".into(), Look::of(png::FOOTPRINT).faded()));
     let expr = "CASE WHEN \"status\" IN ('skipped', 'displaced') THEN \"status\" \
                 WHEN \"status\" = 'built' THEN \"type\" ELSE '' END";
     styles::categorized(

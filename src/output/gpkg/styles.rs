@@ -26,6 +26,8 @@ pub struct Look {
     pub hatched: bool,
     /// Only the outline, in the colour (polygons).
     pub outline: bool,
+    /// Opacity, 0 to 1.
+    pub alpha: f64,
     /// Line width or marker size, millimetres on the screen.
     pub size: f64,
 }
@@ -37,6 +39,7 @@ impl Look {
             rgb,
             hatched: false,
             outline: false,
+            alpha: 1.0,
             size: 0.0,
         }
     }
@@ -53,6 +56,10 @@ impl Look {
             outline: true,
             ..self
         }
+    }
+    /// The same, half seen through (a layer drawn under another of the same colours).
+    pub const fn faded(self) -> Look {
+        Look { alpha: 0.45, ..self }
     }
     /// The same, with a line width or marker size.
     pub const fn sized(self, size: f64) -> Look {
@@ -129,9 +136,10 @@ fn symbol(out: &mut String, name: &str, shape: Shape, look: Look) {
     };
     let _ = writeln!(
         out,
-        "<symbol type=\"{kind}\" name=\"{name}\" alpha=\"1\" clip_to_extent=\"1\" \
+        "<symbol type=\"{kind}\" name=\"{name}\" alpha=\"{}\" clip_to_extent=\"1\" \
          force_rhr=\"0\">\n<layer class=\"{class}\" enabled=\"1\" locked=\"0\" pass=\"0\">\n\
-         <Option type=\"Map\">"
+         <Option type=\"Map\">",
+        look.alpha
     );
     match shape {
         Shape::Fill => {
