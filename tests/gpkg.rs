@@ -64,6 +64,18 @@ fn rows(gpkg: &Path, sql: &str) -> Vec<BTreeMap<String, String>> {
     out
 }
 
+/// `edo-city compare a b --gpkg out`.
+fn compare_gpkg(a: &Path, b: &Path, out: &Path) -> std::process::Output {
+    edo_city()
+        .arg("compare")
+        .arg(a)
+        .arg(b)
+        .arg("--gpkg")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
 /// GDAL's own check of a GeoPackage against the standard's requirements.
 fn validate(gpkg: &Path) {
     let script = "/usr/lib/python3/dist-packages/osgeo_utils/samples/validate_gpkg.py";
@@ -325,14 +337,7 @@ fn compare_writes_the_lots_and_tiles_two_hypotheses_disagree_on() {
         &["--quiet", "--no-plan", "--params", pb],
     );
     let diff = work.path().join("diff.gpkg");
-    let o = edo_city()
-        .arg("compare")
-        .arg(&a)
-        .arg(&b)
-        .arg("--gpkg")
-        .arg(&diff)
-        .output()
-        .unwrap();
+    let o = compare_gpkg(&a, &b, &diff);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     validate(&diff);
     let ra = read_json(&a.join("report.json"));
@@ -372,14 +377,7 @@ fn compare_writes_the_lots_and_tiles_two_hypotheses_disagree_on() {
         &["--quiet", "--format", "obj,glb", "--force"],
     );
     let none = work.path().join("none.gpkg");
-    let o = edo_city()
-        .arg("compare")
-        .arg(&a)
-        .arg(&b)
-        .arg("--gpkg")
-        .arg(&none)
-        .output()
-        .unwrap();
+    let o = compare_gpkg(&a, &b, &none);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
@@ -392,35 +390,7 @@ fn compare_writes_the_lots_and_tiles_two_hypotheses_disagree_on() {
 #[test]
 fn houses_generation_could_not_build_are_marked_in_lots_and_houses() {
     let dir = tempfile::tempdir().unwrap();
-    let mydir = dir.path().join("t");
-    std::fs::create_dir(&mydir).unwrap();
-    // As tests/templates.rs: NaN on narrow lots, an upside-down part on wide ones; both
-    // found only when the tiles are made.
-    std::fs::write(
-        mydir.join("odd.toml"),
-        "name = \"odd\"\nextends = \"machiya\"\n[derived]\nodd_w = \"sqrt(width - 5.0)\"\n\
-         [[part]]\nname = \"upside_down\"\nwhen = \"odd_w > 1\"\nv0 = \"1\"\nv1 = \"2\"\n\
-         bottom = \"3\"\ntop = \"2\"\n",
-    )
-    .unwrap();
-    let params = dir.path().join("p.toml");
-    std::fs::write(&params, "[type_mix]\nodd = 1.0\n").unwrap();
-    let input = dir.path().join("in");
-    common::copy_fixture("kyoto-small", &input);
-    std::fs::remove_file(input.join("lots.csv")).unwrap();
-    let out = dir.path().join("out");
-    let r = build_ok(
-        &input,
-        &out,
-        &[
-            "--quiet",
-            "--no-plan",
-            "--templates",
-            mydir.to_str().unwrap(),
-            "--params",
-            params.to_str().unwrap(),
-        ],
-    );
+    let (out, r) = common::build_with_failing_template(dir.path());
     let gpkg = out.join("plan.gpkg");
     let failed = r["skipped"]
         .as_array()
@@ -445,4 +415,46 @@ fn houses_generation_could_not_build_are_marked_in_lots_and_houses() {
     let nan = one("SELECT count(*) AS n FROM houses WHERE built = 0 AND reason LIKE '%is NaN%'");
     assert!(nan > 0 && nan < failed, "{nan} of {failed}");
     validate(&gpkg);
+}
+
+#[test]
+fn compare_reads_builds_of_a_broken_input() {
+    // A repeated id: plan.gpkg holds two lots of that id (the one built, the record
+    // skipped); the difference keeps one row for it.
+    let work = tempfile::tempdir().unwrap();
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_input/duplicate_id");
+    let (a, b) = (work.path().join("a"), work.path().join("b"));
+    build_ok(&case, &a, &["--quiet", "--no-plan"]);
+    // Every lot too shallow for a house in B.
+    let params = work.path().join("deep.toml");
+    std::fs::write(&params, "[machiya]\nmin_depth = 100.0\n").unwrap();
+    build_ok(
+        &case,
+        &b,
+        &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
+    );
+    let twice = rows(
+        &a.join("plan.gpkg"),
+        "SELECT status FROM lots WHERE id = '2' ORDER BY fid",
+    );
+    let status: Vec<&str> = twice.iter().map(|r| r["status"].as_str()).collect();
+    assert_eq!(
+        status,
+        ["built", "skipped"],
+        "the first built, the repeat skipped"
+    );
+    let diff = work.path().join("diff.gpkg");
+    let o = compare_gpkg(&a, &b, &diff);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    validate(&diff);
+    let lots = rows(&diff, "SELECT * FROM lots ORDER BY id");
+    let ids: Vec<&str> = lots.iter().map(|l| l["id"].as_str()).collect();
+    assert_eq!(ids, ["1", "2", "3"]);
+    for l in &lots {
+        assert!(l["differs"].contains("house"), "{l:?}");
+        assert_eq!(
+            (l["house_a"].as_str(), l["house_b"].as_str()),
+            ("built", "skipped")
+        );
+    }
 }

@@ -413,35 +413,7 @@ fn the_worked_example_of_docs_templates_md_builds() {
 #[test]
 fn a_template_that_fails_on_a_lot_skips_that_lot_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();
-    let mydir = dir.path().join("t");
-    std::fs::create_dir(&mydir).unwrap();
-    // NaN on narrow lots only (sqrt of a negative number), an upside-down part on wide ones.
-    std::fs::write(
-        mydir.join("odd.toml"),
-        "name = \"odd\"\nextends = \"machiya\"\n[derived]\nodd_w = \"sqrt(width - 5.0)\"\n\
-         [[part]]\nname = \"upside_down\"\nwhen = \"odd_w > 1\"\nv0 = \"1\"\nv1 = \"2\"\n\
-         bottom = \"3\"\ntop = \"2\"\n",
-    )
-    .unwrap();
-    let params = dir.path().join("p.toml");
-    std::fs::write(&params, "[type_mix]\nodd = 1.0\n").unwrap();
-    let input = dir.path().join("in");
-    copy_fixture("kyoto-small", &input);
-    std::fs::remove_file(input.join("lots.csv")).unwrap();
-    // The fixture's DBF names types for some lots; those are built as named.
-    let out = dir.path().join("out");
-    let r = build_ok(
-        &input,
-        &out,
-        &[
-            "--quiet",
-            "--no-plan",
-            "--templates",
-            mydir.to_str().unwrap(),
-            "--params",
-            params.to_str().unwrap(),
-        ],
-    );
+    let (_, r) = common::build_with_failing_template(dir.path());
     let skipped = r["skipped"].as_array().unwrap();
     let nan = skipped
         .iter()

@@ -219,6 +219,10 @@ pub fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<(
     {
         say!("  in a browser: edo-city serve {}", opts.out.display());
     }
+    let gpkg = opts.out.join(edo_city::output::PLAN_GPKG);
+    if gpkg.is_file() && opts.selection == edo_city::build::Selection::All {
+        say!("  in QGIS: {} (docs/gpkg.md)", gpkg.display());
+    }
     Ok(())
 }
 

@@ -1,5 +1,6 @@
 //! Stage 4: output. Writes tiles through one [`sink::Sink`] per format (`obj/`: OBJ + MTL,
-//! `gltf/`: GLB, with `tiles3d/`'s `tileset.json`), textures, `report.json` and `manifest.json`.
+//! `gltf/`: GLB, with `tiles3d/`'s `tileset.json`), textures, `plan.gpkg` (`gpkg/`: the
+//! decisions as GIS layers), `report.json` and `manifest.json`.
 //!
 //! Every file goes through [`atomic::write_atomic`]; `manifest.json` is written last, so a
 //! manifest always describes complete tiles.
@@ -10,9 +11,6 @@ pub mod chart;
 pub mod features;
 pub mod gltf;
 pub mod gpkg;
-
-/// The build's decisions as GIS layers, beside the tiles.
-pub const PLAN_GPKG: &str = "plan.gpkg";
 pub mod links;
 pub mod lock;
 pub mod obj;
@@ -32,6 +30,9 @@ use std::path::Path;
 use rayon::prelude::*;
 
 use sha2::{Digest, Sha256};
+
+/// The build's decisions as GIS layers, beside the tiles (`gpkg/`).
+pub const PLAN_GPKG: &str = "plan.gpkg";
 
 use crate::generate::mesh::Mesh;
 use crate::materials::TEXTURES;

@@ -340,3 +340,39 @@ pub fn start_server(mut cmd: std::process::Command) -> (Server, String) {
         .to_string();
     (server, url)
 }
+
+/// Builds the fixture into `dir/out` with a machiya type `odd` drawn for every lot without a
+/// type: NaN on narrow lots (the sqrt of a negative number), an upside-down part on wide ones,
+/// both found only when the tiles are made. Returns the output directory and its report.
+#[allow(dead_code)]
+pub fn build_with_failing_template(dir: &Path) -> (PathBuf, serde_json::Value) {
+    let mydir = dir.join("t");
+    std::fs::create_dir(&mydir).unwrap();
+    std::fs::write(
+        mydir.join("odd.toml"),
+        "name = \"odd\"\nextends = \"machiya\"\n[derived]\nodd_w = \"sqrt(width - 5.0)\"\n\
+         [[part]]\nname = \"upside_down\"\nwhen = \"odd_w > 1\"\nv0 = \"1\"\nv1 = \"2\"\n\
+         bottom = \"3\"\ntop = \"2\"\n",
+    )
+    .unwrap();
+    let params = dir.join("p.toml");
+    std::fs::write(&params, "[type_mix]\nodd = 1.0\n").unwrap();
+    let input = dir.join("in");
+    copy_fixture("kyoto-small", &input);
+    std::fs::remove_file(input.join("lots.csv")).unwrap();
+    // The fixture's DBF names types for some lots; those are built as named.
+    let out = dir.join("out");
+    let r = build_ok(
+        &input,
+        &out,
+        &[
+            "--quiet",
+            "--no-plan",
+            "--templates",
+            mydir.to_str().unwrap(),
+            "--params",
+            params.to_str().unwrap(),
+        ],
+    );
+    (out, r)
+}

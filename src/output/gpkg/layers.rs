@@ -159,7 +159,7 @@ pub(super) struct Index<'a> {
     /// Lots read, by id.
     pub lots: HashMap<&'a str, &'a Lot>,
     /// The first skip of each (layer, id), in report order.
-    pub skips: HashMap<(&'a str, &'a str), &'a Skipped>,
+    skips: HashMap<(&'a str, &'a str), Vec<&'a Skipped>>,
     /// Features a landmark displaced: (kind, id) -> landmark.
     pub displaced: HashMap<(&'a str, &'a str), &'a str>,
     /// Every street's segments, the street's index in `value`.
@@ -192,16 +192,27 @@ impl<'a> Index<'a> {
         index
     }
 
-    /// Every lookup, with `skipped` (the first skip of a layer and id counts).
+    /// Every lookup, with `skipped`.
     fn of(s: &'a PlanSources, skipped: impl Iterator<Item = &'a Skipped>) -> Index<'a> {
         let mut index = Index::default_for(s.data, s.plan);
         for k in skipped {
             index
                 .skips
                 .entry((k.layer.as_str(), k.id.as_str()))
-                .or_insert(k);
+                .or_default()
+                .push(k);
         }
         index
+    }
+
+    /// The first skip of a feature: its layer, its id and its record (a skip of a repeated
+    /// id names another record than the feature built under that id).
+    pub fn skip_of(&self, layer: &str, id: &str, record: usize) -> Option<&'a Skipped> {
+        self.skips
+            .get(&(layer, id))?
+            .iter()
+            .find(|k| k.record.is_none_or(|r| r == record))
+            .copied()
     }
 
     /// The id of the street nearest a point.
@@ -321,7 +332,7 @@ fn lots(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgEr
     )?;
     for lot in &s.data.lots {
         let house = houses.get(lot.id.as_str());
-        let skip = index.skips.get(&("lots", lot.id.as_str()));
+        let skip = index.skip_of("lots", &lot.id, lot.record);
         let displaced = index.displaced.get(&("machiya", lot.id.as_str()));
         let (status, reason) = match (house, skip, displaced) {
             (_, Some(k), _) => ("skipped", k.reason.clone()),
@@ -372,9 +383,16 @@ fn lots(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgEr
     }
     // Lot records that never became lots: at their outline where reading kept it.
     let shapes = shapes_of(s.data);
-    let read: std::collections::HashSet<&str> = s.data.lots.iter().map(|l| l.id.as_str()).collect();
+    // A skip of a lot that was read all the same (none today) is not a lot of its own; a
+    // repeated id is (the record skipped beside the one built).
+    let read: std::collections::HashSet<(&str, usize)> = s
+        .data
+        .lots
+        .iter()
+        .map(|l| (l.id.as_str(), l.record))
+        .collect();
     for k in s.data.skipped.iter().filter(|k| k.layer == "lots") {
-        if read.contains(k.id.as_str()) {
+        if k.record.is_some_and(|r| read.contains(&(k.id.as_str(), r))) {
             continue;
         }
         let shape = shapes.get(&(k.layer.as_str(), k.record, k.id.as_str()));
@@ -542,7 +560,7 @@ fn houses(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), Gpkg
         Some(style),
     )?;
     for h in planned(s.plan) {
-        let skip = index.skips.get(&(source(h), h.id.as_str()));
+        let skip = index.skip_of(source(h), &h.id, h.record);
         w.add(
             Some(&footprint(h, (s.band)(h))),
             &[

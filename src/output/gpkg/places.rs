@@ -228,7 +228,7 @@ pub(super) fn billboards(g: &mut GeoPackage, s: &PlanSources) -> Result<(), Gpkg
                 real("height"),
                 real("crown"),
                 text("form"),
-                text("texture"),
+                text("variant"),
                 real("facing_deg"),
                 text("district"),
                 text("tile"),

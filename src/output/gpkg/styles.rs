@@ -59,7 +59,10 @@ impl Look {
     }
     /// The same, half seen through (a layer drawn under another of the same colours).
     pub const fn faded(self) -> Look {
-        Look { alpha: 0.45, ..self }
+        Look {
+            alpha: 0.45,
+            ..self
+        }
     }
     /// The same, with a line width or marker size.
     pub const fn sized(self, size: f64) -> Look {
