@@ -67,7 +67,8 @@ impl Srs {
             .strip_prefix("EPSG:")
             .or_else(|| t.strip_prefix("epsg:"))
             .and_then(|n| n.trim().parse::<i32>().ok())
-            .or_else(|| wkt.and_then(last_epsg_authority));
+            .or_else(|| wkt.and_then(last_epsg_authority))
+            .or_else(|| utm_code(proj));
         let name = wkt
             .and_then(|w| w.split('"').nth(1))
             .map(str::to_string)
@@ -86,6 +87,24 @@ impl Srs {
             description: proj.into(),
         }
     }
+}
+
+/// The EPSG code of a WGS 84 UTM zone as `geom::crs::Crs::utm_for` spells it (the CRS a
+/// build chooses for data in degrees): 326zz north, 327zz south.
+fn utm_code(proj: &str) -> Option<i32> {
+    let words: Vec<&str> = proj.split_whitespace().collect();
+    let is = |w: &str| words.contains(&w);
+    if !(is("+proj=utm") && is("+datum=WGS84")) {
+        return None;
+    }
+    let zone: i32 = words
+        .iter()
+        .find_map(|w| w.strip_prefix("+zone="))?
+        .parse()
+        .ok()?;
+    (1..=60)
+        .contains(&zone)
+        .then(|| if is("+south") { 32700 } else { 32600 } + zone)
 }
 
 /// The EPSG code a WKT names for the whole CRS: its last `AUTHORITY["EPSG","n"]`.

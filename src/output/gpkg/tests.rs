@@ -148,8 +148,14 @@ fn the_srs_comes_from_the_parameters_or_the_prj() {
     let s = Srs::of_build("", Some(esri), "+proj=tmerc", false);
     assert_eq!((s.id, s.organization.as_str()), (100_000, "NONE"));
     assert_eq!(s.definition, esri);
-    // Reprojected from degrees into a zone the build chose: only its proj string is known.
-    let s = Srs::of_build("", Some(esri), "+proj=utm +zone=53", true);
-    assert_eq!(s.definition, "undefined");
-    assert_eq!(s.description, "+proj=utm +zone=53");
+    // Reprojected from degrees into the UTM zone the build chose: its EPSG code.
+    let utm = "+proj=utm +zone=53 +datum=WGS84 +units=m +no_defs";
+    let s = Srs::of_build("", Some(esri), utm, true);
+    assert_eq!((s.id, s.organization.as_str()), (32653, "EPSG"));
+    assert_eq!(s.description, utm);
+    let s = Srs::of_build("", None, &utm.replace("+zone=53", "+zone=19 +south"), true);
+    assert_eq!(s.id, 32719);
+    // Any other proj string: its own SRS, the definition left undefined.
+    let s = Srs::of_build("", Some(esri), "+proj=tmerc +lat_0=36", true);
+    assert_eq!((s.id, s.definition.as_str()), (100_000, "undefined"));
 }
