@@ -388,7 +388,7 @@ impl GeoPackage {
         columns: &[Column],
         description: &str,
     ) -> rusqlite::Result<()> {
-        let mut cols = vec!["fid INTEGER PRIMARY KEY AUTOINCREMENT NOT NULL".to_string()];
+        let mut cols = vec!["fid INTEGER PRIMARY KEY NOT NULL".to_string()];
         if let Some(g) = geometry {
             cols.push(format!("geom {}", g.name()));
         }
