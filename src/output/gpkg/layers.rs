@@ -10,13 +10,12 @@ use rstar::RTree;
 
 use super::styles::{self, Look, Shape};
 use super::{int, real, text, GeoPackage, GeomKind, GpkgError, Srs, Value};
-use crate::geom::frame::Frame;
 use crate::geom::segment::Segment;
 use crate::model::{Dataset, KuraDecision, Lot, Plan, PlannedHouse, Skipped};
 use crate::output::report::Manifest;
 use crate::params::Params;
 
-use super::places;
+use super::{houses, places};
 
 /// What `plan.gpkg` is made from: the input read, the analysis and the parameters.
 pub struct PlanSources<'a> {
@@ -45,14 +44,14 @@ impl PlanWriter {
         let mut g = GeoPackage::create(path, srs_of(s.data, s.params))?;
         let index = Index::of(s, s.data.skipped.iter().chain(&s.plan.skipped));
         frontages(&mut g, s, &index)?;
-        kura(&mut g, s)?;
+        houses::kura(&mut g, s)?;
         places::fences(&mut g, s)?;
         places::halls(&mut g, s, &index)?;
         places::gardens(&mut g, s, &index)?;
         places::billboards(&mut g, s)?;
         places::landmarks(&mut g, s)?;
         lots(&mut g, s, &index)?;
-        houses(&mut g, s, &index)?;
+        houses::houses(&mut g, s, &index)?;
         Ok(PlanWriter { g })
     }
 
@@ -65,58 +64,13 @@ impl PlanWriter {
             .iter()
             .flat_map(|t| &t.stats.skipped)
             .collect();
-        mark_generated(&self.g, s, &generated)?;
+        houses::mark_generated(&self.g, s, &generated)?;
         let mut g = self.g;
         let index = Index::of(s, report.skipped.iter());
         places::tiles(&mut g, s, manifest)?;
         places::skipped(&mut g, s.data, &report.skipped, &index)?;
         g.finish()
     }
-}
-
-/// Marks in `lots` and `houses` what generation found of the planned houses. A layer's
-/// fids run from 1 in the order its features were added (nothing is deleted): a lot's is its
-/// place in the dataset, a house's its place in the plan, so no map of a million ids is
-/// kept for the few skips there are.
-fn mark_generated(g: &GeoPackage, s: &PlanSources, skips: &[&Skipped]) -> Result<(), GpkgError> {
-    if skips.is_empty() {
-        return Ok(());
-    }
-    let mut by_key: HashMap<(&str, &str), Vec<&Skipped>> = HashMap::new();
-    for k in skips {
-        by_key
-            .entry((k.layer.as_str(), k.id.as_str()))
-            .or_default()
-            .push(k);
-    }
-    let lot_fid: HashMap<&str, i64> = s
-        .data
-        .lots
-        .iter()
-        .enumerate()
-        .filter(|(_, l)| by_key.contains_key(&("lots", l.id.as_str())))
-        .map(|(i, l)| (l.id.as_str(), i as i64 + 1))
-        .collect();
-    for (i, h) in planned(s.plan).enumerate() {
-        let Some(found) = by_key.get(&(source(h), h.id.as_str())) else {
-            continue;
-        };
-        let lot = match h.is_footprint() {
-            false => lot_fid.get(h.id.as_str()).copied(),
-            true => None,
-        };
-        for k in found {
-            // "its kura: ...", "its fence: ...", "its <hall>: ...": a part of the lot; the
-            // house stands.
-            mark(
-                g,
-                (lot, i as i64 + 1),
-                &k.reason,
-                k.reason.starts_with("its "),
-            )?;
-        }
-    }
-    Ok(())
 }
 
 /// Writes a whole `plan.gpkg` at once (`merge`, which has the manifest before it starts).
@@ -257,7 +211,7 @@ pub(super) fn polygon_of(points: Vec<Coord<f64>>) -> Geometry<f64> {
 }
 
 /// Every planned house, lot by lot, in the plan's order.
-fn planned(plan: &Plan) -> impl Iterator<Item = &PlannedHouse> {
+pub(super) fn planned(plan: &Plan) -> impl Iterator<Item = &PlannedHouse> {
     plan.houses.values().flatten()
 }
 
@@ -272,7 +226,7 @@ fn edge_index(outline: &Polygon<f64>, a: Coord<f64>, b: Coord<f64>) -> Option<us
 }
 
 /// What section 4.2 decided for a machiya's kura, in words: (decision, why).
-fn kura_words(k: &KuraDecision, avoid: bool) -> (&'static str, &'static str) {
+pub(super) fn kura_words(k: &KuraDecision, avoid: bool) -> (&'static str, &'static str) {
     match k {
         KuraDecision::NotCandidate => (
             "not a candidate",
@@ -408,40 +362,6 @@ fn lots(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgEr
     w.end()
 }
 
-/// Marks what generation found of a planned house: its lot skipped and the house not built
-/// (`part` false), or a part of it left out, in their `reason`s.
-fn mark(
-    g: &GeoPackage,
-    (lot, house): (Option<i64>, i64),
-    reason: &str,
-    part: bool,
-) -> Result<(), GpkgError> {
-    let sql = |source| GpkgError::Sqlite {
-        path: g.target.clone(),
-        source,
-    };
-    let add = "reason = coalesce(reason || '; ', '') || ?1";
-    let (lots, houses) = match part {
-        false => (
-            "UPDATE lots SET status = 'skipped', reason = ?1 WHERE fid = ?2".to_string(),
-            "UPDATE houses SET built = 0, reason = ?1 WHERE fid = ?2".to_string(),
-        ),
-        true => (
-            format!("UPDATE lots SET {add} WHERE fid = ?2"),
-            format!("UPDATE houses SET {add} WHERE fid = ?2"),
-        ),
-    };
-    if let Some(lot) = lot {
-        g.conn
-            .execute(&lots, rusqlite::params![reason, lot])
-            .map_err(sql)?;
-    }
-    g.conn
-        .execute(&houses, rusqlite::params![reason, house])
-        .map_err(sql)?;
-    Ok(())
-}
-
 /// The outlines reading kept of skipped records, by (layer, record, id).
 pub(super) fn shapes_of(data: &Dataset) -> HashMap<(&str, Option<usize>, &str), &Polygon<f64>> {
     data.skipped_shapes
@@ -517,158 +437,9 @@ fn frontages(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), G
     w.end()
 }
 
-fn source(h: &PlannedHouse) -> &'static str {
+pub(super) fn source(h: &PlannedHouse) -> &'static str {
     match h.is_footprint() {
         true => "footprints",
         false => "lots",
     }
-}
-
-/// `houses`: every house planned, on the ground it covers (a machiya its lot's band behind
-/// the frontage, a footprint building its outline), with its template; generation's skips
-/// are marked.
-fn houses(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgError> {
-    let colours = crate::output::plan::type_colours(s.plan);
-    let mut categories: Vec<(String, Look)> = colours
-        .into_iter()
-        .map(|(ty, rgb)| (ty, Look::of(rgb)))
-        .collect();
-    categories.push(("skipped".into(), Look::of(crate::output::plan::SKIPPED)));
-    let style = styles::categorized(
-        Shape::Fill,
-        "CASE WHEN \"built\" = 0 THEN 'skipped' ELSE \"template\" END",
-        &categories,
-        Some(Look::of(crate::output::plan::FOOTPRINT)),
-    );
-    let mut w = g.layer(
-        "houses",
-        Some(GeomKind::MultiPolygon),
-        &[
-            text("id"),
-            int("record"),
-            text("source"),
-            text("template"),
-            int("type_given"),
-            text("district"),
-            real("height"),
-            text("tile"),
-            int("built"),
-            text("reason"),
-        ],
-        "Each house planned: the ground it covers (a machiya the band of its lot behind the \
-         frontage its template fills, a footprint building its outline) and its template",
-        Some(style),
-    )?;
-    for h in planned(s.plan) {
-        let skip = index.skip_of(source(h), &h.id, h.record);
-        w.add(
-            Some(&footprint(h, (s.band)(h))),
-            &[
-                t(&h.id),
-                n(h.record),
-                t(source(h)),
-                t(&h.mtype),
-                n(h.type_given as usize),
-                opt(h.district.as_deref()),
-                h.footprint_height().map_or(Value::Null, r),
-                t(&h.tile),
-                n(skip.is_none() as usize),
-                opt(skip.map(|k| k.reason.as_str())),
-            ],
-        )?;
-    }
-    w.end()
-}
-
-/// The ground a house covers: the lot clipped to its band behind the frontage (in the
-/// frontage frame, as generation clips it), or its whole outline.
-fn footprint(h: &PlannedHouse, band: Option<(f64, f64)>) -> Geometry<f64> {
-    use crate::generate::clip::{clip_band, LocalPoly};
-    let whole = || Geometry::MultiPolygon(vec![h.outline.clone()].into());
-    let Some((lo, hi)) = band else {
-        return whole();
-    };
-    let frame = Frame {
-        a: h.frontage.a,
-        u: h.frontage.u_axis(),
-        v: h.frontage.v_axis(),
-    };
-    let local = |r: &LineString<f64>| -> Vec<[f64; 2]> {
-        crate::geom::ring::open(r)
-            .iter()
-            .map(|c| frame.local(*c))
-            .collect()
-    };
-    let poly = LocalPoly {
-        exterior: local(h.outline.exterior()),
-        holes: h.outline.interiors().iter().map(local).collect(),
-    };
-    let parts: Vec<Polygon<f64>> = clip_band(&poly, lo, hi)
-        .iter()
-        .map(|p| {
-            let ring = |r: &Vec<[f64; 2]>| {
-                let mut c: Vec<Coord<f64>> = r.iter().map(|q| frame.map(*q)).collect();
-                c.extend(c.first().copied());
-                LineString::from(c)
-            };
-            Polygon::new(ring(&p.exterior), p.holes.iter().map(ring).collect())
-        })
-        .collect();
-    match parts.is_empty() {
-        true => whole(),
-        false => Geometry::MultiPolygon(parts.into()),
-    }
-}
-
-/// `kura`: every kura plot section 4.2 found room for, placed or refused (hatched).
-fn kura(g: &mut GeoPackage, s: &PlanSources) -> Result<(), GpkgError> {
-    let avoid = s.params.kura.collision;
-    let style = styles::categorized(
-        Shape::Fill,
-        "status",
-        &[
-            ("placed".into(), Look::of([120, 120, 120])),
-            ("refused".into(), Look::of([200, 40, 40]).hatched()),
-        ],
-        None,
-    );
-    let mut w = g.layer(
-        "kura",
-        Some(GeomKind::Polygon),
-        &[
-            text("id"),
-            int("record"),
-            text("status"),
-            text("reason"),
-            real("width"),
-            real("depth"),
-            text("tile"),
-        ],
-        "The kura (storehouse) plots of section 4.2: placed, or refused for a collision",
-        Some(style),
-    )?;
-    for h in planned(s.plan) {
-        let Some(rect) = h.kura.rect() else {
-            continue;
-        };
-        let frame = Frame {
-            a: h.frontage.a,
-            u: h.frontage.u_axis(),
-            v: h.frontage.v_axis(),
-        };
-        let (status, why) = kura_words(&h.kura, avoid);
-        w.add(
-            Some(&polygon_of(frame.quad(rect).to_vec())),
-            &[
-                t(&h.id),
-                n(h.record),
-                t(status),
-                t(why),
-                r(rect[2] - rect[0]),
-                r(rect[3] - rect[1]),
-                t(&h.tile),
-            ],
-        )?;
-    }
-    w.end()
 }

@@ -13,6 +13,8 @@
 
 mod diff;
 mod geometry;
+mod houses;
+mod layer;
 mod layers;
 mod places;
 mod rtree;
@@ -20,10 +22,10 @@ mod styles;
 
 use std::path::{Path, PathBuf};
 
-use geo_types::Geometry;
 use rusqlite::{params, Connection};
 
 pub use diff::{write_diff, DiffError};
+pub use layer::LayerWriter;
 pub use layers::{write_plan, write_problems, PlanSources, PlanWriter};
 pub use rusqlite::types::Value;
 
@@ -456,7 +458,7 @@ impl GeoPackage {
 
     fn finish_sql(&self) -> rusqlite::Result<()> {
         for name in &self.spatial {
-            self.conn.execute_batch(&triggers(name))?;
+            self.conn.execute_batch(&rtree::triggers(name))?;
         }
         styles::write(&self.conn, &self.styles)?;
         self.conn.execute_batch("COMMIT;")
@@ -473,167 +475,9 @@ impl Drop for Temporary {
     }
 }
 
-/// Adds the features of one layer.
-pub struct LayerWriter<'c> {
-    name: String,
-    conn: &'c Connection,
-    insert: rusqlite::Statement<'c>,
-    spatial: bool,
-    srs: i32,
-    columns: usize,
-    extent: Option<[f64; 4]>,
-    target: PathBuf,
-    buffer: Vec<u8>,
-    /// Each feature's box, packed into the spatial index when the layer ends.
-    cells: Vec<rtree::Cell>,
-}
-
-impl LayerWriter<'_> {
-    /// Adds one feature: its geometry (`None`: a feature without one) and its values, one
-    /// per column in the layer's order. Returns its fid.
-    pub fn add(
-        &mut self,
-        geom: Option<&Geometry<f64>>,
-        values: &[Value],
-    ) -> Result<i64, GpkgError> {
-        debug_assert_eq!(values.len(), self.columns, "{}", self.name);
-        let sql = |source| GpkgError::Sqlite {
-            path: self.target.clone(),
-            source,
-        };
-        let spatial = self.spatial;
-        let envelope = match (spatial, geom) {
-            (true, Some(g)) => geometry::encode(g, self.srs, &mut self.buffer),
-            _ => None,
-        };
-        let blob = (spatial && geom.is_some()).then_some(&self.buffer[..]);
-        let mut all: Vec<&dyn rusqlite::ToSql> = Vec::with_capacity(values.len() + 1);
-        if spatial {
-            all.push(&blob);
-        }
-        all.extend(values.iter().map(|v| v as &dyn rusqlite::ToSql));
-        self.insert.execute(&all[..]).map_err(sql)?;
-        let fid = self.conn.last_insert_rowid();
-        if let Some(e) = envelope.filter(|_| spatial) {
-            self.cells.push((fid, rtree::cell_box(e)));
-            self.grow(e);
-        }
-        Ok(fid)
-    }
-
-    /// Adds one feature whose geometry is a GeoPackage blob already (copied from another
-    /// package of the same SRS).
-    pub fn add_blob(&mut self, blob: Option<&[u8]>, values: &[Value]) -> Result<(), GpkgError> {
-        let sql = |source| GpkgError::Sqlite {
-            path: self.target.clone(),
-            source,
-        };
-        let mut all: Vec<&dyn rusqlite::ToSql> = Vec::with_capacity(values.len() + 1);
-        all.push(&blob);
-        all.extend(values.iter().map(|v| v as &dyn rusqlite::ToSql));
-        self.insert.execute(&all[..]).map_err(sql)?;
-        let envelope = blob.and_then(geometry::envelope_of);
-        let fid = self.conn.last_insert_rowid();
-        if let Some(e) = envelope.filter(|_| self.spatial) {
-            self.cells.push((fid, rtree::cell_box(e)));
-            self.grow(e);
-        }
-        Ok(())
-    }
-
-    fn grow(&mut self, e: [f64; 4]) {
-        self.extent = Some(match self.extent {
-            None => e,
-            Some(x) => [
-                x[0].min(e[0]),
-                x[1].max(e[1]),
-                x[2].min(e[2]),
-                x[3].max(e[3]),
-            ],
-        });
-    }
-
-    /// Ends the layer: its spatial index, packed (`rtree.rs`), and its extent in
-    /// `gpkg_contents`.
-    pub fn end(mut self) -> Result<(), GpkgError> {
-        if self.spatial {
-            let table = format!("rtree_{}_geom", self.name);
-            rtree::write(self.conn, &table, &mut self.cells).map_err(|source| {
-                GpkgError::Sqlite {
-                    path: self.target.clone(),
-                    source,
-                }
-            })?;
-        }
-        if let Some(e) = self.extent {
-            self.conn
-                .execute(
-                    "UPDATE gpkg_contents SET min_x = ?1, max_x = ?2, min_y = ?3, max_y = ?4 \
-                     WHERE table_name = ?5",
-                    params![e[0], e[1], e[2], e[3], self.name],
-                )
-                .map_err(|source| GpkgError::Sqlite {
-                    path: self.target.clone(),
-                    source,
-                })?;
-        }
-        Ok(())
-    }
-}
-
 /// A name as an SQL identifier.
-fn quoted(name: &str) -> String {
+pub(super) fn quoted(name: &str) -> String {
     format!("\"{}\"", name.replace('"', "\"\""))
-}
-
-/// The spatial index's triggers, as the standard gives them (Annex F.3), for a layer whose
-/// index was written when its features were. They call `ST_*` functions that GDAL and
-/// QGIS register when they edit the file; this writer never fires them.
-fn triggers(t: &str) -> String {
-    let (tq, r) = (quoted(t), quoted(&format!("rtree_{t}_geom")));
-    let n = |suffix: &str| quoted(&format!("rtree_{t}_geom_{suffix}"));
-    format!(
-        "CREATE TRIGGER {insert} AFTER INSERT ON {tq}
-           WHEN (new.geom NOT NULL AND NOT ST_IsEmpty(NEW.geom))
-         BEGIN
-           INSERT OR REPLACE INTO {r} VALUES (NEW.fid, ST_MinX(NEW.geom), ST_MaxX(NEW.geom),
-             ST_MinY(NEW.geom), ST_MaxY(NEW.geom));
-         END;
-         CREATE TRIGGER {update1} AFTER UPDATE OF geom ON {tq}
-           WHEN OLD.fid = NEW.fid AND (NEW.geom NOTNULL AND NOT ST_IsEmpty(NEW.geom))
-         BEGIN
-           INSERT OR REPLACE INTO {r} VALUES (NEW.fid, ST_MinX(NEW.geom), ST_MaxX(NEW.geom),
-             ST_MinY(NEW.geom), ST_MaxY(NEW.geom));
-         END;
-         CREATE TRIGGER {update2} AFTER UPDATE OF geom ON {tq}
-           WHEN OLD.fid = NEW.fid AND (NEW.geom ISNULL OR ST_IsEmpty(NEW.geom))
-         BEGIN
-           DELETE FROM {r} WHERE id = OLD.fid;
-         END;
-         CREATE TRIGGER {update3} AFTER UPDATE ON {tq}
-           WHEN OLD.fid != NEW.fid AND (NEW.geom NOTNULL AND NOT ST_IsEmpty(NEW.geom))
-         BEGIN
-           DELETE FROM {r} WHERE id = OLD.fid;
-           INSERT OR REPLACE INTO {r} VALUES (NEW.fid, ST_MinX(NEW.geom), ST_MaxX(NEW.geom),
-             ST_MinY(NEW.geom), ST_MaxY(NEW.geom));
-         END;
-         CREATE TRIGGER {update4} AFTER UPDATE ON {tq}
-           WHEN OLD.fid != NEW.fid AND (NEW.geom ISNULL OR ST_IsEmpty(NEW.geom))
-         BEGIN
-           DELETE FROM {r} WHERE id IN (OLD.fid, NEW.fid);
-         END;
-         CREATE TRIGGER {delete} AFTER DELETE ON {tq}
-           WHEN old.geom NOT NULL
-         BEGIN
-           DELETE FROM {r} WHERE id = OLD.fid;
-         END;",
-        insert = n("insert"),
-        update1 = n("update1"),
-        update2 = n("update2"),
-        update3 = n("update3"),
-        update4 = n("update4"),
-        delete = n("delete"),
-    )
 }
 
 #[cfg(test)]

@@ -125,6 +125,56 @@ pub fn write(conn: &Connection, table: &str, cells: &mut [Cell]) -> rusqlite::Re
     Ok(())
 }
 
+/// The spatial index's triggers, as the standard gives them (Annex F.3), for a layer whose
+/// index was written when its features were. They call `ST_*` functions that GDAL and
+/// QGIS register when they edit the file; this writer never fires them.
+pub fn triggers(t: &str) -> String {
+    let (tq, r) = (super::quoted(t), super::quoted(&format!("rtree_{t}_geom")));
+    let n = |suffix: &str| super::quoted(&format!("rtree_{t}_geom_{suffix}"));
+    format!(
+        "CREATE TRIGGER {insert} AFTER INSERT ON {tq}
+           WHEN (new.geom NOT NULL AND NOT ST_IsEmpty(NEW.geom))
+         BEGIN
+           INSERT OR REPLACE INTO {r} VALUES (NEW.fid, ST_MinX(NEW.geom), ST_MaxX(NEW.geom),
+             ST_MinY(NEW.geom), ST_MaxY(NEW.geom));
+         END;
+         CREATE TRIGGER {update1} AFTER UPDATE OF geom ON {tq}
+           WHEN OLD.fid = NEW.fid AND (NEW.geom NOTNULL AND NOT ST_IsEmpty(NEW.geom))
+         BEGIN
+           INSERT OR REPLACE INTO {r} VALUES (NEW.fid, ST_MinX(NEW.geom), ST_MaxX(NEW.geom),
+             ST_MinY(NEW.geom), ST_MaxY(NEW.geom));
+         END;
+         CREATE TRIGGER {update2} AFTER UPDATE OF geom ON {tq}
+           WHEN OLD.fid = NEW.fid AND (NEW.geom ISNULL OR ST_IsEmpty(NEW.geom))
+         BEGIN
+           DELETE FROM {r} WHERE id = OLD.fid;
+         END;
+         CREATE TRIGGER {update3} AFTER UPDATE ON {tq}
+           WHEN OLD.fid != NEW.fid AND (NEW.geom NOTNULL AND NOT ST_IsEmpty(NEW.geom))
+         BEGIN
+           DELETE FROM {r} WHERE id = OLD.fid;
+           INSERT OR REPLACE INTO {r} VALUES (NEW.fid, ST_MinX(NEW.geom), ST_MaxX(NEW.geom),
+             ST_MinY(NEW.geom), ST_MaxY(NEW.geom));
+         END;
+         CREATE TRIGGER {update4} AFTER UPDATE ON {tq}
+           WHEN OLD.fid != NEW.fid AND (NEW.geom ISNULL OR ST_IsEmpty(NEW.geom))
+         BEGIN
+           DELETE FROM {r} WHERE id IN (OLD.fid, NEW.fid);
+         END;
+         CREATE TRIGGER {delete} AFTER DELETE ON {tq}
+           WHEN old.geom NOT NULL
+         BEGIN
+           DELETE FROM {r} WHERE id = OLD.fid;
+         END;",
+        insert = n("insert"),
+        update1 = n("update1"),
+        update2 = n("update2"),
+        update3 = n("update3"),
+        update4 = n("update4"),
+        delete = n("delete"),
+    )
+}
+
 /// The box holding every cell.
 fn union(cells: &[Cell]) -> [f32; 4] {
     cells.iter().fold(

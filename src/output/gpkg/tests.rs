@@ -2,7 +2,7 @@
 //! no temporary left behind.
 
 use super::*;
-use geo_types::{point, polygon};
+use geo_types::{point, polygon, Geometry};
 
 fn srs() -> Srs {
     Srs::of_build("", Some(WKT), "+proj=tmerc", false)
