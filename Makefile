@@ -2,15 +2,15 @@
 
 CARGO ?= cargo
 
-.PHONY: run test test-cluster test-future lint bench real textures fixtures clean pictures bad-input viewer-deps
+.PHONY: run test test-cluster test-future lint bench real textures fixtures clean pictures bad-input viewer-deps gis-deps
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
 	$(CARGO) run --release -- build fixtures/kyoto-small --out out
 
 ## Unit, property, end-to-end and doc tests; the glTF validator and the browser test need
-## the viewer's npm packages (installed first when missing).
-test: viewer-deps
+## the viewer's npm packages, the GeoPackage tests GDAL (installed first when missing).
+test: viewer-deps gis-deps
 	$(CARGO) test --all-targets
 	$(CARGO) test --doc
 
@@ -18,6 +18,10 @@ test: viewer-deps
 ## exactly as viewer/package-lock.json pins them, and Debian's chromium for the browser test.
 viewer-deps:
 	bash scripts/viewer-deps.sh
+
+## Debian's gdal-bin and python3-gdal, with which tests/gpkg.rs reads plan.gpkg.
+gis-deps:
+	bash scripts/gis-deps.sh
 
 ## The suite again under faketime on the first leap day a year or more ahead (needs faketime:
 ## scripts/ci-deps.sh installs it); CI runs it after `make test`.

@@ -19,10 +19,3 @@ if ! command -v faketime >/dev/null 2>&1; then
 fi
 command -v faketime >/dev/null
 
-# GDAL reads what the build writes as GIS layers (tests/gpkg.rs): ogrinfo and gdalsrsinfo
-# from gdal-bin, the GeoPackage validator from python3-gdal.
-if ! command -v ogrinfo >/dev/null 2>&1 \
-  || [ ! -f /usr/lib/python3/dist-packages/osgeo_utils/samples/validate_gpkg.py ]; then
-  apt_install gdal-bin python3-gdal
-fi
-command -v ogrinfo >/dev/null
