@@ -68,10 +68,7 @@ fn mark(
     reason: &str,
     part: bool,
 ) -> Result<(), GpkgError> {
-    let sql = |source| GpkgError::Sqlite {
-        path: g.target.clone(),
-        source,
-    };
+    let sql = |e| g.err(e);
     let add = "reason = coalesce(reason || '; ', '') || ?1";
     let (lots, houses) = match part {
         false => (

@@ -32,48 +32,48 @@ impl LayerWriter<'_> {
         values: &[Value],
     ) -> Result<i64, GpkgError> {
         debug_assert_eq!(values.len(), self.columns, "{}", self.name);
-        let sql = |source| GpkgError::Sqlite {
-            path: self.target.clone(),
-            source,
-        };
-        let spatial = self.spatial;
-        let envelope = match (spatial, geom) {
-            (true, Some(g)) => geometry::encode(g, self.srs, &mut self.buffer),
-            _ => None,
-        };
-        let blob = (spatial && geom.is_some()).then_some(&self.buffer[..]);
+        let mut buffer = std::mem::take(&mut self.buffer);
+        let geom = geom.filter(|_| self.spatial);
+        let envelope = geom.and_then(|g| geometry::encode(g, self.srs, &mut buffer));
+        let fid = self.row(geom.map(|_| &buffer[..]), envelope, values);
+        self.buffer = buffer;
+        fid
+    }
+
+    /// Adds one feature whose geometry is a GeoPackage blob already (copied from another
+    /// package of the same SRS).
+    pub fn add_blob(&mut self, blob: Option<&[u8]>, values: &[Value]) -> Result<(), GpkgError> {
+        let envelope = blob.and_then(geometry::envelope_of);
+        self.row(blob, envelope, values).map(|_| ())
+    }
+
+    /// Inserts one row (its blob first when the layer is spatial) and keeps its box for
+    /// the index; returns its fid.
+    fn row(
+        &mut self,
+        blob: Option<&[u8]>,
+        envelope: Option<[f64; 4]>,
+        values: &[Value],
+    ) -> Result<i64, GpkgError> {
         let mut all: Vec<&dyn rusqlite::ToSql> = Vec::with_capacity(values.len() + 1);
-        if spatial {
+        if self.spatial {
             all.push(&blob);
         }
         all.extend(values.iter().map(|v| v as &dyn rusqlite::ToSql));
-        self.insert.execute(&all[..]).map_err(sql)?;
+        self.insert.execute(&all[..]).map_err(|e| self.err(e))?;
         let fid = self.conn.last_insert_rowid();
-        if let Some(e) = envelope.filter(|_| spatial) {
+        if let Some(e) = envelope.filter(|_| self.spatial) {
             self.cells.push((fid, rtree::cell_box(e)));
             self.grow(e);
         }
         Ok(fid)
     }
 
-    /// Adds one feature whose geometry is a GeoPackage blob already (copied from another
-    /// package of the same SRS).
-    pub fn add_blob(&mut self, blob: Option<&[u8]>, values: &[Value]) -> Result<(), GpkgError> {
-        let sql = |source| GpkgError::Sqlite {
+    fn err(&self, source: rusqlite::Error) -> GpkgError {
+        GpkgError::Sqlite {
             path: self.target.clone(),
             source,
-        };
-        let mut all: Vec<&dyn rusqlite::ToSql> = Vec::with_capacity(values.len() + 1);
-        all.push(&blob);
-        all.extend(values.iter().map(|v| v as &dyn rusqlite::ToSql));
-        self.insert.execute(&all[..]).map_err(sql)?;
-        let envelope = blob.and_then(geometry::envelope_of);
-        let fid = self.conn.last_insert_rowid();
-        if let Some(e) = envelope.filter(|_| self.spatial) {
-            self.cells.push((fid, rtree::cell_box(e)));
-            self.grow(e);
         }
-        Ok(())
     }
 
     fn grow(&mut self, e: [f64; 4]) {
@@ -93,12 +93,8 @@ impl LayerWriter<'_> {
     pub fn end(mut self) -> Result<(), GpkgError> {
         if self.spatial {
             let table = format!("rtree_{}_geom", self.name);
-            rtree::write(self.conn, &table, &mut self.cells).map_err(|source| {
-                GpkgError::Sqlite {
-                    path: self.target.clone(),
-                    source,
-                }
-            })?;
+            let written = rtree::write(self.conn, &table, &mut self.cells);
+            written.map_err(|e| self.err(e))?;
         }
         if let Some(e) = self.extent {
             self.conn
@@ -107,10 +103,7 @@ impl LayerWriter<'_> {
                      WHERE table_name = ?5",
                     params![e[0], e[1], e[2], e[3], self.name],
                 )
-                .map_err(|source| GpkgError::Sqlite {
-                    path: self.target.clone(),
-                    source,
-                })?;
+                .map_err(|e| self.err(e))?;
         }
         Ok(())
     }

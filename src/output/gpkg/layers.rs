@@ -66,9 +66,8 @@ impl PlanWriter {
             .collect();
         houses::mark_generated(&self.g, s, &generated)?;
         let mut g = self.g;
-        let index = Index::of(s, report.skipped.iter());
         places::tiles(&mut g, s, manifest)?;
-        places::skipped(&mut g, s.data, &report.skipped, &index)?;
+        places::skipped(&mut g, s.data, &report.skipped, &Index::lots_of(s.data))?;
         g.finish()
     }
 }
@@ -78,8 +77,8 @@ pub fn write_plan(path: &Path, s: &PlanSources, manifest: &Manifest) -> Result<(
     PlanWriter::start(path, s)?.finish(s, manifest)
 }
 
-/// Writes the problems `check` found as one layer, `problems`, at their records' geometry
-/// where one is known, and the lots they concern beside them.
+/// Writes what `check` found: layer `problems` (each record a build would skip, at its
+/// outline where one is known, else its lot's) and layer `warnings`.
 pub fn write_problems(
     path: &Path,
     data: &Dataset,
@@ -88,13 +87,7 @@ pub fn write_problems(
     warnings: &[crate::model::Warning],
 ) -> Result<(), GpkgError> {
     let mut g = GeoPackage::create(path, srs_of(data, params))?;
-    let index = Index {
-        lots: data.lots.iter().map(|l| (l.id.as_str(), l)).collect(),
-        skips: HashMap::new(),
-        displaced: HashMap::new(),
-        streets: RTree::new(),
-    };
-    places::problems(&mut g, data, skipped, warnings, &index)?;
+    places::problems(&mut g, data, skipped, warnings, &Index::lots_of(data))?;
     g.finish()
 }
 
@@ -112,7 +105,7 @@ pub fn srs_of(data: &Dataset, params: &Params) -> Srs {
 pub(super) struct Index<'a> {
     /// Lots read, by id.
     pub lots: HashMap<&'a str, &'a Lot>,
-    /// The first skip of each (layer, id), in report order.
+    /// The skips of each (layer, id), in report order.
     skips: HashMap<(&'a str, &'a str), Vec<&'a Skipped>>,
     /// Features a landmark displaced: (kind, id) -> landmark.
     pub displaced: HashMap<(&'a str, &'a str), &'a str>,
@@ -121,14 +114,28 @@ pub(super) struct Index<'a> {
 }
 
 impl<'a> Index<'a> {
-    /// The lookups of the layers analysis alone decides: no skips of generation yet.
-    fn default_for(data: &'a Dataset, plan: &'a Plan) -> Index<'a> {
-        let mut index = Index {
+    /// The lots by id alone: where a skipped record without an outline of its own is drawn.
+    fn lots_of(data: &'a Dataset) -> Index<'a> {
+        Index {
             lots: data.lots.iter().map(|l| (l.id.as_str(), l)).collect(),
             skips: HashMap::new(),
             displaced: HashMap::new(),
             streets: RTree::new(),
-        };
+        }
+    }
+
+    /// Every lookup, with `skipped`: the skips analysis knows of (generation's are marked
+    /// afterwards).
+    fn of(s: &'a PlanSources, skipped: impl Iterator<Item = &'a Skipped>) -> Index<'a> {
+        let (data, plan) = (s.data, s.plan);
+        let mut index = Index::lots_of(data);
+        for k in skipped {
+            index
+                .skips
+                .entry((k.layer.as_str(), k.id.as_str()))
+                .or_default()
+                .push(k);
+        }
         for d in &plan.landmark_report.displaced {
             index
                 .displaced
@@ -143,19 +150,6 @@ impl<'a> Index<'a> {
             })
         });
         index.streets = RTree::bulk_load(segments.collect());
-        index
-    }
-
-    /// Every lookup, with `skipped`.
-    fn of(s: &'a PlanSources, skipped: impl Iterator<Item = &'a Skipped>) -> Index<'a> {
-        let mut index = Index::default_for(s.data, s.plan);
-        for k in skipped {
-            index
-                .skips
-                .entry((k.layer.as_str(), k.id.as_str()))
-                .or_default()
-                .push(k);
-        }
         index
     }
 

@@ -264,7 +264,7 @@ impl GeoPackage {
         Ok(g)
     }
 
-    fn err(&self, source: rusqlite::Error) -> GpkgError {
+    pub(super) fn err(&self, source: rusqlite::Error) -> GpkgError {
         GpkgError::Sqlite {
             path: self.target.clone(),
             source,
