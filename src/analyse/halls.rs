@@ -248,11 +248,7 @@ fn facing(
     if -u.y * towards.x + u.x * towards.y < 0.0 {
         u = Coord { x: -u.x, y: -u.y };
     }
-    Some(crate::geom::frame::Frame {
-        a: mid,
-        u,
-        v: Coord { x: -u.y, y: u.x },
-    })
+    Some(crate::geom::frame::Frame::along(mid, u))
 }
 
 /// The plot: its (u, v) corner in `frame` and its size, the largest that fits.

@@ -10,11 +10,7 @@ use crate::templates::Catalog;
 
 /// A machiya's frontage frame: u along the street, v into the lot.
 pub fn frame_of(m: &PlannedHouse) -> Frame {
-    Frame {
-        a: m.frontage.a,
-        u: m.frontage.u_axis(),
-        v: m.frontage.v_axis(),
-    }
+    Frame::along(m.frontage.a, m.frontage.u_axis())
 }
 
 /// The exterior ring in the frame, not closed.

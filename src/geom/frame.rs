@@ -29,6 +29,23 @@ pub struct Frame {
 }
 
 impl Frame {
+    /// The frame at `a` along the unit vector `u`, its `v` axis `u` turned a quarter to the
+    /// left: a frontage's frame when `a` is its start and `u` runs along it.
+    ///
+    /// ```
+    /// use edo_city::geom::frame::Frame;
+    /// use geo_types::Coord;
+    /// let f = Frame::along(Coord { x: 1.0, y: 2.0 }, Coord { x: 0.0, y: 1.0 });
+    /// assert_eq!(f.v, Coord { x: -1.0, y: 0.0 });
+    /// ```
+    pub fn along(a: Coord<f64>, u: Coord<f64>) -> Frame {
+        Frame {
+            a,
+            u,
+            v: Coord { x: -u.y, y: u.x },
+        }
+    }
+
     /// Map coordinates of the local point `p = [x, y]`.
     pub fn map(&self, p: [f64; 2]) -> Coord<f64> {
         Coord {

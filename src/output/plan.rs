@@ -435,12 +435,7 @@ fn draw_kura(pm: &mut Pixmap, view: &View, plan: &Plan, avoid: bool) -> bool {
     let mut refused = Batch::new(Draw::Stroke(paint(KURA_REFUSED, 255), wide(1.5)));
     for m in plan.houses.values().flatten() {
         let Some(r) = m.kura.rect() else { continue };
-        let q = crate::geom::frame::Frame {
-            a: m.frontage.a,
-            u: m.frontage.u_axis(),
-            v: m.frontage.v_axis(),
-        }
-        .quad(r);
+        let q = crate::geom::frame::Frame::along(m.frontage.a, m.frontage.u_axis()).quad(r);
         match m.kura.to_build(avoid) {
             Some(_) => built.ring(pm, view, &q),
             None => refused.ring(pm, view, &q),

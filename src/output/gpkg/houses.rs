@@ -155,11 +155,7 @@ fn footprint(h: &PlannedHouse, band: Option<(f64, f64)>) -> Geometry<f64> {
     let Some((lo, hi)) = band else {
         return whole();
     };
-    let frame = Frame {
-        a: h.frontage.a,
-        u: h.frontage.u_axis(),
-        v: h.frontage.v_axis(),
-    };
+    let frame = Frame::along(h.frontage.a, h.frontage.u_axis());
     let local = |r: &LineString<f64>| -> Vec<[f64; 2]> {
         crate::geom::ring::open(r)
             .iter()
@@ -218,11 +214,7 @@ pub(super) fn kura(g: &mut GeoPackage, s: &PlanSources) -> Result<(), GpkgError>
         let Some(rect) = h.kura.rect() else {
             continue;
         };
-        let frame = Frame {
-            a: h.frontage.a,
-            u: h.frontage.u_axis(),
-            v: h.frontage.v_axis(),
-        };
+        let frame = Frame::along(h.frontage.a, h.frontage.u_axis());
         let (status, why) = kura_words(&h.kura, avoid);
         w.add(
             Some(&polygon_of(frame.quad(rect).to_vec())),
