@@ -797,6 +797,7 @@ fn resolved_table(
     };
     check_user_keys(text, path)?;
     let mut user = parse(text, path)?;
+    anchor_designs(&mut user, base_dir);
     let mut merged = match user.remove("extends") {
         None => parse(DEFAULT_TOML, "params/default.toml")?,
         Some(toml::Value::String(name)) => {
@@ -833,6 +834,20 @@ fn resolved_table(
     // exactly those.
     merge(&mut merged, user);
     Ok(merged)
+}
+
+/// `garden.designs`, when relative, made relative to `base_dir`: the directory of the file
+/// that names it (a parameter file kept beside its designs works from anywhere).
+fn anchor_designs(table: &mut toml::Table, base_dir: &Path) {
+    let Some(toml::Value::Table(garden)) = table.get_mut("garden") else {
+        return;
+    };
+    if let Some(toml::Value::String(file)) = garden.get_mut("designs") {
+        if !file.is_empty() && Path::new(file.as_str()).is_relative() && base_dir != Path::new(".")
+        {
+            *file = base_dir.join(file.as_str()).display().to_string();
+        }
+    }
 }
 
 /// Overlays `user` on `base`, table by table; `type_mix` is replaced whole, and each row of

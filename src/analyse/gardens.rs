@@ -12,15 +12,16 @@
 //! hall's veranda, as Ryoanji's from its hojo. Runs before the billboards, which keep out of
 //! the gardens.
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{HashMap, HashSet};
 
 use geo::{Centroid, Contains, Point};
 use geo_types::{Coord, Polygon};
 use rayon::prelude::*;
 
 use super::obstacles::{boundary_distance, Obstacles};
-use crate::growers::garden::ga::{self, GaParams};
-use crate::growers::garden::Settings;
+use crate::growers::garden::ga::{self, Candidate, GaParams};
+use crate::growers::garden::{Layout, Settings};
+use crate::model::design::Design;
 use crate::model::{
     tile::tile_id, Dataset, FenceKind, GardenArea, GardenStat, Lot, Plan, PlannedGarden, Skipped,
 };
@@ -119,11 +120,26 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, para
             });
         }
     }
-    let mut results: Vec<(GardenStat, Option<PlannedGarden>)> = sites
+    let kept: HashMap<&str, &(usize, Design)> =
+        data.designs.iter().map(|d| (d.1.lot.as_str(), d)).collect();
+    let designed: Vec<Designed> = sites
         .par_iter()
-        .map(|site| design(site, obstacles, params))
+        .map(|site| {
+            let d = kept.get(site.key.as_str()).map(|d| &d.1);
+            design(site, d, obstacles, params)
+        })
         .collect();
+    let mut refused: Vec<Option<String>> = designed.iter().map(|d| d.refused.clone()).collect();
+    let mut results: Vec<(GardenStat, Option<PlannedGarden>)> =
+        designed.into_iter().map(|d| (d.stat, d.garden)).collect();
     drop_overlaps(&mut results, &sites);
+    for (k, (stat, _)) in results.iter_mut().enumerate() {
+        if stat.kept && !stat.placed {
+            refused[k] = Some(format!("the design's garden is not built: {}", stat.reason));
+            stat.kept = false;
+        }
+    }
+    refuse_designs(data, &sites, &refused, &mut plan.skipped);
     for ((stat, garden), site) in results.into_iter().zip(&sites) {
         if let (false, Some((id, record))) = (stat.placed, &site.area) {
             plan.skipped.push(Skipped {
@@ -139,6 +155,46 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, para
             plan.tiles.insert(gd.tile.clone());
             plan.gardens.entry(gd.tile.clone()).or_default().push(gd);
         }
+    }
+}
+
+/// Lists as skipped each kept design that was not placed: refused by its site (`refused`,
+/// by site), or for a garden this build does not have.
+fn refuse_designs(
+    data: &Dataset,
+    sites: &[Site],
+    refused: &[Option<String>],
+    out: &mut Vec<Skipped>,
+) {
+    let at: HashMap<&str, usize> = sites
+        .iter()
+        .enumerate()
+        .map(|(k, s)| (s.key.as_str(), k))
+        .collect();
+    for (record, d) in &data.designs {
+        let reason = match at.get(d.lot.as_str()) {
+            Some(&k) => match &refused[k] {
+                Some(r) => r.clone(),
+                None => continue,
+            },
+            None => format!(
+                "a design for no garden of this build: `{}` is no lot of `garden.uses` and no \
+                 polygon of the gardens layer (was the lot renamed, or its use changed?)",
+                d.lot
+            ),
+        };
+        out.push(Skipped {
+            layer: "designs".into(),
+            file: data
+                .layers
+                .iter()
+                .find(|l| l.role == "designs")
+                .map(|l| l.file.clone())
+                .unwrap_or_default(),
+            id: d.lot.clone(),
+            record: Some(*record),
+            reason,
+        });
     }
 }
 
@@ -180,6 +236,7 @@ fn drop_overlaps(results: &mut [(GardenStat, Option<PlannedGarden>)], sites: &[S
                 stat.size = [0.0; 2];
                 stat.fitness = 0.0;
                 stat.stones = 0;
+                stat.layout.clear();
                 results[i].1 = None;
             }
             None => {
@@ -221,8 +278,16 @@ impl Site<'_> {
     }
 }
 
-/// One site's garden: its place, then its design.
-fn design(site: &Site, obstacles: &Obstacles, p: &Params) -> (GardenStat, Option<PlannedGarden>) {
+/// One site's garden, and why its kept design was refused (when it had one that was).
+struct Designed {
+    stat: GardenStat,
+    garden: Option<PlannedGarden>,
+    refused: Option<String>,
+}
+
+/// One site's garden: its place, then its design: the one kept for it in `garden.designs`
+/// when it fits the place, else the GA's.
+fn design(site: &Site, kept: Option<&Design>, obstacles: &Obstacles, p: &Params) -> Designed {
     let g = &p.garden;
     let stat = |placed, reason: String, size, fitness, stones| GardenStat {
         lot: site.lot.clone(),
@@ -232,7 +297,7 @@ fn design(site: &Site, obstacles: &Obstacles, p: &Params) -> (GardenStat, Option
         size,
         fitness,
         stones,
-        scores: BTreeMap::new(),
+        ..GardenStat::default()
     };
     let Some((corner, angle, size)) = place(site, obstacles, p) else {
         let reason = format!(
@@ -241,23 +306,31 @@ fn design(site: &Site, obstacles: &Obstacles, p: &Params) -> (GardenStat, Option
             g.min_size,
             g.clearance
         );
-        return (stat(false, reason, [0.0; 2], 0.0, 0), None);
+        let refused = kept.map(|_| format!("the design's garden is not built: {reason}"));
+        return Designed {
+            stat: stat(false, reason, [0.0; 2], 0.0, 0),
+            garden: None,
+            refused,
+        };
     };
     let s = Settings::sized(size[0], size[1]);
-    let gp = GaParams {
-        population: g.population,
-        gathered: true,
-        ..GaParams::default()
+    let refused = kept.and_then(|d| d.outside(size[0], size[1]));
+    let (best, from_design) = match kept {
+        Some(d) if refused.is_none() => {
+            (Candidate::of(Layout::from_rows(&d.stone_rows()), &s), true)
+        }
+        _ => {
+            let gp = GaParams {
+                population: g.population,
+                gathered: true,
+                ..GaParams::default()
+            };
+            let mut rng = crate::rng::feature_rng(p.seed, "gardens", &site.key);
+            let (pop, _) = ga::run(&s, &gp, g.generations, &mut rng);
+            (pop.best().clone(), false)
+        }
     };
-    let mut rng = crate::rng::feature_rng(p.seed, "gardens", &site.key);
-    let (pop, _) = ga::run(&s, &gp, g.generations, &mut rng);
-    let best = pop.best();
-    let stones: Vec<[f64; 4]> = best
-        .layout
-        .stones
-        .iter()
-        .map(|st| [st.x, st.y, st.size, st.group as f64])
-        .collect();
+    let stones: Vec<[f64; 4]> = best.layout.to_rows();
     let (sn, cs) = angle.sin_cos();
     let centre = Coord {
         x: corner.x + size[0] / 2.0 * cs - size[1] / 2.0 * sn,
@@ -270,21 +343,33 @@ fn design(site: &Site, obstacles: &Obstacles, p: &Params) -> (GardenStat, Option
         size,
         ground: site.ground,
         tile: tile_id(centre, p.tile_size, p.tile_origin),
-        stones,
+        stones: stones.clone(),
     };
-    let n = best.layout.stones.len();
     let scores = crate::growers::garden::rules::WEIGHTS
         .iter()
         .zip(best.scores)
         .map(|((rule, _), v)| (rule.to_string(), v))
         .collect();
-    (
-        GardenStat {
+    Designed {
+        stat: GardenStat {
             scores,
-            ..stat(true, String::new(), size, best.fitness, n)
+            key: site.key.clone(),
+            corner: [corner.x, corner.y],
+            angle,
+            ground: site.ground,
+            layout: stones,
+            kept: from_design,
+            ..stat(
+                true,
+                String::new(),
+                size,
+                best.fitness,
+                best.layout.stones.len(),
+            )
         },
-        Some(garden),
-    )
+        garden: Some(garden),
+        refused: refused.map(|r| format!("{r}; the GA designed the garden instead")),
+    }
 }
 
 /// The largest open rectangle of the site: (corner of its viewing side, that side's angle,

@@ -4,14 +4,17 @@
 //!
 //! Routes: `/` the viewer page; `/viewer/<file>` its scripts; `/node_modules/<pkg>/...` the
 //! npm packages it imports (three.js, 3d-tiles-renderer), from `viewer/node_modules`;
-//! `/hypotheses.json` the builds, in the order given; `/h/<k>/<path>` a file of build k.
-//! Nothing outside those directories is ever served.
+//! `/hypotheses.json` the builds, in the order given; `/h/<k>/<path>` a file of build k;
+//! `/api/gardens...` the rock-garden designer (`serve/api.rs`), which writes only the file
+//! `--designs` names. Nothing outside those directories is ever served.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
 
+mod api;
+mod designer;
 mod http;
 
 /// The flags of `edo-city serve`.
@@ -31,6 +34,10 @@ pub struct ServeArgs {
     /// source tree edo-city was built from.
     #[arg(long)]
     pub viewer: Option<PathBuf>,
+    /// The designs file the garden designer keeps designs in (created at the first keep;
+    /// a build reads it through `[garden] designs`). Without it the designer is read-only.
+    #[arg(long)]
+    pub designs: Option<PathBuf>,
 }
 
 /// One build being served.
@@ -164,6 +171,11 @@ fn viewer_dir(given: Option<PathBuf>) -> Result<PathBuf> {
 pub fn serve_command(args: ServeArgs) -> Result<()> {
     let viewer = viewer_dir(args.viewer)?;
     let builds = hypotheses(&args.outs)?;
+    let gardens = builds
+        .iter()
+        .map(|b| api::BuildGardens::read(&b.dir))
+        .collect::<Result<Vec<_>>>()?;
+    let designer = api::Api::new(gardens, args.designs.clone())?;
     let list = serde_json::to_vec(&serde_json::json!(builds
         .iter()
         .enumerate()
@@ -189,6 +201,9 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
     for (k, b) in builds.iter().enumerate() {
         text += &format!("  {url}?h={k}  {} ({} tiles)\n", b.dir.display(), b.tiles);
     }
+    if let Some(d) = &args.designs {
+        text += &format!("  garden designs are kept in {}\n", d.display());
+    }
     text += "press Ctrl-C to stop\n";
     {
         use std::io::Write as _;
@@ -199,8 +214,15 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
     if args.open {
         let _ = std::process::Command::new("xdg-open").arg(&url).spawn();
     }
-    let handler: http::Handler =
-        std::sync::Arc::new(move |url: &str| answer(url, &viewer, &builds, &list));
+    let handler: http::Handler = std::sync::Arc::new(move |call: &http::Call| {
+        if let Some(a) = designer.answer(call.post, &call.target, &call.body) {
+            return a;
+        }
+        match call.post {
+            true => http::Answer::NotAllowed { allow: "GET, HEAD" },
+            false => answer(&call.target, &viewer, &builds, &list),
+        }
+    });
     http::serve(listener, handler, http::Limits::default()).context("the server stopped")
 }
 

@@ -357,23 +357,7 @@ fn walls(m: &mut Mesh, site: &GardenSite, frame: Frame, s: &Settings) {
 
 /// The meshes of a garden the city planned (its lot is walled already: no wall of its own).
 pub fn planned(g: &crate::model::PlannedGarden, seed: u64, frame: Frame) -> Vec<Mesh> {
-    use crate::growers::garden::{Role, Stone};
-    let mut stones: Vec<Stone> = Vec::with_capacity(g.stones.len());
-    for (k, s) in g.stones.iter().enumerate() {
-        let group = s[3] as usize;
-        let before = g.stones[..k]
-            .iter()
-            .filter(|t| t[3] as usize == group)
-            .count();
-        stones.push(Stone {
-            x: s[0],
-            y: s[1],
-            size: s[2],
-            group,
-            role: Role::of(before),
-        });
-    }
-    let layout = Layout { stones };
+    let layout = Layout::from_rows(&g.stones);
     let settings = Settings::sized(g.size[0], g.size[1]);
     let site = GardenSite {
         corner: g.corner,

@@ -19,6 +19,7 @@ pub mod table;
 pub mod widths;
 
 mod areas;
+mod designs;
 mod landmarks;
 mod lines;
 mod links;
@@ -468,6 +469,7 @@ pub fn read_dataset(dir: &Path, params: &Params) -> Result<Dataset, InputError> 
         landmarks::read_landmark_table(dir, params, &path, &mut data)?;
     }
     data.dem = read_dem(dir, params, &target, &dl.dem.file, &mut data.warnings)?;
+    designs::read_designs(params, &mut data)?;
     for o in layers.all() {
         data.warnings.extend(o.winding_warning());
     }

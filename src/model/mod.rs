@@ -8,6 +8,7 @@ pub mod as_json;
 pub mod attrs;
 pub mod crowd;
 pub mod dem;
+pub mod design;
 pub mod landmark;
 pub mod source;
 pub mod tile;
@@ -274,6 +275,8 @@ pub struct Dataset {
     pub water: Vec<GardenArea>,
     /// The links layer's points.
     pub links: Vec<Link>,
+    /// The rock-garden designs of `garden.designs` that are usable, with their records.
+    pub designs: Vec<(usize, design::Design)>,
     /// The landmarks layer's records whose model was read.
     pub landmarks: Vec<LandmarkRecord>,
     /// The landmarks' models, each read once, by the name the records give.
@@ -869,7 +872,7 @@ impl PlannedGarden {
 }
 
 /// One lot's garden in the report: placed (with its size and fitness) or skipped (why).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct GardenStat {
     /// The lot's id (for a garden of the gardens layer: the lot holding its centre, or
     /// empty when none does).
@@ -895,6 +898,33 @@ pub struct GardenStat {
     /// (0: the rule is kept).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub scores: BTreeMap<String, f64>,
+    /// The garden's key (its lot id, or `area-<id>`): what a design in `garden.designs` is
+    /// for, and what `edo-city serve` designs it by.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub key: String,
+    /// Map point of garden (0, 0), the left end of its viewing side (placed gardens).
+    #[serde(default, skip_serializing_if = "is_origin")]
+    pub corner: [f64; 2],
+    /// Direction of the viewing side, radians counter-clockwise from east.
+    #[serde(default, skip_serializing_if = "is_zero_f64")]
+    pub angle: f64,
+    /// Ground elevation.
+    #[serde(default, skip_serializing_if = "is_zero_f64")]
+    pub ground: f64,
+    /// Its stones: (x, y, size, group) in garden coordinates, as placed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub layout: Vec<[f64; 4]>,
+    /// Whether the stones are a design kept in `garden.designs` (else the GA's).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub kept: bool,
+}
+
+fn is_origin(p: &[f64; 2]) -> bool {
+    p[0] == 0.0 && p[1] == 0.0
+}
+
+fn is_zero_f64(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// What generation found in one tile.

@@ -22,6 +22,10 @@ pub struct GardenParams {
     pub generations: usize,
     /// Layouts per generation.
     pub population: usize,
+    /// The designs file a person kept in the browser (`model::design`), "" for none;
+    /// resolved against the directory of the parameter file that names it when read.
+    #[serde(default)]
+    pub designs: String,
 }
 
 /// The most generations or layouts a garden of the city may ask for.
@@ -65,5 +69,6 @@ pub(super) mod partial {
         clearance: Option<f64>,
         generations: Option<usize>,
         population: Option<usize>,
+        designs: Option<String>,
     }
 }

@@ -212,6 +212,10 @@ mod tests {
             fitness: 0.7,
             stones: 0,
             scores: [("axis".to_string(), 0.1 + 0.2)].into_iter().collect(),
+            corner: [0.1 + 0.2, 5.0],
+            layout: vec![[0.1, 0.2, 1.0 / 3.0, 1.0]],
+            kept: true,
+            ..Default::default()
         });
         let mut data = Dataset::default();
         let mut names = crate::model::FieldNames::default();

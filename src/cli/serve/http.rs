@@ -54,6 +54,8 @@ pub enum Answer {
         path: PathBuf,
         content_type: &'static str,
     },
+    /// 405: the route takes only these methods (`GET, HEAD`).
+    NotAllowed { allow: &'static str },
 }
 
 impl Answer {
@@ -67,9 +69,21 @@ impl Answer {
     }
 }
 
-/// The handler `serve` calls for every GET and HEAD, with the request target as sent
-/// (`/h/0/tileset.json?x=1`).
-pub type Handler = Arc<dyn Fn(&str) -> Answer + Send + Sync>;
+/// One request as the handler sees it.
+pub struct Call {
+    /// A POST (else a GET or HEAD).
+    pub post: bool,
+    /// The request target as sent (`/h/0/tileset.json?x=1`).
+    pub target: String,
+    /// A POST's body (at most [`MAX_BODY`] bytes); empty otherwise.
+    pub body: Vec<u8>,
+}
+
+/// The handler `serve` calls for every GET, HEAD and POST.
+pub type Handler = Arc<dyn Fn(&Call) -> Answer + Send + Sync>;
+
+/// The longest POST body read; longer is refused with 413.
+pub const MAX_BODY: usize = 64 * 1024;
 
 /// The bounds of the server.
 #[derive(Debug, Clone, Copy)]
@@ -174,23 +188,35 @@ async fn respond(
     conn: Arc<Conn>,
 ) -> Result<Response<Body>, Infallible> {
     let busy = Busy::new(conn);
-    if req.method() != Method::GET && req.method() != Method::HEAD {
-        let mut r = bytes(
-            405,
-            "text/plain; charset=utf-8",
-            b"only GET and HEAD\n".to_vec(),
-        );
-        r.headers_mut()
-            .insert(ALLOW, HeaderValue::from_static("GET, HEAD"));
-        return Ok(r.map(|b| busy.keep(b)));
+    let post = req.method() == Method::POST;
+    if req.method() != Method::GET && req.method() != Method::HEAD && !post {
+        return Ok(not_allowed("GET, HEAD, POST").map(|b| busy.keep(b)));
     }
     let target = req
         .uri()
         .path_and_query()
         .map_or("/", |p| p.as_str())
         .to_string();
+    let (req, body) = if post {
+        let (parts, incoming) = req.into_parts();
+        match http_body_util::Limited::new(incoming, MAX_BODY)
+            .collect()
+            .await
+        {
+            Ok(b) => (Request::from_parts(parts, None), b.to_bytes().to_vec()),
+            Err(_) => {
+                let text = format!("a request body is at most {MAX_BODY} bytes\n");
+                let r = bytes(413, "text/plain; charset=utf-8", text.into_bytes());
+                return Ok(r.map(|b| busy.keep(b)));
+            }
+        }
+    } else {
+        let (parts, incoming) = req.into_parts();
+        (Request::from_parts(parts, Some(incoming)), Vec::new())
+    };
+    let call = Call { post, target, body };
     // The handler looks at the file system (links resolved): off the runtime's thread.
-    let answer = tokio::task::spawn_blocking(move || handler(&target))
+    let answer = tokio::task::spawn_blocking(move || handler(&call))
         .await
         .unwrap_or_else(|_| Answer::text(500, "internal error\n".into()));
     let response = match answer {
@@ -199,9 +225,25 @@ async fn respond(
             content_type,
             body,
         } => bytes(status, content_type, body),
-        Answer::File { path, content_type } => file(req, path, content_type).await,
+        Answer::NotAllowed { allow } => not_allowed(allow),
+        Answer::File { path, content_type } => match req.into_parts() {
+            (parts, Some(incoming)) => {
+                file(Request::from_parts(parts, incoming), path, content_type).await
+            }
+            // A file is never the answer to a POST.
+            (_, None) => not_allowed("GET, HEAD"),
+        },
     };
     Ok(response.map(|b| busy.keep(b)))
+}
+
+/// 405 with the methods the route takes.
+fn not_allowed(allow: &'static str) -> Response<Body> {
+    let text = format!("only {allow} here\n");
+    let mut r = bytes(405, "text/plain; charset=utf-8", text.into_bytes());
+    r.headers_mut()
+        .insert(ALLOW, HeaderValue::from_static(allow));
+    r
 }
 
 /// A response of bytes in memory.

@@ -74,6 +74,38 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// A layout from (x, y, size, group) rows, each group largest first: roles by order.
+    pub fn from_rows(rows: &[[f64; 4]]) -> Layout {
+        let mut seen: Vec<usize> = Vec::new();
+        let stones = rows
+            .iter()
+            .map(|r| {
+                let group = r[3].max(0.0) as usize;
+                if seen.len() <= group {
+                    seen.resize(group + 1, 0);
+                }
+                let role = Role::of(seen[group]);
+                seen[group] += 1;
+                Stone {
+                    x: r[0],
+                    y: r[1],
+                    size: r[2],
+                    group,
+                    role,
+                }
+            })
+            .collect();
+        Layout { stones }
+    }
+
+    /// The stones as (x, y, size, group) rows.
+    pub fn to_rows(&self) -> Vec<[f64; 4]> {
+        self.stones
+            .iter()
+            .map(|st| [st.x, st.y, st.size, st.group as f64])
+            .collect()
+    }
+
     /// The stone indices of each group, in order.
     pub fn groups(&self) -> Vec<Vec<usize>> {
         let n = self.stones.iter().map(|s| s.group + 1).max().unwrap_or(0);

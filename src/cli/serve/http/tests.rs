@@ -8,7 +8,13 @@ use super::*;
 fn start(limits: Limits, path: PathBuf) -> u16 {
     let listener = std::net::TcpListener::bind(("127.0.0.1", 0)).unwrap();
     let port = listener.local_addr().unwrap().port();
-    let handler: Handler = Arc::new(move |url: &str| match url {
+    let handler: Handler = Arc::new(move |call: &Call| match call.target.as_str() {
+        "/echo" if call.post => Answer::Bytes {
+            status: 200,
+            content_type: "text/plain; charset=utf-8",
+            body: call.body.clone(),
+        },
+        _ if call.post => Answer::NotAllowed { allow: "GET, HEAD" },
         "/file" => Answer::File {
             path: path.clone(),
             content_type: "text/plain; charset=utf-8",
@@ -100,6 +106,26 @@ fn files_keep_our_types_and_tower_http_answers_head_and_ranges() {
         post.to_ascii_lowercase().contains("allow: get, head"),
         "{post}"
     );
+    let put = ask(
+        port,
+        "PUT / HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\nConnection: close\r\n\r\n",
+    );
+    assert!(put.starts_with("HTTP/1.1 405"), "{put}");
+    let echo = ask(
+        port,
+        "POST /echo HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\nConnection: close\r\n\r\nhello",
+    );
+    assert!(
+        echo.starts_with("HTTP/1.1 200") && echo.ends_with("\r\n\r\nhello"),
+        "{echo}"
+    );
+    let big = MAX_BODY + 1;
+    let head = format!(
+        "POST /echo HTTP/1.1\r\nHost: x\r\nContent-Length: {big}\r\nConnection: close\r\n\r\n{}",
+        "x".repeat(big)
+    );
+    let too_big = ask(port, &head);
+    assert!(too_big.starts_with("HTTP/1.1 413"), "{too_big}");
     let missing = ask(
         port,
         "GET /nothing HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n",
