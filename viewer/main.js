@@ -11,6 +11,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TilesRenderer } from '3d-tiles-renderer';
 import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
+import { createDesigner } from './garden.js';
 
 const SKY = 0xbcd6ea;
 const EYE = 1.6;
@@ -41,6 +42,7 @@ renderer.setScissorTest(false);
 document.body.appendChild(renderer.domElement);
 
 const scene = new THREE.Scene();
+api.scene = scene;
 scene.add(new THREE.HemisphereLight(0xffffff, 0x8a7f6a, 2.2));
 const sun = new THREE.DirectionalLight(0xffffff, 1.6);
 sun.position.set(0.4, 1.0, 0.25);
@@ -50,6 +52,33 @@ const camera = new THREE.PerspectiveCamera(50, window.innerWidth / window.innerH
 const controls = new OrbitControls(camera, renderer.domElement);
 controls.enableDamping = false;
 controls.maxPolarAngle = Math.PI * 0.495;
+
+api.garden = createDesigner({
+  scene,
+  point: (east, north, up) => point(east, north, up),
+  render: () => render(),
+  build: () => api.current,
+  hideStones: (on) => {
+    designing = on;
+    for (const c of cities) if (c) applyToggles(c.tiles.group);
+  },
+  // The garden in the left part of the picture: the designer's panel covers the right.
+  frame: (east, north, up, size) => {
+    if (walking) toggleWalk();
+    const p = point(east, north, up);
+    const d = Math.max(size, 10);
+    camera.position.set(p.x - 0.9 * d, p.y + 1.3 * d, p.z + 1.0 * d);
+    controls.target.copy(p);
+    controls.update();
+    camera.updateMatrixWorld();
+    const right = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
+    const shift = right.multiplyScalar(0.55 * d);
+    camera.position.add(shift);
+    controls.target.add(shift);
+    controls.update();
+    render();
+  },
+});
 
 const params = new URLSearchParams(location.search);
 const hidden = new Set();
@@ -66,12 +95,15 @@ function placementOf(tileset) {
   return zUpToYUp.multiply(root.invert());
 }
 
-/** Hides or shows the nodes of the hidden kinds in one loaded model. */
+/** Hides or shows the nodes of the hidden kinds in one loaded model (the tiles' stones also
+ * while the garden designer stands a candidate in their place). */
 function applyToggles(object) {
   object.traverse((o) => {
-    if (o.userData.kind !== undefined) o.visible = !hidden.has(o.userData.kind);
+    if (o.userData.kind === undefined) return;
+    o.visible = !hidden.has(o.userData.kind) && !(designing && o.userData.kind === 'stone');
   });
 }
+let designing = false;
 
 function city(k) {
   if (cities[k]) return cities[k];
@@ -361,6 +393,20 @@ function pick(event) {
     .filter(([, v]) => v !== '' && v !== null && v !== undefined)
     .map(([k, v]) => `${k}: ${v}`)
     .join('\n');
+  offerDesign(row.lot);
+}
+
+/** A "design this garden" button under the info of a lot that has a garden to design. */
+async function offerDesign(lot) {
+  if (lot === undefined || lot === null || lot === '') return;
+  const list = await api.garden.list().catch(() => null);
+  const g = list && list.gardens.find((x) => x.lot === String(lot) || x.lot_id === String(lot));
+  if (!g || api.info === null || api.info.lot !== lot) return;
+  const b = document.createElement('button');
+  b.id = 'design';
+  b.textContent = `design this garden (${g.lot})`;
+  b.onclick = () => api.garden.open(g.lot).catch((e) => console.warn(e.message));
+  document.getElementById('info').append('\n', b);
 }
 
 async function main() {

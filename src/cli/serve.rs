@@ -171,11 +171,8 @@ fn viewer_dir(given: Option<PathBuf>) -> Result<PathBuf> {
 pub fn serve_command(args: ServeArgs) -> Result<()> {
     let viewer = viewer_dir(args.viewer)?;
     let builds = hypotheses(&args.outs)?;
-    let gardens = builds
-        .iter()
-        .map(|b| api::BuildGardens::read(&b.dir))
-        .collect::<Result<Vec<_>>>()?;
-    let designer = api::Api::new(gardens, args.designs.clone())?;
+    let dirs: Vec<PathBuf> = builds.iter().map(|b| b.dir.clone()).collect();
+    let designer = api::Api::new(&dirs, args.designs.clone())?;
     let list = serde_json::to_vec(&serde_json::json!(builds
         .iter()
         .enumerate()

@@ -17,7 +17,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
@@ -32,6 +32,7 @@ use edo_city::model::GardenStat;
 const MAX_SESSIONS: usize = 64;
 
 /// The gardens of one build being served.
+#[derive(Default)]
 pub struct BuildGardens {
     seed: u64,
     population: usize,
@@ -77,9 +78,23 @@ impl BuildGardens {
     }
 }
 
+/// A build's gardens as last read, and the manifest they were read with: a build rebuilt
+/// while `serve` runs is read again (a visitor rebuilds with a kept design and reloads).
+struct Served {
+    dir: PathBuf,
+    stamp: Option<(std::time::SystemTime, u64)>,
+    gardens: Arc<BuildGardens>,
+}
+
+/// The manifest's time and length: written last by every build.
+fn stamp(dir: &Path) -> Option<(std::time::SystemTime, u64)> {
+    let m = std::fs::metadata(dir.join("manifest.json")).ok()?;
+    Some((m.modified().ok()?, m.len()))
+}
+
 /// The designer's state: the builds' gardens, the sessions, the designs file.
 pub struct Api {
-    builds: Vec<BuildGardens>,
+    builds: Vec<Mutex<Served>>,
     designs: Option<PathBuf>,
     sessions: Mutex<Sessions>,
     /// Held while the designs file is read and written: one keep at a time.
@@ -116,7 +131,15 @@ struct Step {
 impl Api {
     /// The API over `builds`, writing designs to `designs` when given (checked now: a file
     /// that exists must be a designs file, and its directory must exist).
-    pub fn new(builds: Vec<BuildGardens>, designs: Option<PathBuf>) -> Result<Api> {
+    pub fn new(dirs: &[PathBuf], designs: Option<PathBuf>) -> Result<Api> {
+        let mut builds = Vec::new();
+        for dir in dirs {
+            builds.push(Mutex::new(Served {
+                dir: dir.clone(),
+                stamp: stamp(dir),
+                gardens: Arc::new(BuildGardens::read(dir)?),
+            }));
+        }
         if let Some(path) = &designs {
             if path.exists() {
                 read_designs(path).map_err(|r| anyhow::anyhow!(r.message))?;
@@ -160,13 +183,23 @@ impl Api {
         })
     }
 
-    fn build(&self, h: usize) -> Result<&BuildGardens, Refusal> {
-        self.builds.get(h).ok_or_else(|| {
+    fn build(&self, h: usize) -> Result<Arc<BuildGardens>, Refusal> {
+        let served = self.builds.get(h).ok_or_else(|| {
             refuse(
                 404,
                 format!("no build {h}: serve has {} build(s)", self.builds.len()),
             )
-        })
+        })?;
+        let mut s = served.lock().unwrap_or_else(|e| e.into_inner());
+        let now = stamp(&s.dir);
+        if now != s.stamp {
+            // Half-way through a rebuild the old list stands until the new manifest is read.
+            if let Ok(g) = BuildGardens::read(&s.dir) {
+                s.gardens = Arc::new(g);
+                s.stamp = now;
+            }
+        }
+        Ok(s.gardens.clone())
     }
 
     fn list(&self, query: &str) -> Result<serde_json::Value, Refusal> {
@@ -229,6 +262,7 @@ impl Api {
             _ => None,
         };
         let session = Session::open(garden, o.h, b.seed, population, base);
+        drop(b);
         let mut s = self.lock();
         s.next_id += 1;
         s.clock += 1;
