@@ -214,53 +214,70 @@ export function createDesigner(ctx) {
     return el;
   }
 
+  // One scene for every picture: lights, the gravel (resized per garden) and a pool of
+  // stones sharing one geometry and three materials (new meshes per picture made each
+  // generation take a second in a software-rendered browser).
+  const thumbScene = new THREE.Scene();
+  thumbScene.add(new THREE.HemisphereLight(0xffffff, 0x8a7f6a, 2.4));
+  const thumbSun = new THREE.DirectionalLight(0xffffff, 1.4);
+  thumbSun.position.set(0.3, 1, -0.5);
+  thumbScene.add(thumbSun);
+  const gravel = new THREE.Mesh(new THREE.PlaneGeometry(1, 1), new THREE.MeshStandardMaterial({ color: 0xd9d4c7 }));
+  gravel.rotation.x = -Math.PI / 2;
+  thumbScene.add(gravel);
+  const pool = [];
+  const thumbCamera = new THREE.PerspectiveCamera(50, THUMB.w / THUMB.h, 0.1, 500);
+
   /** A candidate seen from the garden's viewpoint, into `canvas`. */
   function drawFromViewpoint(c, canvas) {
     const [w, d] = state.size;
-    const scene = new THREE.Scene();
-    scene.add(new THREE.HemisphereLight(0xffffff, 0x8a7f6a, 2.4));
-    const sun = new THREE.DirectionalLight(0xffffff, 1.4);
-    sun.position.set(0.3, 1, -0.5);
-    scene.add(sun);
     // Garden frame: x along the viewing side, y away from it -> scene x, -z.
-    const gravel = new THREE.Mesh(new THREE.PlaneGeometry(w, d), new THREE.MeshStandardMaterial({ color: 0xd9d4c7 }));
-    gravel.rotation.x = -Math.PI / 2;
+    gravel.scale.set(w, d, 1);
     gravel.position.set(w / 2, 0, -d / 2);
-    scene.add(gravel);
-    for (const st of c.stones) {
-      const m = stoneMesh(st);
-      m.position.set(st.x, 0, -st.y);
-      scene.add(m);
+    while (pool.length < c.stones.length) {
+      const m = new THREE.Mesh(UNIT_STONE, STONE_MATERIALS.other);
+      pool.push(m);
+      thumbScene.add(m);
     }
-    const [vx, vy] = state.viewpoint;
-    // From the veranda, raised so that every group shows: the eye plus a quarter of the
-    // garden's depth (a seated visitor of Ryoanji's 10 m deep garden sees it from ~1.2 m; a
-    // picture the size of a card needs the stones apart).
-    const camera = new THREE.PerspectiveCamera(50, THUMB.w / THUMB.h, 0.1, 500);
-    camera.position.set(vx, EYE + 0.6 * d, -vy);
-    camera.lookAt(w / 2, 0, -d * 0.5);
-    thumbs.render(scene, camera);
-    canvas.getContext('2d').drawImage(thumbs.domElement, 0, 0);
-    scene.traverse((o) => {
-      if (o.isMesh) {
-        o.geometry.dispose();
-        o.material.dispose();
-      }
+    pool.forEach((m, k) => {
+      const st = c.stones[k];
+      m.visible = st !== undefined;
+      if (!st) return;
+      placeStone(m, st);
+      m.position.set(st.x, 0, -st.y);
     });
+    // From the veranda, raised so that every group shows: the eye plus 0.6 of the garden's
+    // depth (a seated visitor sees Ryoanji from ~1.2 m; a picture the size of a card needs
+    // the stones apart).
+    const [vx, vy] = state.viewpoint;
+    thumbCamera.position.set(vx, EYE + 0.6 * d, -vy);
+    thumbCamera.lookAt(w / 2, 0, -d * 0.5);
+    thumbs.render(thumbScene, thumbCamera);
+    canvas.getContext('2d').drawImage(thumbs.domElement, 0, 0);
   }
 
   return api;
 }
 
-/** A stone: a low faceted block, its plan `size` across, shin darker. */
+/** The stones' shape: a faceted block of diameter 1, its base at 0 (scaled per stone). */
+const UNIT_STONE = new THREE.DodecahedronGeometry(0.5, 0).translate(0, 0.5, 0);
+/** Shin darkest, as the eye picks the master stone of a group. */
+const STONE_MATERIALS = {
+  shin: new THREE.MeshStandardMaterial({ color: 0x5d5a55, flatShading: true }),
+  soe: new THREE.MeshStandardMaterial({ color: 0x6e6a63, flatShading: true }),
+  other: new THREE.MeshStandardMaterial({ color: 0x7d786f, flatShading: true }),
+};
+
+/** Sizes and shades `m` as stone `st`: its plan `size` across, flattened as the tiles' are. */
+function placeStone(m, st) {
+  m.scale.set(st.size, st.size * 0.7, st.size);
+  m.material = STONE_MATERIALS[st.role] ?? STONE_MATERIALS.other;
+}
+
+/** A stone of its own (the one standing in the precinct). */
 function stoneMesh(st) {
-  const r = st.size / 2;
-  const geometry = new THREE.DodecahedronGeometry(r, 0);
-  const shade = st.role === 'shin' ? 0x5d5a55 : st.role === 'soe' ? 0x6e6a63 : 0x7d786f;
-  const m = new THREE.Mesh(geometry, new THREE.MeshStandardMaterial({ color: shade, flatShading: true }));
-  // Flattened and sunk a little, as the tiles' stones are; the caller places its base.
-  geometry.translate(0, r * 0.5, 0);
-  m.scale.set(1, 0.7, 1);
+  const m = new THREE.Mesh(UNIT_STONE, STONE_MATERIALS.other);
+  placeStone(m, st);
   return m;
 }
 

@@ -112,7 +112,7 @@ try {
     // Stand candidate 1 in the precinct, then keep it.
     await page.click('#dcards .dcard[data-k="1"] button');
     out.in_place = await page.evaluate(() => window.edoCity.garden.shown);
-    if (arg4) await page.screenshot({ path: `${arg4}/garden-designer.png` });
+    if (arg4) await page.screenshot({ path: `${arg4}/garden-designer.jpg`, type: 'jpeg', quality: 85 });
     await page.click('#dkeep');
     await page.waitForFunction(() => window.edoCity.garden.kept !== null);
     out.kept = await page.evaluate(() => window.edoCity.garden.kept);
@@ -129,7 +129,7 @@ try {
       window.edoCity.scene.traverse((o) => { if (o.userData.kind === 'stone' && o.visible) n += 1; });
       return n;
     });
-    if (arg4) await page.screenshot({ path: `${arg4}/garden-kept.png` });
+    if (arg4) await page.screenshot({ path: `${arg4}/garden-kept.jpg`, type: 'jpeg', quality: 85 });
   } else if (phase === 'time') {
     const population = Number(arg4);
     const generations = Number(arg5 ?? 5);
