@@ -75,7 +75,13 @@ fn a_visitor_designs_the_temple_garden_keeps_it_and_finds_it_in_the_rebuilt_city
     build_ok(
         &fixture("kyoto-small"),
         &out,
-        &["--quiet", "--no-plan", "--force", "--params", params.to_str().unwrap()],
+        &[
+            "--quiet",
+            "--no-plan",
+            "--force",
+            "--params",
+            params.to_str().unwrap(),
+        ],
     );
     let checked = garden_mjs(&url, &["check", "343"]);
     drop(server);

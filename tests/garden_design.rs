@@ -457,3 +457,67 @@ fn designs_that_no_longer_fit_or_have_no_garden_are_skipped_with_why() {
     );
     assert!(!dir.path().join("c/manifest.json").exists());
 }
+
+#[test]
+fn a_changed_designs_file_reaches_a_regenerated_tile() {
+    // `--tiles` reuses the cached analysis only when every file it read is the same: the
+    // designs file is one of them, wherever the parameter file puts it.
+    let dir = tempfile::tempdir().unwrap();
+    let (out, _) = built(dir.path());
+    let g = garden(&read_json(&out.join("report.json")), "343");
+    let design = |dx: f64| {
+        let stones: Vec<Value> = g["layout"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .enumerate()
+            .map(|(k, s)| {
+                let x = s[0].as_f64().unwrap() + if k == 5 { dx } else { 0.0 };
+                json!({"x": x, "y": s[1], "size": s[2], "group": s[3].as_f64().unwrap() as u64})
+            })
+            .collect();
+        json!({"edo_city_designs": 1, "designs": [
+            {"lot": "343", "seed": 1, "size": g["size"], "stones": stones, "fitness": 1.0}
+        ]})
+        .to_string()
+    };
+    let kept = dir.path().join("kept");
+    std::fs::create_dir(&kept).unwrap();
+    std::fs::write(kept.join("designs.json"), design(0.3)).unwrap();
+    let params = kept.join("p.toml");
+    std::fs::write(&params, format!("{USES}designs = \"designs.json\"\n")).unwrap();
+    // Run from the parameter file's directory, named relative to it: the case a key that
+    // resolved the designs against the input directory got wrong.
+    let _ = params;
+    let build = |out: &Path, extra: &[&str]| {
+        let o = common::build_cmd(&fixture("kyoto-small"), out, extra)
+            .args(["--quiet", "--params", "p.toml"])
+            .current_dir(&kept)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    let partial = dir.path().join("partial");
+    build(&partial, &[]);
+    let tile = std::fs::read_dir(partial.join("tiles"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|f| {
+            f.extension().is_some_and(|e| e == "obj")
+                && std::fs::read_to_string(f).unwrap().contains("o stone_343_")
+        })
+        .unwrap();
+    let id = tile.file_stem().unwrap().to_str().unwrap().to_string();
+    let before = std::fs::read(&tile).unwrap();
+
+    std::fs::write(kept.join("designs.json"), design(0.6)).unwrap();
+    build(&partial, &["--tiles", &id]);
+    let full = dir.path().join("full");
+    build(&full, &[]);
+    let (now, want) = (
+        std::fs::read(&tile).unwrap(),
+        std::fs::read(full.join("tiles").join(format!("{id}.obj"))).unwrap(),
+    );
+    assert!(now != before, "the regenerated tile has the new design");
+    assert!(now == want, "and is the full build's");
+}
