@@ -28,8 +28,9 @@ use super::http::Answer;
 use edo_city::model::design::Designs;
 use edo_city::model::GardenStat;
 
-/// Sessions held at once; past it the one unused longest is closed.
-const MAX_SESSIONS: usize = 64;
+/// Sessions held at once; past it the one unused longest is closed. With
+/// `designer::MAX_KEPT_LAYOUTS` each, the sessions hold at most about 250 MB.
+const MAX_SESSIONS: usize = 32;
 
 /// The gardens of one build being served.
 #[derive(Default)]

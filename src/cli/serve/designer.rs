@@ -19,8 +19,12 @@ use edo_city::model::GardenStat;
 
 /// Layouts shown per generation (the seed's sheets show a handful; 6-9 fit a screen).
 pub const SHOWN: usize = 9;
-/// Generations a session keeps for "undo".
+/// Generations a session keeps for "undo" at most.
 pub const UNDO_DEPTH: usize = 200;
+/// Layouts a session keeps in all (its generations x its population): about 7 MB, so the
+/// server's sessions together stay within a bound whatever the visitors ask for. A session
+/// of 100 layouts undoes 100 generations, one of 1000 undoes 10.
+pub const MAX_KEPT_LAYOUTS: usize = 10_000;
 /// Generations a session may breed.
 pub const MAX_GENERATIONS: usize = 10_000;
 /// The largest population a visitor may ask for.
@@ -164,7 +168,7 @@ impl Session {
         };
         let best = next.best().fitness;
         self.steps.push(step(next));
-        if self.steps.len() > UNDO_DEPTH + 1 {
+        if self.steps.len() > self.undo_depth() + 1 {
             self.steps.remove(0);
         }
         self.generation = g;
@@ -176,6 +180,12 @@ impl Session {
         Ok(())
     }
 
+    /// The generations this session keeps for "undo": [`UNDO_DEPTH`], fewer for a large
+    /// population ([`MAX_KEPT_LAYOUTS`]).
+    pub fn undo_depth(&self) -> usize {
+        (MAX_KEPT_LAYOUTS / self.params.population.max(1)).clamp(1, UNDO_DEPTH)
+    }
+
     /// Back one generation.
     pub fn undo(&mut self) -> Result<(), Refusal> {
         if self.steps.len() < 2 {
@@ -183,7 +193,11 @@ impl Session {
                 409,
                 match self.generation {
                     0 => "this is the first generation: nothing to undo".to_string(),
-                    _ => format!("a session undoes at most {UNDO_DEPTH} generations"),
+                    _ => format!(
+                        "a session of {} layouts undoes at most {} generations",
+                        self.params.population,
+                        self.undo_depth()
+                    ),
                 },
             ));
         }
@@ -347,6 +361,18 @@ mod tests {
         s.undo().unwrap();
         assert_eq!(s.state(1), one, "undo gives back the generation before");
         assert_eq!(s.design(99).unwrap_err().status, 400);
+        // Undo reaches back as far as the session's bound, no farther.
+        let mut big = Session::open(&garden(), 0, 5, MAX_KEPT_LAYOUTS / 3, None);
+        assert_eq!(big.undo_depth(), 3);
+        for _ in 0..5 {
+            big.next(&[]).unwrap();
+        }
+        for _ in 0..3 {
+            big.undo().unwrap();
+        }
+        assert_eq!(big.generation, 2);
+        let e = big.undo().unwrap_err();
+        assert!(e.message.contains("at most 3"), "{}", e.message);
         let d = s.design(0).unwrap();
         assert_eq!((d.lot.as_str(), d.seed, d.history.len()), ("343", 5, 1));
         assert!(d.problem().is_none() && d.outside(10.0, 4.0).is_none());
