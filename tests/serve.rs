@@ -54,21 +54,7 @@ fn connect(port: u16) -> TcpStream {
 
 /// A GET of `target` on a connection of its own: status and the response as text.
 fn get(port: u16, target: &str) -> (u16, String) {
-    let mut s = connect(port);
-    write!(
-        s,
-        "GET {target} HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n"
-    )
-    .unwrap();
-    let mut bytes = Vec::new();
-    s.read_to_end(&mut bytes).unwrap();
-    let text = String::from_utf8_lossy(&bytes).into_owned();
-    let status = text
-        .split(' ')
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0);
-    (status, text)
+    common::http(port, "GET", target, "")
 }
 
 /// Whether the server closed `s`: end of file or a reset, not a read that timed out.
