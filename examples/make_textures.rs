@@ -60,11 +60,14 @@ impl Canvas {
             }
         }
     }
+    /// Writes the canvas; the transparent texels of a cut-out take the colour of the drawn
+    /// ones next to them (`edo_city::output::cutout::bleed`): black there made dark fringes
+    /// and black cards where a converter drops the alpha.
     fn save(&self, name: &str) {
         let path = format!("textures/{name}");
-        self.img
-            .save(&path)
-            .unwrap_or_else(|e| panic!("{path}: {e}"));
+        let mut img = self.img.clone();
+        edo_city::output::cutout::bleed(&mut img);
+        img.save(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
         println!("wrote {path}");
     }
 }
@@ -185,7 +188,7 @@ fn species_billboards() {
         let r = r.max(top * 0.1);
         let height = 256u32;
         let width = ((f64::from(height) * 2.0 * r / top).round() as u32).clamp(96, 512);
-        let img = edo_city::output::render::render(
+        let mut img = edo_city::output::render::render(
             &[mesh],
             edo_city::output::render::View::South,
             [-r, r, 0.0, top],
@@ -196,6 +199,7 @@ fn species_billboards() {
             .texture
             .expect("a billboard material has a texture");
         let path = format!("textures/{name}");
+        edo_city::output::cutout::bleed(&mut img);
         img.save(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
         println!("wrote {path} (species {})", s.name);
     }

@@ -303,6 +303,12 @@ fn a_texture_set_replaces_textures_by_name() {
     std::fs::create_dir(&set).unwrap();
     let scan = image::RgbaImage::from_pixel(4, 4, image::Rgba([200, 20, 20, 255]));
     scan.save(set.join("kawara.png")).unwrap();
+    // A person cut out of a scan: drawn in the middle, black and transparent around it.
+    let mut person = image::RgbaImage::new(8, 8);
+    for (x, y) in [(3, 3), (4, 3), (3, 4), (4, 4)] {
+        person.put_pixel(x, y, image::Rgba([30, 60, 150, 255]));
+    }
+    person.save(set.join("person_01.png")).unwrap();
     let params = work.path().join("p.toml");
     std::fs::write(
         &params,
@@ -319,6 +325,15 @@ fn a_texture_set_replaces_textures_by_name() {
         std::fs::read(out.join("tiles/textures/kawara.png")).unwrap(),
         std::fs::read(set.join("kawara.png")).unwrap()
     );
+    // The cut-out's transparent texels take the drawn colour (no black card where a
+    // converter drops the alpha); its alpha is the scan's.
+    let written = image::open(out.join("tiles/textures/person_01.png"))
+        .unwrap()
+        .to_rgba8();
+    for (x, y, p) in written.enumerate_pixels() {
+        assert_eq!(p[3], person.get_pixel(x, y)[3]);
+        assert_eq!(&p.0[..3], &[30, 60, 150], "texel ({x}, {y})");
+    }
     // A file that replaces nothing, or is not a PNG, stops the build before it writes.
     std::fs::write(set.join("kawara.png"), b"not a png").unwrap();
     let out2 = work.path().join("out2");

@@ -8,6 +8,7 @@
 pub mod accounting;
 pub mod atomic;
 pub mod chart;
+pub mod cutout;
 pub mod features;
 pub mod gltf;
 pub mod gpkg;
@@ -103,6 +104,16 @@ pub fn texture_library(set: &str) -> Result<Vec<Texture>, String> {
         let bytes = read_texture(&path)?;
         image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
             .map_err(|e| format!("{}: not a readable PNG: {e}", path.display()))?;
+        // A cut-out's transparent texels get the colour of their drawn neighbours, as the
+        // shipped ones have (`cutout::bleed`).
+        let cut_out = crate::materials::MATERIALS
+            .iter()
+            .any(|m| m.alpha && m.texture == Some(slot.0));
+        let bytes = match cut_out {
+            true => cutout::bleed_png(&bytes)
+                .map_err(|e| format!("{}: not a readable PNG: {e}", path.display()))?,
+            false => bytes,
+        };
         slot.1 = Cow::Owned(bytes);
     }
     Ok(lib)
@@ -141,7 +152,7 @@ pub fn with_masks(mut lib: Vec<Texture>) -> Result<Vec<Texture>, String> {
     let masks: Vec<Result<Texture, String>> = wanted
         .par_iter()
         .map(|&(mask, tex, bytes)| {
-            let png = mask_png(bytes).map_err(|e| format!("{tex}: {e}"))?;
+            let png = cutout::mask_png(bytes).map_err(|e| format!("{tex}: {e}"))?;
             Ok((mask, Cow::Owned(png)))
         })
         .collect();
@@ -149,18 +160,6 @@ pub fn with_masks(mut lib: Vec<Texture>) -> Result<Vec<Texture>, String> {
         lib.push(m?);
     }
     Ok(lib)
-}
-
-/// RGBA = (a, a, a, a) of a PNG.
-pub fn mask_png(png: &[u8]) -> Result<Vec<u8>, image::ImageError> {
-    let mut img = image::load_from_memory_with_format(png, image::ImageFormat::Png)?.to_rgba8();
-    for p in img.pixels_mut() {
-        let a = p[3];
-        p.0 = [a, a, a, a];
-    }
-    let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png)?;
-    Ok(out.into_inner())
 }
 
 /// Writes the texture library to `<out>/tiles/textures/` ([`TEXTURE_DIR`]).
