@@ -96,6 +96,29 @@ fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
     );
     assert!((eye - g - 1.6).abs() < 0.05, "{text}");
     assert_eq!(out["hypotheses"], serde_json::json!(["edo", "other-seed"]));
+    // window.edoCity.stats: the first view's draw calls, triangles, tiles and bytes.
+    let stats = &out["stats"];
+    let n = |k: &str| stats[k].as_f64().unwrap_or(-1.0);
+    let tiles = m["tiles"].as_array().unwrap().len() as f64;
+    assert!(n("drawCalls") >= 1.0 && n("triangles") >= 1000.0, "{stats}");
+    assert!(
+        n("tilesLoaded") >= 1.0 && n("tilesLoaded") <= tiles,
+        "{stats}"
+    );
+    assert!(n("fps") > 0.0, "{stats}");
+    // More than the tileset (the tiles came), no more than both builds' files.
+    let bytes = |dir: &Path| -> u64 {
+        common::all_files(dir)
+            .values()
+            .map(|b| b.len() as u64)
+            .sum()
+    };
+    let tileset = std::fs::metadata(a.join("tileset.json")).unwrap().len() as f64;
+    assert!(n("bytesFetched") > tileset + 10_000.0, "{stats}");
+    assert!(
+        n("bytesFetched") <= (bytes(&a) + bytes(&b)) as f64,
+        "{stats}"
+    );
 }
 
 /// Writes `<b id=inj>x</b>` into every lot's `district` (the DBF's fourth field, 20 bytes

@@ -32,9 +32,28 @@ const api = (window.edoCity = {
   sample: () => sample(),
   groundAt: (x, z) => groundAt({ x, z }),
   setSplit: (on) => setSplit(on),
+  // The viewer's own numbers, for the level-of-detail budgets (issue 40): the last frame's
+  // draw calls and triangles, the tiles loaded of the current build, the bytes of the
+  // builds' files fetched so far (bodies as sent) and the frames of the last second.
+  stats: {
+    drawCalls: 0,
+    triangles: 0,
+    tilesLoaded: 0,
+    fps: 0,
+    get bytesFetched() {
+      return performance
+        .getEntriesByType('resource')
+        .filter((e) => new URL(e.name).pathname.startsWith('/h/'))
+        .reduce((sum, e) => sum + (e.encodedBodySize || 0), 0);
+    },
+  },
 });
+// Every tile's fetch stays counted (the browser keeps 250 entries by default).
+performance.setResourceTimingBufferSize(1000000);
 
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+// Counted per frame (split view renders twice): reset by the animation loop.
+renderer.info.autoReset = false;
 renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
 renderer.setSize(window.innerWidth, window.innerHeight);
 renderer.setClearColor(SKY);
@@ -456,13 +475,28 @@ async function main() {
     for (const c of cities) if (c) c.tiles.setResolutionFromRenderer(camera, renderer);
   });
   let last = performance.now();
+  const frames = [];
   renderer.setAnimationLoop((now) => {
     walkStep(Math.min((now - last) / 1000, 0.1));
     last = now;
     if (!walking) controls.update();
+    renderer.info.reset();
     render();
+    countFrame(now, frames);
     markReady();
   });
+}
+
+/** The stats of the frame just drawn. */
+function countFrame(now, frames) {
+  const st = api.stats;
+  st.drawCalls = renderer.info.render.calls;
+  st.triangles = renderer.info.render.triangles;
+  const c = cities[api.current];
+  st.tilesLoaded = c ? c.models.size : 0;
+  frames.push(now);
+  while (frames.length > 1 && frames[0] < now - 1000) frames.shift();
+  st.fps = frames.length > 1 ? ((frames.length - 1) * 1000) / (now - frames[0]) : 0;
 }
 
 main().catch((e) => {

@@ -76,6 +76,11 @@ try {
 
   const first = await page.evaluate(() => window.edoCity.sample());
   out.first = first;
+  // The viewer's own numbers of the first view.
+  out.stats = await page.evaluate(() => {
+    const s = window.edoCity.stats;
+    return { drawCalls: s.drawCalls, triangles: s.triangles, tilesLoaded: s.tilesLoaded, bytesFetched: s.bytesFetched, fps: s.fps };
+  });
   if (first.drawn < first.pixels * 0.2) fail(`the picture is nearly blank: ${first.drawn} of ${first.pixels} pixels drawn`);
   if (first.grey < first.pixels * 0.01) fail(`too few roof-grey pixels: ${first.grey}`);
   if (shot) await page.screenshot({ path: shot });
