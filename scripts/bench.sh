@@ -122,8 +122,13 @@ print('ground bytes per tile (OBJ): mean', round(sum(g) / len(g)), 'max', max(g)
 print('halls:', dict(collections.Counter((h['template'], 'placed' if h['placed'] else 'skipped') for h in r.get('halls', []))))"
 
 echo "== against the box-extrusion script (30,052 lots; scripts/box_extrude.py, pyshp; 5 runs of each, alternating)"
-python3 -c 'import shapefile' 2>/dev/null || python3 -m pip install --quiet pyshp 2>/dev/null \
-  || python3 -m pip install --quiet --break-system-packages pyshp
+# pyshp in a virtual environment of our own (kept beside the release build, made once):
+# never the system's Python.
+venv=${CARGO_TARGET_DIR:-target}/bench-venv
+if ! "$venv/bin/python" -c 'import shapefile' 2>/dev/null; then
+  python3 -m venv "$venv" 2>/dev/null || { source scripts/apt-install.sh; apt_install python3-venv; python3 -m venv "$venv"; }
+  "$venv/bin/pip" install --quiet pyshp
+fi
 cargo build --release --quiet --example raw_write
 printf '[trees]\nstyle = "lsystem"\n[people]\nmotion = "boids"\n' > "$work/all.toml"
 : > "$work/ab.txt"
@@ -132,7 +137,7 @@ for i in $(seq 1 5); do
     rm -rf "$work/ab-$what"
     start=$(date +%s.%N)
     case $what in
-      script) python3 scripts/box_extrude.py "$work/town-30052/lots.shp" "$work/box.obj" ;;
+      script) "$venv/bin/python" scripts/box_extrude.py "$work/town-30052/lots.shp" "$work/box.obj" ;;
       default) $bin build "$work/town-30052" --out "$work/ab-$what" --quiet --format obj ;;
       all) $bin build "$work/town-30052" --out "$work/ab-$what" --quiet --format obj,glb --params "$work/all.toml" ;;
     esac

@@ -2,7 +2,7 @@
 one OBJ. The yardstick of `make bench` (issue 25): edo-city with its default features must
 be faster than this, and within 2x of it with every feature on.
 
-    python3 scripts/box_extrude.py TOWN/lots.shp OUT.obj
+    python3 scripts/box_extrude.py TOWN/lots.shp OUT.obj   (pyshp: make bench puts it in target/bench-venv)
 """
 import sys
 

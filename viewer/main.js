@@ -34,7 +34,7 @@ const api = (window.edoCity = {
   setSplit: (on) => setSplit(on),
   // The viewer's own numbers, for the level-of-detail budgets (issue 40): the last frame's
   // draw calls and triangles, the tiles loaded of the current build, the bytes of the
-  // builds' files fetched so far (bodies as sent) and the frames of the last second.
+  // builds' files fetched so far (bodies as sent) and the frames a second (over the last second, or the last frame when it took longer).
   stats: {
     drawCalls: 0,
     triangles: 0,
@@ -495,7 +495,8 @@ function countFrame(now, frames) {
   const c = cities[api.current];
   st.tilesLoaded = c ? c.models.size : 0;
   frames.push(now);
-  while (frames.length > 1 && frames[0] < now - 1000) frames.shift();
+  // The last second's frames, and at least the last two (a frame may take longer).
+  while (frames.length > 2 && frames[0] < now - 1000) frames.shift();
   st.fps = frames.length > 1 ? ((frames.length - 1) * 1000) / (now - frames[0]) : 0;
 }
 

@@ -1,0 +1,46 @@
+// The first overview of a served build, measured from the viewer's own numbers
+// (window.edoCity.stats) in Debian's chromium (headless, SwiftShader), 1280 x 720: time to
+// ready, bytes fetched, draw calls and triangles a frame, frames per second over 3 s; then
+// the same at street level in walk mode at a given point. For BENCHMARKS.md (issue 40), not
+// for tests: times depend on the machine.
+//
+// Usage: node test/first-view.mjs <url> [east north]
+import { chromium } from 'playwright-core';
+
+const [url, east, north] = process.argv.slice(2);
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+  headless: true,
+  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-background-networking',
+    '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic'],
+});
+const out = {};
+try {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 720 } });
+  page.setDefaultTimeout(600000);
+  const t0 = Date.now();
+  await page.goto(`${url}?h=0`, { waitUntil: 'domcontentloaded' });
+  await page.waitForFunction(() => window.edoCity && window.edoCity.ready, null, { timeout: 600000, polling: 250 });
+  out.ready_s = (Date.now() - t0) / 1000;
+  const measure = () =>
+    page.evaluate(
+      () =>
+        new Promise((resolve) => {
+          setTimeout(() => {
+            const s = window.edoCity.stats;
+            resolve({ drawCalls: s.drawCalls, triangles: s.triangles, tilesLoaded: s.tilesLoaded, bytesFetched: s.bytesFetched, fps: s.fps });
+          }, 3000);
+        }),
+    );
+  out.overview = await measure();
+  if (east !== undefined) {
+    // Walk mode at the point; the tiles of the new view are given 20 s to stream in.
+    await page.evaluate(([e, n]) => window.edoCity.lookAt(Number(e), Number(n), 0, 30), [east, north]);
+    await page.keyboard.press('k');
+    await page.waitForTimeout(20000);
+    out.street = await measure();
+  }
+} finally {
+  await browser.close();
+}
+console.log(JSON.stringify(out));
