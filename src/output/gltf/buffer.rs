@@ -98,6 +98,28 @@ impl Buffer {
         self.accessors.len() - 1
     }
 
+    /// A unit-vector accessor (normals) quantized to normalized bytes (`KHR_mesh_quantization`):
+    /// 4 bytes a vertex (x, y, z and a pad, as vertex attributes align to 4) instead of 12.
+    /// A byte step is 1/127: under half a degree, which flat-shaded walls and roofs cannot
+    /// show; the shaders normalize the normal again.
+    pub fn unit_vectors(&mut self, data: &[f32]) -> usize {
+        let q = |x: f32| ((x.clamp(-1.0, 1.0) * 127.0).round() as i8).to_le_bytes()[0];
+        let packed: Vec<[u8; 4]> = data
+            .chunks_exact(3)
+            .map(|v| [q(v[0]), q(v[1]), q(v[2]), 0])
+            .collect();
+        let view = self.numbers(&packed, |b| b, Some(VERTICES));
+        self.views[view]["byteStride"] = json!(4);
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": 5120,
+            "normalized": true,
+            "count": packed.len(),
+            "type": "VEC3",
+        }));
+        self.accessors.len() - 1
+    }
+
     /// The index accessor: u16 while the vertices fit, else u32.
     pub fn indices(&mut self, idx: &[u32], vertices: usize) -> usize {
         let (view, ctype) = if vertices <= u16::MAX as usize {
@@ -174,6 +196,25 @@ mod tests {
         let jlen = u32::from_le_bytes(out[12..16].try_into().unwrap()) as usize;
         assert_eq!(jlen % 4, 0);
         assert_eq!(&out[20 + jlen + 4..20 + jlen + 8], b"BIN\0");
+    }
+
+    #[test]
+    fn normals_become_padded_normalized_bytes() {
+        let mut b = Buffer::default();
+        let a = b.unit_vectors(&[0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.6, 0.8, 0.0]);
+        let acc = &b.accessors[a];
+        assert_eq!(
+            (&acc["componentType"], &acc["normalized"], &acc["count"]),
+            (&json!(5120), &json!(true), &json!(3))
+        );
+        let view = acc["bufferView"].as_u64().unwrap() as usize;
+        assert_eq!(b.views[view]["byteStride"], 4);
+        assert_eq!(b.views[view]["byteLength"], 12);
+        let q = |v: i8| v.to_le_bytes()[0];
+        assert_eq!(
+            b.bin,
+            [0, 0, q(127), 0, q(-127), 0, 0, 0, q(76), q(102), 0, 0]
+        );
     }
 
     #[test]

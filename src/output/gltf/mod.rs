@@ -7,7 +7,8 @@
 //! sub-millimetre precision); `tileset.json` places each tile. One node per object kind
 //! (`machiya`, `kura`, `fence`, `people`, ...), so a viewer can hide a kind; one primitive
 //! per material within it, merged across objects; each vertex carries its object's row in
-//! the metadata table (`_FEATURE_ID_0`). Cut-outs are `MASK` at 0.5, double-sided; no BLEND.
+//! the metadata table (`_FEATURE_ID_0`). Normals are normalized bytes (`KHR_mesh_quantization`,
+//! required). Cut-outs are `MASK` at 0.5, double-sided; no BLEND.
 //! Textures are the shared library by relative URI (`textures/<file>`, in `tiles/`): one copy per
 //! build, cached by a browser across tiles, loadable from any static server.
 
@@ -186,7 +187,8 @@ pub fn tile_glb(
     // the buffer was copied again and again.
     let vertex_bytes: usize = (kinds.iter().flat_map(|(_, p)| p.values()))
         .map(|p| {
-            4 * (p.positions.len() + p.normals.len() + p.uvs.len() + p.ids.len() + p.indices.len())
+            4 * (p.positions.len() + p.normals.len() / 3 + p.uvs.len() + p.ids.len())
+                + 4 * p.indices.len()
                 + 40
         })
         .sum();
@@ -202,7 +204,7 @@ pub fn tile_glb(
             }
             let vertices = p.positions.len() / 3;
             let pos = buf.floats(&p.positions, 3, true);
-            let nor = buf.floats(&p.normals, 3, false);
+            let nor = buf.unit_vectors(&p.normals);
             let uv = buf.floats(&p.uvs, 2, false);
             let fid = buf.floats(&p.ids, 1, false);
             let ind = buf.indices(&p.indices, vertices);
@@ -244,7 +246,13 @@ pub fn tile_glb(
     });
     if !nodes.is_empty() {
         let metadata = metadata::structural_metadata(features, &mut buf);
-        doc["extensionsUsed"] = json!(["EXT_mesh_features", "EXT_structural_metadata"]);
+        doc["extensionsUsed"] = json!([
+            "EXT_mesh_features",
+            "EXT_structural_metadata",
+            "KHR_mesh_quantization"
+        ]);
+        // Byte normals are not core glTF: a client must know the extension to read them.
+        doc["extensionsRequired"] = json!(["KHR_mesh_quantization"]);
         doc["extensions"] = json!({"EXT_structural_metadata": metadata});
         doc["scenes"][0]["nodes"] = json!((0..nodes.len()).collect::<Vec<_>>());
         doc["nodes"] = json!(nodes);
