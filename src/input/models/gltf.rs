@@ -36,8 +36,10 @@ pub(super) fn load_gltf(
         };
         format!("{shown} is not a readable glTF: {e}")
     };
-    let g = gltf::Gltf::from_slice(&bytes).map_err(|e| bad(&e))?;
+    let g = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| bad(&e))?;
+    validate(&g.document).map_err(|e| bad(&e))?;
     drop(bytes);
+    float_positions(&g.document, shown)?;
     let buffers = buffers(&g, dir, shown, confined)?;
     check_accessors(&g.document, shown)?;
     let mut model = Model::default();
@@ -235,6 +237,52 @@ fn local_uri(uri: &str, dir: &Path, shown: &str) -> Result<std::path::PathBuf, S
         )
     })?;
     Ok(dir.join(&*decoded))
+}
+
+/// The crate's validation, with one extension more than it knows: `KHR_mesh_quantization`,
+/// which our own GLB tiles require (byte normals). What this reader takes from a model reads
+/// the same under it: positions (checked to be floats by [`float_positions`]), texture
+/// coordinates (normalized integers turned to floats by the crate) and indices; normals are
+/// not read.
+fn validate(doc: &gltf::Document) -> Result<(), gltf::Error> {
+    use gltf::json::validation::{Error, Validate};
+    let root = doc.as_json();
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        errors.push((path(), error))
+    });
+    errors.retain(|(path, error)| {
+        let quantization = path.as_str().starts_with("extensionsRequired[")
+            && path.as_str().ends_with("= \"KHR_mesh_quantization\"");
+        !(quantization && matches!(error, Error::Unsupported))
+    });
+    match errors.is_empty() {
+        true => Ok(()),
+        false => Err(gltf::Error::Validation(errors)),
+    }
+}
+
+/// Refuses positions that are not floats (`KHR_mesh_quantization` allows integers with a
+/// node scale, which the crate's reader would take as floats).
+fn float_positions(doc: &gltf::Document, shown: &str) -> Result<(), String> {
+    for mesh in doc.meshes() {
+        for prim in mesh.primitives() {
+            let Some(a) = prim.get(&gltf::Semantic::Positions) else {
+                continue;
+            };
+            if a.data_type() != gltf::accessor::DataType::F32
+                || a.dimensions() != gltf::accessor::Dimensions::Vec3
+            {
+                return Err(format!(
+                    "{shown}: mesh {} has quantized positions ({:?}), which are not read: \
+                     export the model with float positions",
+                    mesh.index(),
+                    a.data_type()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Refuses accessors that declare more elements than a model may hold, and sparse parts
