@@ -364,3 +364,74 @@ fn landmark_triangles_are_budgeted_per_tile_with_the_rest_skipped() {
         (Some(1), Some(1))
     );
 }
+
+/// A glTF of one triangle whose positions are an `EXT_meshopt_compression` view: the
+/// compressed bytes in `compressed.bin`, the view in a fallback buffer of `fallback` bytes,
+/// with `ext` added to the view's extension object.
+fn meshopt_gltf(compressed_len: usize, fallback: u64, ext: &str) -> String {
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},
+"extensionsUsed":["EXT_meshopt_compression"],"extensionsRequired":["EXT_meshopt_compression"],
+"buffers":[{{"uri":"compressed.bin","byteLength":{compressed_len}}},
+  {{"byteLength":{fallback},"extensions":{{"EXT_meshopt_compression":{{"fallback":true}}}}}}],
+"bufferViews":[{{"buffer":1,"byteLength":36,"byteStride":12,"extensions":{{"EXT_meshopt_compression":
+  {{"buffer":0,"byteLength":{compressed_len},"byteStride":12,"count":3,"mode":"ATTRIBUTES"{ext}}}}}}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[10,10,0]}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+"nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}],"scene":0}}"#
+    )
+}
+
+#[test]
+fn meshopt_compressed_models_are_decoded_and_damaged_ones_skipped_with_why() {
+    let tmp = tempfile::tempdir().unwrap();
+    let models = tmp.path().join("models");
+    std::fs::create_dir_all(&models).unwrap();
+    let triangle: Vec<[u8; 12]> = triangle_bin()
+        .chunks(12)
+        .map(|c| c.try_into().unwrap())
+        .collect();
+    let packed = meshopt::encoding::encode_vertex_buffer(&triangle).unwrap();
+    std::fs::write(models.join("compressed.bin"), &packed).unwrap();
+    let n = packed.len();
+    let cases = [
+        ("ok", meshopt_gltf(n, 36, "")),
+        ("filtered", meshopt_gltf(n, 36, r#","filter":"OCTAHEDRAL""#)),
+        ("huge", meshopt_gltf(n, 1 << 40, "")),
+        (
+            "short",
+            meshopt_gltf(n, 36, "").replace(r#""count":3"#, r#""count":2"#),
+        ),
+    ];
+    let mut rows = Vec::new();
+    for (name, text) in &cases {
+        std::fs::write(models.join(format!("{name}.gltf")), text).unwrap();
+        rows.push(row(name, &format!("{name}.gltf")));
+    }
+    // Garbage where the compressed bytes should be.
+    std::fs::write(models.join("garbage.bin"), vec![0xa0; n]).unwrap();
+    std::fs::write(
+        models.join("garbage.gltf"),
+        meshopt_gltf(n, 36, "").replace("compressed.bin", "garbage.bin"),
+    )
+    .unwrap();
+    rows.push(row("garbage", "garbage.gltf"));
+    let report = build(tmp.path(), &rows);
+    assert_eq!(placed(&report), vec!["ok".to_string()]);
+    assert!(why(&report, "filtered").contains("OCTAHEDRAL filter"));
+    assert!(
+        why(&report, "huge").contains("more than"),
+        "{}",
+        why(&report, "huge")
+    );
+    assert!(
+        why(&report, "short").contains("damaged"),
+        "{}",
+        why(&report, "short")
+    );
+    let g = why(&report, "garbage");
+    assert!(
+        g.contains("does not decode") || g.contains("damaged"),
+        "{g}"
+    );
+}

@@ -11,6 +11,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TilesRenderer } from '3d-tiles-renderer';
 import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
+import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { createDesigner } from './garden.js';
 
 const SKY = 0xbcd6ea;
@@ -128,7 +129,9 @@ function city(k) {
   if (cities[k]) return cities[k];
   const h = api.hypotheses[k];
   const tiles = new TilesRenderer(h.tileset);
-  tiles.registerPlugin(new GLTFExtensionsPlugin({ metadata: true, rtc: true }));
+  // Tiles are EXT_meshopt_compression by default ([output] glb_compression): three.js' own
+  // decoder (WebAssembly, served from the pinned npm package) unpacks them.
+  tiles.registerPlugin(new GLTFExtensionsPlugin({ metadata: true, rtc: true, meshoptDecoder: MeshoptDecoder }));
   tiles.errorTarget = 8;
   tiles.setCamera(camera);
   tiles.setResolutionFromRenderer(camera, renderer);

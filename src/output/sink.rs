@@ -61,7 +61,9 @@ pub fn sinks(output: &crate::params::OutputParams) -> Vec<Box<dyn Sink>> {
             "obj" => Box::new(super::obj::ObjSink {
                 by_kind: output.obj_objects == "kind",
             }),
-            "glb" => Box::new(super::gltf::GlbSink),
+            "glb" => Box::new(super::gltf::GlbSink {
+                meshopt: output.glb_compression == "meshopt",
+            }),
             _ => continue,
         };
         if !out.iter().any(|o| o.format() == s.format()) {

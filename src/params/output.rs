@@ -19,15 +19,34 @@ pub struct OutputParams {
     /// draw calls a tile in three.js instead of thousands; the houses' names are gone).
     #[serde(default = "each")]
     pub obj_objects: String,
+    /// GLB vertex and index data: `"meshopt"` (`EXT_meshopt_compression`, required: three.js
+    /// with its decoder, CesiumJS, gltfpack read it) or `"none"` (plain views, for clients
+    /// without a decoder, such as Blender's importer and the Khronos validator).
+    #[serde(default = "meshopt")]
+    pub glb_compression: String,
 }
 
 fn each() -> String {
     "each".into()
 }
 
+fn meshopt() -> String {
+    "meshopt".into()
+}
+
+/// The values of `output.glb_compression`.
+pub const GLB_COMPRESSIONS: &[&str] = &["meshopt", "none"];
+
 impl OutputParams {
     pub(super) fn validate(&self) -> Result<(), String> {
         check_formats(&self.formats).map_err(|e| format!("`output.formats`: {e}"))?;
+        if !GLB_COMPRESSIONS.contains(&self.glb_compression.as_str()) {
+            return Err(format!(
+                "`output.glb_compression` must be \"meshopt\" or \"none\" (for clients without \
+                 a meshopt decoder), got \"{}\"",
+                self.glb_compression
+            ));
+        }
         match self.obj_objects.as_str() {
             "each" | "kind" => Ok(()),
             other => Err(format!(
@@ -79,5 +98,6 @@ pub(super) mod partial {
     pub struct Output {
         formats: Option<Vec<String>>,
         obj_objects: Option<String>,
+        glb_compression: Option<String>,
     }
 }

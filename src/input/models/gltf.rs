@@ -40,7 +40,8 @@ pub(super) fn load_gltf(
     validate(&g.document).map_err(|e| bad(&e))?;
     drop(bytes);
     float_positions(&g.document, shown)?;
-    let buffers = buffers(&g, dir, shown, confined)?;
+    let mut buffers = buffers(&g, dir, shown, confined)?;
+    super::meshopt::decode(&g.document, &mut buffers, shown)?;
     check_accessors(&g.document, shown)?;
     let mut model = Model::default();
     for m in g.document.materials() {
@@ -182,6 +183,15 @@ fn buffers(
     let mut out = Vec::new();
     for b in g.document.buffers() {
         let mut data = match b.source() {
+            // Filled by decoding its compressed views; counted against the bound first.
+            _ if super::meshopt::is_fallback(&b) => {
+                if total + b.length() as u64 > MAX_MODEL_BYTES {
+                    return Err(format!(
+                        "{shown}: its buffers hold more than {MAX_MODEL_BYTES} bytes: decimate it"
+                    ));
+                }
+                vec![0; b.length()]
+            }
             gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
                 format!(
                     "{shown}: buffer {} is the GLB's binary chunk, which is missing: it is \
@@ -239,8 +249,9 @@ fn local_uri(uri: &str, dir: &Path, shown: &str) -> Result<std::path::PathBuf, S
     Ok(dir.join(&*decoded))
 }
 
-/// The crate's validation, with one extension more than it knows: `KHR_mesh_quantization`,
-/// which our own GLB tiles require (byte normals). What this reader takes from a model reads
+/// The crate's validation, with two extensions more than it knows: `KHR_mesh_quantization`,
+/// which our own GLB tiles require (byte normals), and `EXT_meshopt_compression`, which
+/// they require by default and [`super::meshopt`] decodes. What this reader takes from a model reads
 /// the same under it: positions (checked to be floats by [`float_positions`]), texture
 /// coordinates (normalized integers turned to floats by the crate) and indices; normals are
 /// not read.
@@ -253,7 +264,8 @@ fn validate(doc: &gltf::Document) -> Result<(), gltf::Error> {
     });
     errors.retain(|(path, error)| {
         let quantization = path.as_str().starts_with("extensionsRequired[")
-            && path.as_str().ends_with("= \"KHR_mesh_quantization\"");
+            && (path.as_str().ends_with("= \"KHR_mesh_quantization\"")
+                || path.as_str().ends_with("= \"EXT_meshopt_compression\""));
         !(quantization && matches!(error, Error::Unsupported))
     });
     match errors.is_empty() {

@@ -8,6 +8,7 @@
 //! anything of that size is allocated.
 
 mod gltf;
+mod meshopt;
 
 use std::cell::RefCell;
 use std::path::Path;

@@ -1,6 +1,12 @@
 //! The binary half of a GLB: one BIN buffer of views, each 8-byte aligned (the structural
 //! metadata extension asks 8 for its tables; vertex data needs 4), and the accessors over
 //! them, collected as glTF JSON.
+//!
+//! With meshopt on, vertex and index views are `EXT_meshopt_compression` views: their
+//! compressed bytes are in the BIN buffer and the view itself points into buffer 1, a
+//! fallback buffer with no data that the decoder fills (the extension's layout for files
+//! that require it). The metadata's views stay plain: they are small, and three.js' metadata
+//! plugin reads them straight from the buffer.
 
 use serde_json::{json, Value};
 
@@ -18,9 +24,91 @@ pub struct Buffer {
     pub views: Vec<Value>,
     /// `accessors`.
     pub accessors: Vec<Value>,
+    /// Vertex and index views compressed by meshopt.
+    pub meshopt: bool,
+    /// The decoded size of the compressed views: the fallback buffer's `byteLength`.
+    pub fallback: usize,
+}
+
+/// meshopt's two codecs, as `EXT_meshopt_compression` names them.
+#[derive(Clone, Copy)]
+enum Mode {
+    /// The vertex codec over elements of a fixed size.
+    Attributes,
+    /// The index codec over triangles.
+    Triangles,
 }
 
 impl Buffer {
+    /// An empty buffer whose vertex and index views are compressed when `meshopt` is set.
+    pub fn new(meshopt: bool) -> Buffer {
+        Buffer {
+            meshopt,
+            ..Buffer::default()
+        }
+    }
+
+    /// The glTF `buffers`: the BIN chunk and, when a view was compressed, the fallback buffer.
+    pub fn buffers_json(&self) -> Value {
+        let mut out = vec![json!({"byteLength": self.bin.len().next_multiple_of(4)})];
+        if self.fallback > 0 {
+            out.push(json!({
+                "byteLength": self.fallback,
+                "extensions": {"EXT_meshopt_compression": {"fallback": true}},
+            }));
+        }
+        json!(out)
+    }
+
+    /// Whether a view was compressed (and the file needs `EXT_meshopt_compression`).
+    pub fn compressed(&self) -> bool {
+        self.fallback > 0
+    }
+
+    /// Stores `raw` (`count` elements of `stride` bytes) compressed as a view of the fallback
+    /// buffer; `None` (nothing stored) if meshopt refuses it, and the caller stores it plain.
+    /// `indices` are the same data as numbers when `mode` is [`Mode::Triangles`].
+    fn compressed_view(
+        &mut self,
+        raw: &[u8],
+        stride: usize,
+        mode: Mode,
+        indices: &[u32],
+        target: u32,
+    ) -> Option<usize> {
+        let count = raw.len() / stride;
+        let encoded = match mode {
+            Mode::Attributes => encode_attributes(raw, stride)?,
+            Mode::Triangles => {
+                let vertices = indices.iter().max().map_or(0, |&m| m as usize + 1);
+                meshopt::encoding::encode_index_buffer(indices, vertices).ok()?
+            }
+        };
+        let start = self.align();
+        self.bin.extend_from_slice(&encoded);
+        let offset = self.fallback.next_multiple_of(8);
+        self.fallback = offset + raw.len();
+        let mut v = json!({
+            "buffer": 1,
+            "byteOffset": offset,
+            "byteLength": raw.len(),
+            "target": target,
+            "extensions": {"EXT_meshopt_compression": {
+                "buffer": 0,
+                "byteOffset": start,
+                "byteLength": encoded.len(),
+                "byteStride": stride,
+                "count": count,
+                "mode": match mode { Mode::Attributes => "ATTRIBUTES", Mode::Triangles => "TRIANGLES" },
+            }},
+        });
+        if let Mode::Attributes = mode {
+            v["byteStride"] = json!(stride);
+        }
+        self.views.push(v);
+        Some(self.views.len() - 1)
+    }
+
     /// Pads the buffer to the next view's 8-byte boundary; returns where the view starts.
     fn align(&mut self) -> usize {
         let start = self.bin.len().next_multiple_of(8);
@@ -50,6 +138,22 @@ impl Buffer {
         self.close_view(start, target)
     }
 
+    /// Appends vertex attributes `data` little-endian as a view, `N` bytes an element,
+    /// compressed when meshopt is on.
+    fn attributes<T: Copy, const N: usize>(
+        &mut self,
+        data: &[T],
+        bytes: impl Fn(T) -> [u8; N],
+    ) -> usize {
+        if self.meshopt && !data.is_empty() {
+            let raw: Vec<u8> = data.iter().flat_map(|&x| bytes(x)).collect();
+            if let Some(v) = self.compressed_view(&raw, N, Mode::Attributes, &[], VERTICES) {
+                return v;
+            }
+        }
+        self.numbers(data, bytes, Some(VERTICES))
+    }
+
     /// Appends `data` little-endian as a view, written straight into the buffer (a tile's
     /// vertices are most of its bytes; each copy of them was measured).
     fn numbers<T: Copy, const N: usize>(
@@ -69,7 +173,12 @@ impl Buffer {
     /// A float accessor of `n`-component elements (`SCALAR`, `VEC2`, `VEC3`), with `min`
     /// and `max` when asked (positions must have them).
     pub fn floats(&mut self, data: &[f32], n: usize, bounds: bool) -> usize {
-        let view = self.numbers(data, f32::to_le_bytes, Some(VERTICES));
+        let view = match n {
+            1 => self.attributes(data, f32::to_le_bytes),
+            2 => self.attributes(pairs(data), |v| flat::<2, 8>(v.map(f32::to_le_bytes))),
+            3 => self.attributes(triples(data), |v| flat::<3, 12>(v.map(f32::to_le_bytes))),
+            _ => self.numbers(data, f32::to_le_bytes, Some(VERTICES)),
+        };
         let kind = match n {
             1 => "SCALAR",
             2 => "VEC2",
@@ -108,7 +217,7 @@ impl Buffer {
             .chunks_exact(3)
             .map(|v| [q(v[0]), q(v[1]), q(v[2]), 0])
             .collect();
-        let view = self.numbers(&packed, |b| b, Some(VERTICES));
+        let view = self.attributes(&packed, |b| b);
         self.views[view]["byteStride"] = json!(4);
         self.accessors.push(json!({
             "bufferView": view,
@@ -122,11 +231,26 @@ impl Buffer {
 
     /// The index accessor: u16 while the vertices fit, else u32.
     pub fn indices(&mut self, idx: &[u32], vertices: usize) -> usize {
-        let (view, ctype) = if vertices <= u16::MAX as usize {
-            let view = self.numbers(idx, |i| (i as u16).to_le_bytes(), Some(INDICES));
-            (view, 5123)
-        } else {
-            (self.numbers(idx, u32::to_le_bytes, Some(INDICES)), 5125)
+        let short = vertices <= u16::MAX as usize;
+        let compressed = (self.meshopt && !idx.is_empty() && idx.len().is_multiple_of(3))
+            .then(|| {
+                let raw: Vec<u8> = if short {
+                    idx.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect()
+                } else {
+                    idx.iter().flat_map(|&i| i.to_le_bytes()).collect()
+                };
+                let stride = if short { 2 } else { 4 };
+                self.compressed_view(&raw, stride, Mode::Triangles, idx, INDICES)
+            })
+            .flatten();
+        let (view, ctype) = match (compressed, short) {
+            (Some(v), true) => (v, 5123),
+            (Some(v), false) => (v, 5125),
+            (None, true) => (
+                self.numbers(idx, |i| (i as u16).to_le_bytes(), Some(INDICES)),
+                5123,
+            ),
+            (None, false) => (self.numbers(idx, u32::to_le_bytes, Some(INDICES)), 5125),
         };
         self.accessors.push(json!({
             "bufferView": view,
@@ -136,6 +260,43 @@ impl Buffer {
         }));
         self.accessors.len() - 1
     }
+}
+
+/// meshopt's vertex codec over `raw`, elements of `stride` bytes (4, 8 or 12 here); `None`
+/// for another stride or if the codec refuses.
+fn encode_attributes(raw: &[u8], stride: usize) -> Option<Vec<u8>> {
+    fn encode<const N: usize>(raw: &[u8]) -> Option<Vec<u8>> {
+        let (elements, rest) = raw.as_chunks::<N>();
+        if !rest.is_empty() {
+            return None;
+        }
+        meshopt::encoding::encode_vertex_buffer(elements).ok()
+    }
+    match stride {
+        4 => encode::<4>(raw),
+        8 => encode::<8>(raw),
+        12 => encode::<12>(raw),
+        _ => None,
+    }
+}
+
+/// `data` as pairs (its length is even: two coordinates a vertex).
+fn pairs(data: &[f32]) -> &[[f32; 2]] {
+    data.as_chunks::<2>().0
+}
+
+/// `data` as triples.
+fn triples(data: &[f32]) -> &[[f32; 3]] {
+    data.as_chunks::<3>().0
+}
+
+/// `N` arrays of 4 bytes as one array.
+fn flat<const N: usize, const M: usize>(parts: [[u8; 4]; N]) -> [u8; M] {
+    let mut out = [0u8; M];
+    for (o, b) in out.chunks_exact_mut(4).zip(parts.iter()) {
+        o.copy_from_slice(b);
+    }
+    out
 }
 
 /// A GLB file in two pieces, written one after the other: the header with the JSON chunk and
@@ -214,6 +375,73 @@ mod tests {
         assert_eq!(
             b.bin,
             [0, 0, q(127), 0, q(-127), 0, 0, 0, q(76), q(102), 0, 0]
+        );
+    }
+
+    /// The view's compressed bytes and its extension object.
+    fn compressed_of(b: &Buffer, view: usize) -> (&[u8], &Value) {
+        let e = &b.views[view]["extensions"]["EXT_meshopt_compression"];
+        let start = e["byteOffset"].as_u64().unwrap() as usize;
+        let len = e["byteLength"].as_u64().unwrap() as usize;
+        (&b.bin[start..start + len], e)
+    }
+
+    #[test]
+    fn compressed_views_decode_to_the_plain_bytes_with_the_codec_versions_the_extension_reads() {
+        let positions: Vec<f32> = (0..300).map(|i| (i % 17) as f32 * 0.25).collect();
+        let idx: Vec<u32> = (0..99).map(|i| (i * 7) % 100).collect();
+        let mut plain = Buffer::new(false);
+        let mut packed = Buffer::new(true);
+        for b in [&mut plain, &mut packed] {
+            b.floats(&positions, 3, true);
+            b.indices(&idx, 100);
+        }
+        assert!(!plain.compressed() && packed.compressed());
+        // Vertex codec version 0 (0xa0) is the one EXT_meshopt_compression defines;
+        // index codec 0xe0 | version.
+        let (bytes, e) = compressed_of(&packed, 0);
+        assert_eq!(
+            (bytes[0], &e["mode"], &e["byteStride"]),
+            (0xa0, &json!("ATTRIBUTES"), &json!(12))
+        );
+        let decoded: Vec<[u8; 12]> = meshopt::encoding::decode_vertex_buffer(bytes, 100).unwrap();
+        assert_eq!(decoded.concat(), plain.bin[..1200]);
+        let (bytes, e) = compressed_of(&packed, 1);
+        assert_eq!(
+            (bytes[0] & 0xf0, &e["mode"], &e["count"]),
+            (0xe0, &json!("TRIANGLES"), &json!(99))
+        );
+        // The index codec may rotate a triangle's corners (its winding kept).
+        let decoded: Vec<u16> = meshopt::encoding::decode_index_buffer(bytes, 99).unwrap();
+        let rotated = |t: &[u16]| {
+            let k = (0..3).min_by_key(|&k| t[k]).unwrap();
+            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+        };
+        let expected: Vec<[u16; 3]> = idx
+            .iter()
+            .map(|&i| i as u16)
+            .collect::<Vec<_>>()
+            .chunks(3)
+            .map(rotated)
+            .collect();
+        let got: Vec<[u16; 3]> = decoded.chunks(3).map(rotated).collect();
+        assert_eq!(got, expected);
+        // The views point into the fallback buffer, 8-byte aligned, as long as the plain ones.
+        assert_eq!(packed.views[1]["buffer"], 1);
+        assert_eq!(packed.views[1]["byteOffset"], 1200);
+        assert_eq!(packed.views[1]["byteLength"], plain.views[1]["byteLength"]);
+        assert_eq!(packed.fallback, 1398);
+        assert_eq!(
+            packed.buffers_json()[1]["extensions"]["EXT_meshopt_compression"]["fallback"],
+            true
+        );
+        // The accessors are the same but for where their views are.
+        assert_eq!(packed.accessors, plain.accessors);
+        assert!(
+            packed.bin.len() < plain.bin.len() / 2,
+            "{} {}",
+            packed.bin.len(),
+            plain.bin.len()
         );
     }
 

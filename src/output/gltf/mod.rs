@@ -126,12 +126,12 @@ impl Primitive {
                     let q = mesh.positions[p as usize];
                     for k in 0..3 {
                         self.positions
-                            .push(((q[k] - shift[k]) as f64 / 1000.0) as f32);
+                            .push(snap((q[k] - shift[k]) as f64 / 1000.0, METRE_STEPS));
                     }
                     self.normals.extend_from_slice(&n);
                     let uv = mesh.uvs.get(t as usize).copied().unwrap_or([0, 0]);
-                    self.uvs.push(uv[0] as f32 / 10_000.0);
-                    self.uvs.push(1.0 - uv[1] as f32 / 10_000.0);
+                    self.uvs.push(snap(uv[0] as f64 / 10_000.0, UV_STEPS));
+                    self.uvs.push(snap(1.0 - uv[1] as f64 / 10_000.0, UV_STEPS));
                     self.ids.push(object as f32);
                     v
                 }
@@ -144,6 +144,54 @@ impl Primitive {
         }
         self.corners = idx;
     }
+}
+
+impl Primitive {
+    /// Orders the triangles for the GPU's vertex cache and then the vertices by first use
+    /// (meshoptimizer's two passes): the drawing is the same, the index and vertex codecs
+    /// find smaller deltas, and a plain GLB gets the same order as a compressed one.
+    fn reorder(&mut self) {
+        let vertices = self.ids.len();
+        if vertices == 0 {
+            return;
+        }
+        // The FIFO optimizer (tipsify): linear in the triangles whatever the mesh. The default
+        // one rescores every triangle of each cached vertex per triangle emitted, quadratic
+        // on a vertex shared by many (a landmark of 600,000 triangles on three vertices did
+        // not finish in minutes).
+        meshopt::optimize::optimize_vertex_cache_fifo_in_place(&mut self.indices, vertices, 16);
+        let remap = meshopt::optimize::optimize_vertex_fetch_remap(&self.indices, vertices);
+        for i in &mut self.indices {
+            *i = remap[*i as usize];
+        }
+        let used = remap.iter().filter(|&&r| r != u32::MAX).count();
+        let permute = |data: &[f32], n: usize| {
+            let mut out = vec![0.0f32; used * n];
+            for (old, &new) in remap.iter().enumerate() {
+                if new != u32::MAX {
+                    let new = new as usize;
+                    out[new * n..new * n + n].copy_from_slice(&data[old * n..old * n + n]);
+                }
+            }
+            out
+        };
+        self.positions = permute(&self.positions, 3);
+        self.normals = permute(&self.normals, 3);
+        self.uvs = permute(&self.uvs, 2);
+        self.ids = permute(&self.ids, 1);
+    }
+}
+
+/// Positions are rounded to 1/1024 m (under half a millimetre from the millimetres they
+/// were) and texture coordinates to 1/4096 (an eighth of a texel of a 512-pixel texture):
+/// the low bits of their floats are then zero, which meshopt's vertex codec stores in next
+/// to nothing. Measured on the example town: positions 326 -> 247 KB, uvs 258 -> 200 KB.
+const METRE_STEPS: f64 = 1024.0;
+const UV_STEPS: f64 = 4096.0;
+
+/// `v` rounded to the nearest 1/`steps`, as f32 (exact: a float of few significant bits).
+fn snap(v: f64, steps: f64) -> f32 {
+    ((v * steps).round() / steps) as f32
 }
 
 /// sRGB to linear, for `baseColorFactor` (glTF factors are linear).
@@ -163,6 +211,7 @@ pub fn tile_glb(
     features: &[Feature],
     shift: [i64; 3],
     palette: Palette,
+    meshopt: bool,
 ) -> buffer::Glb {
     // Node per kind, in order of first appearance; primitive per material, by material id.
     let mut kinds: Vec<(&str, std::collections::BTreeMap<u16, Primitive>)> = Vec::new();
@@ -182,7 +231,10 @@ pub fn tile_glb(
                 .face(i as u32, mesh, &face.corners, shift);
         }
     }
-    let mut buf = Buffer::default();
+    for p in kinds.iter_mut().flat_map(|(_, p)| p.values_mut()) {
+        p.reorder();
+    }
+    let mut buf = Buffer::new(meshopt);
     // The vertex data's bytes (and each view's padding), reserved once: grown by doubling,
     // the buffer was copied again and again.
     let vertex_bytes: usize = (kinds.iter().flat_map(|(_, p)| p.values()))
@@ -246,19 +298,26 @@ pub fn tile_glb(
     });
     if !nodes.is_empty() {
         let metadata = metadata::structural_metadata(features, &mut buf);
-        doc["extensionsUsed"] = json!([
+        let mut used = vec![
             "EXT_mesh_features",
             "EXT_structural_metadata",
-            "KHR_mesh_quantization"
-        ]);
-        // Byte normals are not core glTF: a client must know the extension to read them.
-        doc["extensionsRequired"] = json!(["KHR_mesh_quantization"]);
+            "KHR_mesh_quantization",
+        ];
+        // Byte normals are not core glTF: a client must know the extension to read them; and
+        // compressed views have no data but what the decoder makes.
+        let mut required = vec!["KHR_mesh_quantization"];
+        if buf.compressed() {
+            used.push("EXT_meshopt_compression");
+            required.push("EXT_meshopt_compression");
+        }
+        doc["extensionsUsed"] = json!(used);
+        doc["extensionsRequired"] = json!(required);
         doc["extensions"] = json!({"EXT_structural_metadata": metadata});
         doc["scenes"][0]["nodes"] = json!((0..nodes.len()).collect::<Vec<_>>());
         doc["nodes"] = json!(nodes);
         doc["meshes"] = json!(meshes_json);
         doc["materials"] = json!(materials);
-        doc["buffers"] = json!([{"byteLength": buf.bin.len().next_multiple_of(4)}]);
+        doc["buffers"] = buf.buffers_json();
         doc["bufferViews"] = json!(buf.views);
         doc["accessors"] = json!(buf.accessors);
     }
@@ -302,7 +361,10 @@ fn materials(used: &[u16], palette: Palette) -> (Vec<Value>, Vec<Value>, Vec<Val
 }
 
 /// The GLB format: `tiles/<id>.glb`, and `tileset.json` over all of them.
-pub struct GlbSink;
+pub struct GlbSink {
+    /// `output.glb_compression = "meshopt"`.
+    pub meshopt: bool,
+}
 
 impl crate::output::sink::Sink for GlbSink {
     fn format(&self) -> &'static str {
@@ -320,6 +382,7 @@ impl crate::output::sink::Sink for GlbSink {
             tile.features,
             tile.centre,
             tile.palette,
+            self.meshopt,
         );
         let path = format!("tiles/{}.glb", tile.id);
         Ok(crate::output::sink::TileFiles {
