@@ -673,7 +673,7 @@ fn write_city(
         output::atomic::write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
     }
     if opts.selection == Selection::All {
-        shards::remove_stale_tiles(&opts.out, &manifest.tiles);
+        shards::remove_stale_tiles(&opts.out, &manifest);
         shards::remove_stale_textures(&opts.out, &manifest.textures);
     }
     // Drawn beside the tiles: its own time, not the wall time it added.

@@ -1,5 +1,5 @@
-//! Golden outputs: the example town's every tile (sha256 of its OBJ and MTL) and its whole
-//! report.json, committed in `tests/golden/`. A template or rule that changes the geometry
+//! Golden outputs: the example town's every tile (sha256 of its OBJ, MTL and GLB), the
+//! levels of detail above them and `tileset.json`, and its whole report.json, committed in `tests/golden/`. A template or rule that changes the geometry
 //! by accident fails here; a change made on purpose is accepted with
 //! `EDO_CITY_BLESS=1 cargo test --test golden` and shows in the diff of `tests/golden/`
 //! (resvg keeps its reference images the same way).
@@ -42,9 +42,18 @@ fn snapshot(name: &str, extra: &[&str]) -> serde_json::Value {
         }
         tiles.insert(t["id"].as_str().unwrap().to_string(), files);
     }
+    // The levels of detail above the tiles (tileset.json's parents): made from the tiles'
+    // bytes, pinned with them.
+    let mut lod = BTreeMap::new();
+    for f in manifest["files"].as_array().unwrap() {
+        let path = f["path"].as_str().unwrap();
+        if path.starts_with("tiles/lod/") || path == "tileset.json" {
+            lod.insert(path.to_string(), f["sha256"].clone());
+        }
+    }
     let mut report = read_json(&out.join("report.json"));
     report["input"] = serde_json::Value::String(format!("fixtures/{name}"));
-    serde_json::json!({ "tiles": tiles, "report": report })
+    serde_json::json!({ "tiles": tiles, "lod": lod, "report": report })
 }
 
 /// Compares a snapshot with its golden file, or writes it with `EDO_CITY_BLESS=1`.

@@ -112,6 +112,14 @@ fn two_hypotheses_started_together_never_mix_in_one_directory() {
             .unwrap()
             .iter()
             .flat_map(|t| [&t["obj"], &t["mtl"], &t["glb"]])
+            // The levels of detail above the tiles, among the build's files.
+            .chain(
+                m["files"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .filter(|f| f["path"].as_str().unwrap().starts_with("tiles/")),
+            )
             .map(|f| {
                 let path = f["path"].as_str().unwrap().to_string();
                 let bytes = std::fs::read(out.join(&path)).unwrap();

@@ -71,6 +71,13 @@ fn walk(node: &Value, to_root: Affine, leaves: &mut Vec<(Value, Affine)>) {
         None => to_root,
     };
     let Some(children) = node.get("children").and_then(|c| c.as_array()) else {
+        assert!(
+            !node["content"]["uri"]
+                .as_str()
+                .unwrap()
+                .starts_with("tiles/lod/"),
+            "a leaf is a tile, not a level of detail"
+        );
         assert_eq!(node["geometricError"], 0.0, "a leaf's error is 0");
         assert!(node["content"]["uri"].as_str().unwrap().ends_with(".glb"));
         leaves.push((node.clone(), here));
@@ -107,7 +114,7 @@ fn the_tileset_holds_every_tile_and_places_a_house_where_proj_does() {
     let tileset = read_json(&out.path().join("tileset.json"));
     assert_eq!(tileset["asset"]["version"], "1.1");
     let root = &tileset["root"];
-    assert_eq!(root["refine"], "ADD");
+    assert_eq!(root["refine"], "REPLACE");
     let mut leaves = Vec::new();
     walk(root, Affine::IDENTITY, &mut leaves);
     let tiles = manifest["tiles"].as_array().unwrap();
@@ -384,4 +391,145 @@ fn obj_objects_by_kind_keep_every_face_in_a_few_objects() {
         .unwrap();
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("obj_objects"));
+}
+
+/// The BIN chunk of a GLB and the bytes of one of its (plain) views.
+fn view_bytes<'a>(glb: &'a [u8], json: &Value, view: &Value) -> &'a [u8] {
+    let len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let bin = &glb[20 + len + 8..];
+    let v = &json["bufferViews"][view.as_u64().unwrap() as usize];
+    assert_eq!(v["buffer"], 0, "metadata views are plain");
+    let o = v["byteOffset"].as_u64().unwrap_or(0) as usize;
+    &bin[o..o + v["byteLength"].as_u64().unwrap() as usize]
+}
+
+/// The strings of a string column of a GLB's property table.
+fn strings(glb: &[u8], json: &Value, key: &str) -> Vec<String> {
+    let t = &json["extensions"]["EXT_structural_metadata"]["propertyTables"][0];
+    let p = &t["properties"][key];
+    if p.is_null() {
+        // No row has one: the column is left out.
+        return vec![String::new(); t["count"].as_u64().unwrap() as usize];
+    }
+    let values = view_bytes(glb, json, &p["values"]);
+    let offsets: Vec<usize> = view_bytes(glb, json, &p["stringOffsets"])
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as usize)
+        .collect();
+    offsets
+        .windows(2)
+        .map(|w| String::from_utf8(values[w[0]..w[1]].to_vec()).unwrap())
+        .collect()
+}
+
+/// Triangles of a GLB (every primitive's index count / 3).
+fn triangles(json: &Value) -> u64 {
+    (json["meshes"].as_array().unwrap().iter())
+        .flat_map(|m| m["primitives"].as_array().unwrap().iter())
+        .map(|p| {
+            json["accessors"][p["indices"].as_u64().unwrap() as usize]["count"]
+                .as_u64()
+                .unwrap()
+                / 3
+        })
+        .sum()
+}
+
+/// The levels of detail: every inner node has content of its own (`tiles/lod/`), with fewer
+/// triangles than its leaves, a measured error above zero, its quantized vertices inside its
+/// box, and a metadata row for every house below it, so a click on a distant house names
+/// its lot; no people on it.
+#[test]
+fn parents_hold_the_city_coarser_and_still_name_every_lot() {
+    let out = tempfile::tempdir().unwrap();
+    // Small tiles: the example town spans a few levels.
+    let params = out.path().join("p.toml");
+    std::fs::write(
+        &params,
+        "tile_size = 60.0\n[output]\nglb_compression = \"none\"\n",
+    )
+    .unwrap();
+    let dir = out.path().join("o");
+    build_example(
+        &dir,
+        &["--format", "glb", "--params", params.to_str().unwrap()],
+    );
+    let tileset = read_json(&dir.join("tileset.json"));
+    assert!(
+        tileset["extras"]["levels"].as_u64().unwrap() >= 2,
+        "{}",
+        tileset["extras"]
+    );
+    // (node, its leaves' GLB paths), for every inner node.
+    fn inner(node: &Value, out: &mut Vec<(Value, Vec<String>)>) -> Vec<String> {
+        let Some(children) = node.get("children").and_then(|c| c.as_array()) else {
+            return vec![node["content"]["uri"].as_str().unwrap().to_string()];
+        };
+        let leaves: Vec<String> = children.iter().flat_map(|c| inner(c, out)).collect();
+        out.push((node.clone(), leaves.clone()));
+        leaves
+    }
+    let mut parents = Vec::new();
+    inner(&tileset["root"], &mut parents);
+    assert!(parents.len() >= 3, "{} parents", parents.len());
+    for (node, leaves) in &parents {
+        let uri = node["content"]["uri"].as_str().unwrap();
+        assert!(uri.starts_with("tiles/lod/"), "{uri}");
+        let e = node["geometricError"].as_f64().unwrap();
+        assert!((0.5..100.0).contains(&e), "{uri}: error {e}");
+        let bytes = std::fs::read(dir.join(uri)).unwrap();
+        let g = glb_json(&bytes);
+        let lots = strings(&bytes, &g, "lot");
+        let names = strings(&bytes, &g, "name");
+        let mut below = 0;
+        for leaf in leaves {
+            let lb = std::fs::read(dir.join(leaf)).unwrap();
+            let lg = glb_json(&lb);
+            below += triangles(&lg);
+            for (name, lot) in strings(&lb, &lg, "name")
+                .iter()
+                .zip(strings(&lb, &lg, "lot"))
+            {
+                if name.starts_with("machiya_") {
+                    assert!(
+                        names.contains(name) && lots.contains(&lot),
+                        "{uri}: house {name} of lot {lot} has no row"
+                    );
+                }
+            }
+        }
+        let here = triangles(&g);
+        assert!(
+            here > 0 && here < below,
+            "{uri}: {here} triangles against {below} below"
+        );
+        // One node: its translation and scale place the quantized positions in the box.
+        let n = &g["nodes"][0];
+        assert_eq!(n["name"], "lod");
+        let t = floats(&n["translation"]);
+        let sc = floats(&n["scale"])[0];
+        for p in g["meshes"][0]["primitives"].as_array().unwrap() {
+            let a = &g["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
+            for m in [&a["min"], &a["max"]] {
+                let v = floats(m);
+                let y_up = [t[0] + sc * v[0], t[1] + sc * v[1], t[2] + sc * v[2]];
+                assert!(
+                    inside(
+                        &node["boundingVolume"]["box"],
+                        [y_up[0], -y_up[2], y_up[1]],
+                        0.1
+                    ),
+                    "{uri}: a vertex outside its box"
+                );
+            }
+        }
+        assert!(
+            g["materials"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|m| !m["name"].as_str().unwrap().starts_with("person")),
+            "{uri}: people are left out"
+        );
+    }
 }

@@ -132,7 +132,10 @@ function city(k) {
   // Tiles are EXT_meshopt_compression by default ([output] glb_compression): three.js' own
   // decoder (WebAssembly, served from the pinned npm package) unpacks them.
   tiles.registerPlugin(new GLTFExtensionsPlugin({ metadata: true, rtc: true, meshoptDecoder: MeshoptDecoder }));
-  tiles.errorTarget = 8;
+  // The tileset's parents are the city in coarser levels, each replaced by its children when
+  // its measured error would cover more than 16 pixels (CesiumJS' default): the whole town
+  // from above is the root alone; a street's tiles come in full as the camera nears them.
+  tiles.errorTarget = 16;
   tiles.setCamera(camera);
   tiles.setResolutionFromRenderer(camera, renderer);
   tiles.group.matrixAutoUpdate = false;

@@ -267,25 +267,27 @@ fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), BuildError> {
     write_atomic(path, &bytes).map_err(|e| write_err(path, e))
 }
 
-/// Deletes the tiles an earlier build into the same directory listed in its manifest that
-/// this build did not write, so the directory holds one consistent city. Files the tool did
-/// not write itself are never touched.
-pub fn remove_stale_tiles(out: &Path, tiles: &[report::ManifestTile]) {
+/// Deletes the tiles (and the levels of detail above them) an earlier build into the same
+/// directory listed in its manifest that this build did not write, so the directory holds
+/// one consistent city. Files the tool did not write itself are never touched.
+pub fn remove_stale_tiles(out: &Path, manifest: &Manifest) {
     let Ok(old) = read_manifest(&out.join("manifest.json")) else {
         return;
     };
-    let current: HashSet<&str> = tiles
-        .iter()
+    let current: HashSet<&str> = (manifest.tiles.iter())
         .flat_map(|t| t.files().map(|f| f.path.as_str()))
+        .chain(manifest.files.iter().map(|f| f.path.as_str()))
         .collect();
-    for tile in &old.tiles {
-        for path in tile.files().map(|f| &f.path) {
-            let safe = path.starts_with("tiles/") && !path.contains("..");
-            if safe && !current.contains(path.as_str()) {
-                let _ = std::fs::remove_file(out.join(path));
-            }
+    let old_files = (old.tiles.iter())
+        .flat_map(|t| t.files().map(|f| f.path.clone()).collect::<Vec<_>>())
+        .chain(old.files.iter().map(|f| f.path.clone()));
+    for path in old_files {
+        let safe = path.starts_with("tiles/") && !path.contains("..");
+        if safe && !current.contains(path.as_str()) {
+            let _ = std::fs::remove_file(out.join(&path));
         }
     }
+    let _ = std::fs::remove_dir(out.join(crate::output::tiles3d::LOD_DIR));
 }
 
 /// Merges the shard outputs in `dirs` into the first: tiles of the others are copied over,

@@ -11,7 +11,9 @@ if (!out) {
   process.exit(2);
 }
 const manifest = JSON.parse(await readFile(path.join(out, 'manifest.json'), 'utf8'));
-const glbs = manifest.tiles.filter((t) => t.glb).map((t) => t.glb.path);
+// The leaves, and the parents above them (the levels of detail, in the build's files).
+const glbs = manifest.tiles.filter((t) => t.glb).map((t) => t.glb.path)
+  .concat(manifest.files.map((f) => f.path).filter((p) => p.startsWith('tiles/lod/')));
 if (glbs.length === 0) {
   console.error(`${out}: the manifest lists no GLB tile (build with --format glb)`);
   process.exit(1);

@@ -41,7 +41,7 @@ pub(super) fn load_gltf(
     drop(bytes);
     float_positions(&g.document, shown)?;
     let mut buffers = buffers(&g, dir, shown, confined)?;
-    super::meshopt::decode(&g.document, &mut buffers, shown)?;
+    crate::geom::meshopt::decode(&g.document, &mut buffers, shown)?;
     check_accessors(&g.document, shown)?;
     let mut model = Model::default();
     for m in g.document.materials() {
@@ -184,7 +184,7 @@ fn buffers(
     for b in g.document.buffers() {
         let mut data = match b.source() {
             // Filled by decoding its compressed views; counted against the bound first.
-            _ if super::meshopt::is_fallback(&b) => {
+            _ if crate::geom::meshopt::is_fallback(&b) => {
                 if total + b.length() as u64 > MAX_MODEL_BYTES {
                     return Err(format!(
                         "{shown}: its buffers hold more than {MAX_MODEL_BYTES} bytes: decimate it"

@@ -8,7 +8,6 @@
 //! anything of that size is allocated.
 
 mod gltf;
-mod meshopt;
 
 use std::cell::RefCell;
 use std::path::Path;

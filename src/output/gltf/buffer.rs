@@ -229,6 +229,46 @@ impl Buffer {
         self.accessors.len() - 1
     }
 
+    /// A position accessor of shorts (`KHR_mesh_quantization`; the node's scale makes them
+    /// metres): 8 bytes a vertex (x, y, z and a pad, as vertex attributes align to 4).
+    pub fn short_positions(&mut self, data: &[[i16; 3]]) -> usize {
+        let packed: Vec<[i16; 4]> = data.iter().map(|p| [p[0], p[1], p[2], 0]).collect();
+        let view = self.attributes(&packed, |p| {
+            let mut b = [0u8; 8];
+            for (k, v) in p.iter().enumerate() {
+                b[2 * k..2 * k + 2].copy_from_slice(&v.to_le_bytes());
+            }
+            b
+        });
+        self.views[view]["byteStride"] = json!(8);
+        let lo = [0, 1, 2].map(|k| data.iter().map(|p| p[k]).min().unwrap_or(0));
+        let hi = [0, 1, 2].map(|k| data.iter().map(|p| p[k]).max().unwrap_or(0));
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": 5122,
+            "count": data.len(),
+            "type": "VEC3",
+            "min": lo,
+            "max": hi,
+        }));
+        self.accessors.len() - 1
+    }
+
+    /// A vertex colour accessor (`COLOR_0`): linear RGBA as normalized unsigned bytes, which
+    /// core glTF allows; 4 bytes a vertex.
+    pub fn colours(&mut self, data: &[[u8; 4]]) -> usize {
+        let view = self.attributes(data, |b| b);
+        self.views[view]["byteStride"] = json!(4);
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": 5121,
+            "normalized": true,
+            "count": data.len(),
+            "type": "VEC4",
+        }));
+        self.accessors.len() - 1
+    }
+
     /// The index accessor: u16 while the vertices fit, else u32.
     pub fn indices(&mut self, idx: &[u32], vertices: usize) -> usize {
         let short = vertices <= u16::MAX as usize;

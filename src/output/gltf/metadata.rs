@@ -1,7 +1,10 @@
 //! Per-object metadata as `EXT_structural_metadata`: one class (`object`) and one property
 //! table with a row per object of the tile, which the `_FEATURE_ID_0` vertex attribute of
-//! `EXT_mesh_features` points into. Strings are UTF-8 with UINT32 offsets; `kura` is a
-//! BOOLEAN bitstream, least significant bit first.
+//! `EXT_mesh_features` points into. Names and lots are strings (UTF-8 with UINT32 offsets);
+//! the columns of few distinct values (kind, type, district, use, source) are ENUMs of the
+//! tile's values, a byte or two a row (the strings of a parent tile over 35,000 objects took
+//! 2.1 MB, the enums 0.2 MB); an empty value is the enum's `noData`, which readers give as
+//! no value. `kura` is a BOOLEAN bitstream, least significant bit first.
 
 use serde_json::{json, Map, Value};
 
@@ -12,12 +15,16 @@ use crate::output::features::Feature;
 const STRINGS: &[(&str, &str)] = &[
     ("name", "the object's name in the OBJ tile"),
     (
-        "kind",
-        "machiya, footprint, kura, fence, gate, people, trees, garden, stone, ...",
-    ),
-    (
         "lot",
         "the lot (or footprint, fence line, garden polygon) it belongs to",
+    ),
+];
+
+/// The enum properties, in table order, with what each holds.
+pub const ENUMS: &[(&str, &str)] = &[
+    (
+        "kind",
+        "machiya, footprint, kura, fence, gate, people, trees, garden, stone, ...",
     ),
     ("mtype", "the machiya type"),
     ("district", "the lot's district"),
@@ -27,6 +34,9 @@ const STRINGS: &[(&str, &str)] = &[
         "the layer file it came from, relative to the input directory",
     ),
 ];
+
+/// The name of an enum's value for an empty string.
+pub const NO_VALUE: &str = "(none)";
 
 /// The string of property `key` of `f`.
 fn value<'a>(f: &'a Feature, key: &str) -> &'a str {
@@ -66,6 +76,43 @@ pub fn structural_metadata(features: &[Feature], buf: &mut Buffer) -> Value {
         let o = buf.view(&offsets, None);
         table_props.insert(key.to_string(), json!({"values": v, "stringOffsets": o}));
     }
+    let mut enums = Map::new();
+    for (key, what) in ENUMS {
+        // Values in sorted order after "no value": the same values give the same bytes.
+        let mut names: Vec<&str> = features.iter().map(|f| value(f, key)).collect();
+        names.sort_unstable();
+        names.dedup();
+        names.retain(|n| !n.is_empty());
+        let wide = names.len() + 1 > 256;
+        let mut bytes = Vec::with_capacity(features.len() * if wide { 2 } else { 1 });
+        for f in features {
+            let v = value(f, key);
+            let i = match v.is_empty() {
+                true => 0,
+                false => names.binary_search(&v).map_or(0, |i| i + 1),
+            };
+            if wide {
+                bytes.extend_from_slice(&(i as u16).to_le_bytes());
+            } else {
+                bytes.push(i as u8);
+            }
+        }
+        let values: Vec<Value> = std::iter::once(NO_VALUE)
+            .chain(names.iter().copied())
+            .enumerate()
+            .map(|(i, n)| json!({"name": n, "value": i}))
+            .collect();
+        enums.insert(
+            key.to_string(),
+            json!({"valueType": if wide { "UINT16" } else { "UINT8" }, "values": values}),
+        );
+        class_props.insert(
+            key.to_string(),
+            json!({"type": "ENUM", "enumType": key, "noData": NO_VALUE, "description": what}),
+        );
+        let v = buf.view(&bytes, None);
+        table_props.insert(key.to_string(), json!({"values": v}));
+    }
     class_props.insert(
         "kura".into(),
         json!({"type": "BOOLEAN", "description": "whether the lot has a kura in this tile"}),
@@ -81,6 +128,7 @@ pub fn structural_metadata(features: &[Feature], buf: &mut Buffer) -> Value {
     json!({
         "schema": {
             "id": "edo_city",
+            "enums": enums,
             "classes": {"object": {
                 "description": "one object of the city: a house, a kura, a wall, a garden stone, the people or trees of a tile",
                 "properties": class_props,

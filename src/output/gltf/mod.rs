@@ -195,7 +195,7 @@ fn snap(v: f64, steps: f64) -> f32 {
 }
 
 /// sRGB to linear, for `baseColorFactor` (glTF factors are linear).
-fn linear(c: f32) -> f32 {
+pub fn linear(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
     } else {
@@ -397,7 +397,7 @@ impl crate::output::sink::Sink for GlbSink {
         manifest: &crate::output::report::Manifest,
         warnings: &mut Vec<String>,
     ) -> std::io::Result<Vec<crate::output::report::ManifestFile>> {
-        crate::output::tiles3d::write_tileset(out, manifest, warnings).map(|f| vec![f])
+        crate::output::tiles3d::write_tileset(out, manifest, warnings)
     }
 }
 

@@ -11,10 +11,12 @@
 //! warning says the city is not placed on the globe.
 
 pub mod globe;
+pub mod lod;
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use super::report::{Manifest, ManifestFile, ManifestTile};
@@ -98,9 +100,43 @@ struct Leaf<'a> {
     local: Aabb,
 }
 
-/// The tileset's JSON for `manifest` (see the module docs); `warnings` gets why the city is
-/// not on the globe, when it is not.
-pub fn tileset(manifest: &Manifest, warnings: &mut Vec<String>) -> Result<Value, String> {
+/// Where the parents' content goes, relative to the output directory.
+pub const LOD_DIR: &str = "tiles/lod";
+
+/// The smallest geometric error of a parent, metres: its surfaces lose their textures for
+/// their mean colours, whose drawn detail (a lattice, a row of tiles) is about this size,
+/// even where no surface moved.
+const MIN_ERROR: f64 = 0.5;
+
+/// The simplification asked of a level: its width over this (1 km groups: 4 m).
+const TARGET_PER_WIDTH: f64 = 256.0;
+
+/// A node of the tree being built: its cell at its level, box in the root's frame, JSON,
+/// and what its parent is made from.
+struct Node {
+    cell: (i64, i64),
+    bounds: Aabb,
+    json: Value,
+    source: Source,
+}
+
+/// What a parent reads of a child.
+enum Source {
+    /// A leaf's GLB (path relative to the output) and its frame in the root's.
+    Leaf(String, Affine),
+    /// A parent's content, made on the level below.
+    Made(lod::Content),
+}
+
+/// The tileset's JSON for `manifest` (see the module docs), writing the parents' content
+/// into `out` (listed in `files`); `warnings` gets why the city is not on the globe, when it
+/// is not.
+pub fn tileset(
+    out: &Path,
+    manifest: &Manifest,
+    warnings: &mut Vec<String>,
+    files: &mut Vec<ManifestFile>,
+) -> Result<Value, String> {
     let globe = placement(manifest)?;
     let origin = manifest.origin;
     let root_frame = match &globe {
@@ -140,59 +176,79 @@ pub fn tileset(manifest: &Manifest, warnings: &mut Vec<String>) -> Result<Value,
             local,
         });
     }
+    // Cells counted from the city's first column and row, so that the groups of every
+    // level start at its edge and the root is reached in as few levels as the city's width
+    // asks (a city straddling a multiple of 4^n would otherwise take levels of one group).
+    let first = (
+        leaves.iter().map(|l| l.cell.0).min().unwrap_or(0),
+        leaves.iter().map(|l| l.cell.1).min().unwrap_or(0),
+    );
+    for l in &mut leaves {
+        l.cell = (l.cell.0 - first.0, l.cell.1 - first.1);
+    }
     // Level 0: the leaves as nodes (box in the root frame for grouping, JSON).
-    let mut nodes: Vec<((i64, i64), Aabb, Value)> = leaves
+    let mut nodes: Vec<Node> = leaves
         .iter()
         .map(|l| {
-            let in_root = Aabb::of(l.local.corners().map(|p| l.transform.apply(p)));
+            let path = l
+                .tile
+                .glb
+                .as_ref()
+                .map(|f| f.path.clone())
+                .unwrap_or_default();
             let json = json!({
                 "boundingVolume": {"box": l.local.as_box()},
                 "geometricError": 0.0,
                 "transform": l.transform.column_major(),
-                "content": {"uri": l.tile.glb.as_ref().map(|f| f.path.clone())},
+                "content": {"uri": path},
             });
-            (l.cell, in_root, json)
+            Node {
+                cell: l.cell,
+                bounds: Aabb::of(l.local.corners().map(|p| l.transform.apply(p))),
+                json,
+                source: Source::Leaf(path, l.transform),
+            }
         })
         .collect();
+    let meshopt = manifest.params.output.glb_compression == "meshopt";
+    let textures = lod::read::texture_colours(out);
     let mut width = size;
+    let mut level = 0;
     while nodes.len() > 1 {
         width *= FANOUT as f64;
-        let mut groups: BTreeMap<(i64, i64), Vec<(Aabb, Value)>> = BTreeMap::new();
-        for ((c, r), b, j) in nodes {
-            let key = (c.div_euclid(FANOUT), r.div_euclid(FANOUT));
-            groups.entry(key).or_default().push((b, j));
+        level += 1;
+        let mut groups: BTreeMap<(i64, i64), Vec<Node>> = BTreeMap::new();
+        for n in nodes {
+            let key = (n.cell.0.div_euclid(FANOUT), n.cell.1.div_euclid(FANOUT));
+            groups.entry(key).or_default().push(n);
         }
-        nodes = groups
-            .into_iter()
-            .map(|(cell, children)| {
-                let b = Aabb::of(
-                    children
-                        .iter()
-                        .flat_map(|(b, _)| b.corners().collect::<Vec<_>>()),
-                );
-                let json = json!({
-                    "boundingVolume": {"box": b.as_box()},
-                    "geometricError": width,
-                    "children": children.into_iter().map(|(_, j)| j).collect::<Vec<_>>(),
-                });
-                (cell, b, json)
-            })
+        let groups: Vec<_> = groups.into_iter().collect();
+        let target = width / TARGET_PER_WIDTH;
+        let made: Vec<Result<(Node, ManifestFile), String>> = groups
+            .into_par_iter()
+            .map(|(cell, children)| parent(out, cell, children, level, target, meshopt, &textures))
             .collect();
+        nodes = Vec::new();
+        for m in made {
+            let (node, file) = m?;
+            files.push(file);
+            nodes.push(node);
+        }
     }
     let mut root = match nodes.pop() {
-        Some((_, _, j)) if j.get("children").is_some() => j,
+        Some(n) if n.json.get("children").is_some() => n.json,
         // One tile (or none): the root is a group over it.
-        Some((_, b, j)) => json!({
-            "boundingVolume": {"box": b.as_box()},
-            "geometricError": width,
-            "children": [j],
+        Some(n) => json!({
+            "boundingVolume": {"box": n.bounds.as_box()},
+            "geometricError": MIN_ERROR,
+            "children": [n.json],
         }),
         None => json!({
             "boundingVolume": {"box": [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]},
             "geometricError": 0.0,
         }),
     };
-    root["refine"] = json!("ADD");
+    root["refine"] = json!("REPLACE");
     root["transform"] = json!(root_frame.column_major());
     let top = root["geometricError"].as_f64().unwrap_or(0.0) * 2.0;
     Ok(json!({
@@ -207,17 +263,83 @@ pub fn tileset(manifest: &Manifest, warnings: &mut Vec<String>) -> Result<Value,
             "crs": manifest.crs,
             "placed": globe.is_some(),
             "tiles": leaves.len(),
+            "levels": level,
         },
     }))
 }
 
-/// Writes `<out>/tileset.json`; returns its manifest entry.
+/// The parent at `cell` of `level` over `children`: its content made and written, its node.
+fn parent(
+    out: &Path,
+    cell: (i64, i64),
+    children: Vec<Node>,
+    level: u32,
+    target: f64,
+    meshopt: bool,
+    textures: &lod::TextureColours,
+) -> Result<(Node, ManifestFile), String> {
+    let mut contents = Vec::with_capacity(children.len());
+    let mut bounds = Vec::new();
+    let mut json_children = Vec::with_capacity(children.len());
+    for c in children {
+        bounds.extend(c.bounds.corners());
+        json_children.push(c.json);
+        contents.push(match c.source {
+            Source::Made(content) => content,
+            Source::Leaf(path, transform) => {
+                let bytes = std::fs::read(out.join(&path)).map_err(|e| {
+                    format!("{path}: cannot read it back for the levels of detail: {e}")
+                })?;
+                lod::read::leaf(&bytes, &path, &transform, textures)?
+            }
+        });
+    }
+    let content = lod::coarsen(contents, level, target);
+    let name = format!("{level}_{}_{}", cell.0, cell.1);
+    let glb = lod::write::content_glb(&name, &content, level, meshopt);
+    let path = format!("{LOD_DIR}/{name}.glb");
+    let file =
+        super::write_listed(out, path.clone(), &glb.parts()).map_err(|e| format!("{path}: {e}"))?;
+    bounds.extend(content_points(&content));
+    let bounds = Aabb::of(bounds);
+    let error = content.error.max(MIN_ERROR);
+    let json = json!({
+        "boundingVolume": {"box": bounds.as_box()},
+        "geometricError": error,
+        "content": {"uri": path},
+        "children": json_children,
+    });
+    Ok((
+        Node {
+            cell,
+            bounds,
+            json,
+            source: Source::Made(content),
+        },
+        file,
+    ))
+}
+
+/// Every corner the content's cut-outs reach (the only surfaces that grow past their
+/// children's boxes: a kept card is scaled up).
+fn content_points(content: &lod::Content) -> Vec<[f64; 3]> {
+    content
+        .cutouts
+        .values()
+        .flat_map(|c| c.part.positions.iter().copied())
+        .collect()
+}
+
+/// Writes `<out>/tileset.json` and the parents' content; returns their manifest entries.
 pub fn write_tileset(
     out: &Path,
     manifest: &Manifest,
     warnings: &mut Vec<String>,
-) -> std::io::Result<ManifestFile> {
-    let json = tileset(manifest, warnings).map_err(std::io::Error::other)?;
+) -> std::io::Result<Vec<ManifestFile>> {
+    let mut files = Vec::new();
+    std::fs::create_dir_all(out.join(LOD_DIR))?;
+    let json = tileset(out, manifest, warnings, &mut files).map_err(std::io::Error::other)?;
     let bytes = serde_json::to_vec_pretty(&json).expect("serialises");
-    super::write_listed(out, "tileset.json".into(), &[&bytes])
+    files.push(super::write_listed(out, "tileset.json".into(), &[&bytes])?);
+    Ok(files)
 }

@@ -1,5 +1,6 @@
-//! `EXT_meshopt_compression` in a glTF landmark model: our own GLB tiles are written so by
-//! default (`output.glb_compression = "meshopt"`), and gltfpack writes it. A compressed
+//! `EXT_meshopt_compression` in a glTF: our own GLB tiles are written so by default
+//! (`output.glb_compression = "meshopt"`, and read back for the tileset's parents), and
+//! gltfpack writes it in landmark models. A compressed
 //! view's data is decoded by meshoptimizer's decoders (which are safe on any input: garbage
 //! gives garbage, never a read out of bounds) into its fallback buffer, where the gltf
 //! crate's reader then finds it as in any plain model. Filters are not undone: a filtered
@@ -16,6 +17,14 @@ pub fn is_fallback(b: &gltf::Buffer) -> bool {
         .and_then(|e| e.get("fallback"))
         .and_then(Value::as_bool)
         .unwrap_or(false)
+}
+
+/// At most 80 characters of a value read from a file, for a message.
+fn excerpt(s: &str) -> String {
+    match s.char_indices().nth(80) {
+        Some((i, _)) => format!("{}...", &s[..i]),
+        None => s.to_string(),
+    }
 }
 
 /// A compressed view's extension object, as numbers checked against the buffers.
@@ -63,7 +72,7 @@ fn compressed(v: &gltf::buffer::View, shown: &str) -> Result<Option<Compressed>,
                 "{shown}: buffer view {}'s {EXTENSION} mode `{}` is not read (ATTRIBUTES and \
                  TRIANGLES are)",
                 v.index(),
-                super::excerpt(other)
+                excerpt(other)
             ))
         }
     };

@@ -1,0 +1,322 @@
+//! The levels of detail (詳細度) above the leaf tiles: each inner node of the tileset has
+//! content of its own, made from its children's (the leaves' GLB files read back, or the
+//! level below's content), which its children replace as the viewer comes closer
+//! (`refine: REPLACE`).
+//!
+//! What a parent holds: houses, kura and halls as massing ([`massing`]: walls and a gable
+//! roof on the first level, flat-topped boxes above it), the other surfaces (ground,
+//! streets, walls, bark, stones) simplified by meshoptimizer with small parts pruned, the
+//! cut-outs (leaves, billboards) thinned to a quarter of their cards per level with each
+//! kept card twice the size, and no people. Surfaces are coloured per vertex (a texture by
+//! its mean colour) and drawn by one primitive; each cut-out material keeps its texture.
+//! Every object keeps its metadata row, so a click on a distant house names its lot.
+//!
+//! The `geometricError` of a parent is measured, not guessed: the largest of its children's
+//! errors, plus the largest distance this level moves a surface (a building's vertex from
+//! its massing, meshoptimizer's own error, a card's size, the people left out).
+
+pub mod massing;
+pub mod read;
+pub mod write;
+
+use std::collections::BTreeMap;
+
+use crate::output::features::Feature;
+use massing::Mass;
+
+/// The kinds drawn as massing on the levels above the leaves.
+pub const MASSED: &[&str] = &["machiya", "kura", "hall", "footprint"];
+
+/// Cards kept per level: one in this many, each scaled by its square root.
+const THINNING: usize = 4;
+
+/// Triangles with per-vertex data; positions in the root's frame (z up, metres).
+#[derive(Debug, Clone, Default)]
+pub struct Part {
+    /// Root frame, z up, metres.
+    pub positions: Vec<[f64; 3]>,
+    /// Linear RGBA (solid surfaces).
+    pub colours: Vec<[u8; 4]>,
+    /// Texture coordinates (cut-outs).
+    pub uvs: Vec<[f32; 2]>,
+    /// Each vertex's row in the metadata table.
+    pub ids: Vec<u32>,
+    /// Triangles, three vertices each.
+    pub indices: Vec<u32>,
+}
+
+impl Part {
+    /// Appends `other`, its rows shifted by `rows`.
+    fn append(&mut self, other: Part, rows: u32) {
+        let base = self.positions.len() as u32;
+        self.positions.extend(other.positions);
+        self.colours.extend(other.colours);
+        self.uvs.extend(other.uvs);
+        self.ids.extend(other.ids.into_iter().map(|i| i + rows));
+        self.indices
+            .extend(other.indices.into_iter().map(|i| i + base));
+    }
+}
+
+/// A cut-out material's cards and its texture (URI relative to `tiles/`).
+#[derive(Debug, Clone, Default)]
+pub struct Cutout {
+    /// The texture, relative to `tiles/`.
+    pub uri: String,
+    /// The cards.
+    pub part: Part,
+}
+
+/// What a tile holds, for the levels above it.
+#[derive(Debug, Clone, Default)]
+pub struct Content {
+    /// The metadata table's rows.
+    pub features: Vec<Feature>,
+    /// Buildings as massing (empty in a leaf).
+    pub masses: Vec<Mass>,
+    /// Every other opaque surface.
+    pub solid: Part,
+    /// Cut-out cards by material name.
+    pub cutouts: BTreeMap<String, Cutout>,
+    /// The largest size of what was left out (people), metres.
+    pub dropped: f64,
+    /// The content's geometric error: 0 for a leaf.
+    pub error: f64,
+}
+
+/// The mean colour of each texture by its URI relative to `tiles/` (linear RGBA).
+#[derive(Debug, Clone, Default)]
+pub struct TextureColours(pub BTreeMap<String, [f32; 4]>);
+
+impl TextureColours {
+    /// The mean colour of `uri`, mid grey for a texture the library does not hold.
+    pub fn mean(&self, uri: &str) -> [f32; 4] {
+        self.0.get(uri).copied().unwrap_or([0.5, 0.5, 0.5, 1.0])
+    }
+}
+
+/// The content of a parent of `children` at `level` (1 above the leaves), simplified to
+/// about `target` metres.
+pub fn coarsen(children: Vec<Content>, level: u32, target: f64) -> Content {
+    let mut out = Content::default();
+    let mut child_error = 0.0f64;
+    let mut dropped = 0.0f64;
+    for c in children {
+        let rows = out.features.len() as u32;
+        child_error = child_error.max(c.error);
+        dropped = dropped.max(c.dropped);
+        out.features.extend(c.features);
+        out.masses.extend(c.masses.into_iter().map(|m| Mass {
+            id: m.id + rows,
+            ..m
+        }));
+        out.solid.append(c.solid, rows);
+        for (name, cut) in c.cutouts {
+            let e = out.cutouts.entry(name).or_insert_with(|| Cutout {
+                uri: cut.uri.clone(),
+                part: Part::default(),
+            });
+            e.part.append(cut.part, rows);
+        }
+    }
+    let (masses, rest) = split_buildings(std::mem::take(&mut out.solid), &out.features);
+    let mut level_error = dropped;
+    for m in &masses {
+        level_error = level_error.max(m.gable_error);
+    }
+    out.masses.extend(masses);
+    if level > 1 {
+        for m in &out.masses {
+            level_error = level_error.max(m.flat_error);
+        }
+    }
+    let (solid, e) = simplify(rest, target);
+    out.solid = solid;
+    level_error = level_error.max(e);
+    for cut in out.cutouts.values_mut() {
+        let (part, e) = thin(std::mem::take(&mut cut.part), target);
+        cut.part = part;
+        level_error = level_error.max(e);
+    }
+    out.error = child_error + level_error;
+    out
+}
+
+/// The buildings of `solid` (triangles of a [`MASSED`] kind) as massing, and the rest.
+fn split_buildings(solid: Part, features: &[Feature]) -> (Vec<Mass>, Part) {
+    let massed = |id: u32| {
+        features
+            .get(id as usize)
+            .is_some_and(|f| MASSED.contains(&f.kind.as_str()))
+    };
+    type Tri = ([[f64; 3]; 3], [u8; 4]);
+    let mut buildings: BTreeMap<u32, Vec<Tri>> = BTreeMap::new();
+    let mut rest = Part::default();
+    let mut seen: Vec<u32> = vec![u32::MAX; solid.positions.len()];
+    for t in solid.indices.chunks_exact(3) {
+        let id = solid.ids[t[0] as usize];
+        if massed(id) {
+            let corners = [0, 1, 2].map(|k| solid.positions[t[k] as usize]);
+            buildings
+                .entry(id)
+                .or_default()
+                .push((corners, solid.colours[t[0] as usize]));
+            continue;
+        }
+        for &v in t {
+            let v = v as usize;
+            if seen[v] == u32::MAX {
+                seen[v] = rest.positions.len() as u32;
+                rest.positions.push(solid.positions[v]);
+                rest.colours.push(solid.colours[v]);
+                rest.ids.push(solid.ids[v]);
+            }
+            rest.indices.push(seen[v]);
+        }
+    }
+    let masses = buildings
+        .into_iter()
+        .filter_map(|(id, tris)| massing::mass(id, &tris))
+        .collect();
+    (masses, rest)
+}
+
+/// `part` welded (equal position, colour and row) and simplified by meshoptimizer to
+/// `target` metres, small disconnected parts pruned; with the error meshoptimizer measured.
+fn simplify(part: Part, target: f64) -> (Part, f64) {
+    if part.indices.is_empty() {
+        return (part, 0.0);
+    }
+    let centre = part.positions[0];
+    let mut welded = Part::default();
+    let mut index: std::collections::HashMap<([i64; 3], [u8; 4], u32), u32> =
+        std::collections::HashMap::new();
+    let remap: Vec<u32> = (0..part.positions.len())
+        .map(|v| {
+            let p = part.positions[v];
+            let key = (
+                p.map(|x| (x * 1000.0).round() as i64),
+                part.colours[v],
+                part.ids[v],
+            );
+            *index.entry(key).or_insert_with(|| {
+                welded.positions.push(p);
+                welded.colours.push(part.colours[v]);
+                welded.ids.push(part.ids[v]);
+                (welded.positions.len() - 1) as u32
+            })
+        })
+        .collect();
+    let indices: Vec<u32> = part.indices.iter().map(|&i| remap[i as usize]).collect();
+    let local: Vec<f32> = welded
+        .positions
+        .iter()
+        .flat_map(|p| [0, 1, 2].map(|k| (p[k] - centre[k]) as f32))
+        .collect();
+    let bytes = meshopt::utilities::typed_to_bytes(&local);
+    let adapter =
+        meshopt::VertexDataAdapter::new(bytes, 12, 0).expect("a whole number of vertices");
+    let mut error = 0.0f32;
+    let kept = meshopt::simplify(
+        &indices,
+        &adapter,
+        0,
+        target as f32,
+        meshopt::SimplifyOptions::ErrorAbsolute | meshopt::SimplifyOptions::Prune,
+        Some(&mut error),
+    );
+    // Only the vertices still used.
+    let mut out = Part::default();
+    let mut seen = vec![u32::MAX; welded.positions.len()];
+    for &v in &kept {
+        let v = v as usize;
+        if seen[v] == u32::MAX {
+            seen[v] = out.positions.len() as u32;
+            out.positions.push(welded.positions[v]);
+            out.colours.push(welded.colours[v]);
+            out.ids.push(welded.ids[v]);
+        }
+        out.indices.push(seen[v]);
+    }
+    (out, error as f64)
+}
+
+/// The connected parts of a triangle list over `n` vertices (vertices joined by a triangle),
+/// each as its vertices, in order of their first vertex; unused vertices are parts alone.
+pub fn components(indices: &[u32], n: usize) -> Vec<Vec<u32>> {
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], mut v: u32) -> u32 {
+        while parent[v as usize] != v {
+            parent[v as usize] = parent[parent[v as usize] as usize];
+            v = parent[v as usize];
+        }
+        v
+    }
+    for t in indices.chunks_exact(3) {
+        for k in 1..3 {
+            let (a, b) = (root(&mut parent, t[0]), root(&mut parent, t[k]));
+            if a != b {
+                parent[a.max(b) as usize] = a.min(b);
+            }
+        }
+    }
+    let mut part_of: Vec<u32> = vec![u32::MAX; n];
+    let mut parts: Vec<Vec<u32>> = Vec::new();
+    for v in 0..n as u32 {
+        let r = root(&mut parent, v) as usize;
+        if part_of[r] == u32::MAX {
+            part_of[r] = parts.len() as u32;
+            parts.push(Vec::new());
+        }
+        parts[part_of[r] as usize].push(v);
+    }
+    parts
+}
+
+/// Every [`THINNING`]th card of `part` (a card: triangles joined by their vertices), each
+/// scaled about its centre so the cards cover as much as before; cards larger than `target`
+/// are all kept as they are. The error is the largest thinned card's size.
+fn thin(part: Part, target: f64) -> (Part, f64) {
+    let n = part.positions.len();
+    let cards = components(&part.indices, n);
+    let scale = (THINNING as f64).sqrt();
+    let mut moved: Vec<Option<[f64; 3]>> = vec![None; n];
+    let mut error = 0.0f64;
+    for (i, card) in cards.iter().enumerate() {
+        let points: Vec<[f64; 3]> = card.iter().map(|&v| part.positions[v as usize]).collect();
+        let size = read::extent(&points);
+        if size > target {
+            for &v in card {
+                moved[v as usize] = Some(part.positions[v as usize]);
+            }
+            continue;
+        }
+        error = error.max(size);
+        if i % THINNING != 0 {
+            continue;
+        }
+        let c = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).sum::<f64>() / points.len() as f64);
+        for &v in card {
+            let p = part.positions[v as usize];
+            moved[v as usize] = Some([0, 1, 2].map(|k| c[k] + (p[k] - c[k]) * scale));
+        }
+    }
+    let mut out = Part::default();
+    let mut seen = vec![u32::MAX; n];
+    for t in part.indices.chunks_exact(3) {
+        if moved[t[0] as usize].is_none() {
+            continue;
+        }
+        for &v in t {
+            let v = v as usize;
+            if seen[v] == u32::MAX {
+                seen[v] = out.positions.len() as u32;
+                out.positions.push(moved[v].unwrap_or(part.positions[v]));
+                out.uvs.push(part.uvs.get(v).copied().unwrap_or_default());
+                out.ids.push(part.ids[v]);
+            }
+            out.indices.push(seen[v]);
+        }
+    }
+    (out, error)
+}

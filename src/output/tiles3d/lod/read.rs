@@ -1,0 +1,262 @@
+//! A leaf tile's GLB read back as the content its parents are made from: the surfaces in the
+//! root's frame (z up, metres), coloured by their material (a texture by its mean colour),
+//! the cut-outs with their texture coordinates, and the metadata table's rows.
+//!
+//! Parents are made from the leaves' files, not from the meshes in memory, so that a full
+//! build, `--tiles` and `merge` (whose leaves were written by other processes) make the same
+//! parents from the same bytes, and so that no more than a group of leaves is in memory.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use gltf::Semantic;
+use serde_json::Value;
+
+use super::{Content, Cutout, Part, TextureColours};
+use crate::output::features::Feature;
+use crate::output::gltf::metadata;
+use crate::output::tiles3d::globe::Affine;
+
+/// The kinds a parent leaves out: people are the size of the error of the first level.
+pub const LEFT_OUT: &[&str] = &["people"];
+
+/// Reads `tiles/<id>.glb` (its bytes `bytes`) placed by `transform` (leaf frame, z up, to
+/// the root's frame).
+pub fn leaf(
+    bytes: &[u8],
+    shown: &str,
+    transform: &Affine,
+    textures: &TextureColours,
+) -> Result<Content, String> {
+    let g = gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| format!("{shown}: not a readable GLB: {e}"))?;
+    let mut buffers: Vec<gltf::buffer::Data> = Vec::new();
+    let mut blob = g.blob.clone();
+    for b in g.document.buffers() {
+        let data = if crate::geom::meshopt::is_fallback(&b) {
+            vec![0; b.length().next_multiple_of(4)]
+        } else {
+            let mut d = blob.take().unwrap_or_default();
+            d.resize(d.len().next_multiple_of(4).max(b.length()), 0);
+            d
+        };
+        buffers.push(gltf::buffer::Data(data));
+    }
+    crate::geom::meshopt::decode(&g.document, &mut buffers, shown)?;
+    let get = |b: gltf::Buffer| buffers.get(b.index()).map(|d| &d.0[..]);
+    let mut content = Content {
+        features: features(&g.document, &buffers),
+        ..Content::default()
+    };
+    // glTF's y-up leaf frame to the 3D Tiles z-up one, then to the root's frame.
+    let place = |p: [f32; 3]| transform.apply([p[0] as f64, -p[2] as f64, p[1] as f64]);
+    for node in g.document.nodes() {
+        let Some(mesh) = node.mesh() else { continue };
+        let kind = node.name().unwrap_or("");
+        for prim in mesh.primitives() {
+            let reader = prim.reader(get);
+            let positions: Vec<[f64; 3]> = match reader.read_positions() {
+                Some(p) => p.map(place).collect(),
+                None => continue,
+            };
+            if LEFT_OUT.contains(&kind) {
+                // The size of the largest figure (a card or a mesh of its own), not of the
+                // crowd: a tile's people are one object.
+                let indices: Vec<u32> = reader
+                    .read_indices()
+                    .map(|i| i.into_u32().collect())
+                    .unwrap_or_default();
+                if indices.iter().all(|&i| (i as usize) < positions.len()) {
+                    for part in super::components(&indices, positions.len()) {
+                        let p: Vec<[f64; 3]> =
+                            part.iter().map(|&v| positions[v as usize]).collect();
+                        content.dropped = content.dropped.max(extent(&p));
+                    }
+                }
+                continue;
+            }
+            let ids: Vec<u32> = match prim.get(&Semantic::Extras("FEATURE_ID_0".into())) {
+                Some(a) => gltf::accessor::Iter::<f32>::new(a, get)
+                    .map(|it| it.map(|v| v as u32).collect())
+                    .unwrap_or_default(),
+                None => vec![0; positions.len()],
+            };
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..positions.len() as u32).collect(),
+            };
+            if ids.len() != positions.len()
+                || indices.iter().any(|&i| i as usize >= positions.len())
+            {
+                return Err(format!("{shown}: a primitive's accessors disagree"));
+            }
+            let material = prim.material();
+            let texture = material
+                .pbr_metallic_roughness()
+                .base_color_texture()
+                .and_then(|t| match t.texture().source().source() {
+                    gltf::image::Source::Uri { uri, .. } => Some(uri.to_string()),
+                    _ => None,
+                });
+            let part = if material.alpha_mode() == gltf::material::AlphaMode::Mask {
+                let Some(uri) = texture else { continue };
+                let name = material.name().unwrap_or("cutout").to_string();
+                let uvs = reader
+                    .read_tex_coords(0)
+                    .map(|t| t.into_f32().collect::<Vec<_>>())
+                    .unwrap_or_else(|| vec![[0.0; 2]; positions.len()]);
+                let c = content.cutouts.entry(name).or_insert_with(|| Cutout {
+                    uri: uri.clone(),
+                    part: Part::default(),
+                });
+                c.part.uvs.extend(uvs);
+                &mut c.part
+            } else {
+                let colour = match &texture {
+                    Some(uri) => textures.mean(uri),
+                    None => material.pbr_metallic_roughness().base_color_factor(),
+                };
+                let c = colour.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8);
+                content
+                    .solid
+                    .colours
+                    .extend(std::iter::repeat_n(c, positions.len()));
+                &mut content.solid
+            };
+            let base = part.positions.len() as u32;
+            part.positions.extend(positions);
+            part.ids.extend(ids);
+            part.indices.extend(indices.iter().map(|i| i + base));
+        }
+    }
+    Ok(content)
+}
+
+/// The largest side of the box around `points`.
+pub fn extent(points: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
+}
+
+/// The rows of the GLB's property table, as the writer laid them out
+/// ([`crate::output::gltf::metadata`]); a column the table leaves out is empty in every row.
+fn features(doc: &gltf::Document, buffers: &[gltf::buffer::Data]) -> Vec<Feature> {
+    let Some(table) = doc
+        .extension_value("EXT_structural_metadata")
+        .and_then(|m| m.get("propertyTables"))
+        .and_then(|t| t.get(0))
+    else {
+        return Vec::new();
+    };
+    let count = table["count"].as_u64().unwrap_or(0) as usize;
+    let view = |v: &Value| -> &[u8] {
+        let Some(view) = v.as_u64().and_then(|i| doc.views().nth(i as usize)) else {
+            return &[];
+        };
+        buffers
+            .get(view.buffer().index())
+            .and_then(|b| b.0.get(view.offset()..view.offset() + view.length()))
+            .unwrap_or(&[])
+    };
+    let enums = doc
+        .extension_value("EXT_structural_metadata")
+        .map(|m| &m["schema"]["enums"]);
+    let column = |key: &str| -> Vec<String> {
+        let p = &table["properties"][key];
+        let values = view(&p["values"]);
+        if let Some(e) = enums.map(|e| &e[key]).filter(|e| e.is_object()) {
+            // An enum: a byte or two a row, named by the schema; "no value" is empty.
+            let names: BTreeMap<u64, &str> = (e["values"].as_array().into_iter().flatten())
+                .filter_map(|v| Some((v["value"].as_u64()?, v["name"].as_str()?)))
+                .collect();
+            let wide = e["valueType"] == "UINT16";
+            return (0..count)
+                .map(|i| {
+                    let v = match wide {
+                        true => values
+                            .get(2 * i..2 * i + 2)
+                            .map(|b| u16::from_le_bytes([b[0], b[1]]) as u64),
+                        false => values.get(i).map(|&b| b as u64),
+                    };
+                    match v.and_then(|v| names.get(&v)) {
+                        Some(&n) if n != metadata::NO_VALUE => n.to_string(),
+                        _ => String::new(),
+                    }
+                })
+                .collect();
+        }
+        let offsets: Vec<usize> = view(&p["stringOffsets"])
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]) as usize)
+            .collect();
+        (0..count)
+            .map(|i| {
+                let (Some(&a), Some(&b)) = (offsets.get(i), offsets.get(i + 1)) else {
+                    return String::new();
+                };
+                values
+                    .get(a..b)
+                    .map(|s| String::from_utf8_lossy(s).into_owned())
+                    .unwrap_or_default()
+            })
+            .collect()
+    };
+    let mut cols: BTreeMap<&str, Vec<String>> = BTreeMap::new();
+    for key in ["name", "kind", "lot", "mtype", "district", "use", "source"] {
+        cols.insert(key, column(key));
+    }
+    let kura = view(&table["properties"]["kura"]["values"]);
+    let mut take = |key: &str, i: usize| std::mem::take(&mut cols.get_mut(key).unwrap()[i]);
+    (0..count)
+        .map(|i| Feature {
+            name: take("name", i),
+            kind: take("kind", i),
+            lot: take("lot", i),
+            mtype: take("mtype", i),
+            district: take("district", i),
+            lot_use: take("use", i),
+            source: take("source", i),
+            kura: kura.get(i / 8).is_some_and(|b| b >> (i % 8) & 1 == 1),
+        })
+        .collect()
+}
+
+/// The mean colour of each texture of the library (linear, alpha-weighted), read once.
+pub fn texture_colours(out: &Path) -> TextureColours {
+    let mut means = BTreeMap::new();
+    let dir = out.join(crate::output::TEXTURE_DIR);
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return TextureColours(means);
+    };
+    let mut names: Vec<_> = entries
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    for name in names {
+        let Ok(img) = image::open(dir.join(&name)) else {
+            continue;
+        };
+        let img = img.to_rgba8();
+        let (mut sum, mut weight) = ([0.0f64; 3], 0.0f64);
+        for p in img.pixels() {
+            let a = p[3] as f64 / 255.0;
+            for k in 0..3 {
+                sum[k] += a * crate::output::gltf::linear(p[k] as f32 / 255.0) as f64;
+            }
+            weight += a;
+        }
+        if weight > 0.0 {
+            let m = sum.map(|s| (s / weight) as f32);
+            means.insert(format!("textures/{name}"), [m[0], m[1], m[2], 1.0]);
+        }
+    }
+    TextureColours(means)
+}
