@@ -298,20 +298,7 @@ pub fn tile_glb(
     });
     if !nodes.is_empty() {
         let metadata = metadata::structural_metadata(features, &mut buf);
-        let mut used = vec![
-            "EXT_mesh_features",
-            "EXT_structural_metadata",
-            "KHR_mesh_quantization",
-        ];
-        // Byte normals are not core glTF: a client must know the extension to read them; and
-        // compressed views have no data but what the decoder makes.
-        let mut required = vec!["KHR_mesh_quantization"];
-        if buf.compressed() {
-            used.push("EXT_meshopt_compression");
-            required.push("EXT_meshopt_compression");
-        }
-        doc["extensionsUsed"] = json!(used);
-        doc["extensionsRequired"] = json!(required);
+        declare_extensions(&mut doc, &buf);
         doc["extensions"] = json!({"EXT_structural_metadata": metadata});
         doc["scenes"][0]["nodes"] = json!((0..nodes.len()).collect::<Vec<_>>());
         doc["nodes"] = json!(nodes);
@@ -328,6 +315,25 @@ pub fn tile_glb(
             json!([{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]);
     }
     buffer::glb(&doc, buf.bin)
+}
+
+/// `extensionsUsed` and `extensionsRequired` of a tile (a leaf or a parent): the metadata
+/// extensions, `KHR_mesh_quantization` (byte normals, short positions: not core glTF, so a
+/// client must know it to read them) and, when a view of `buf` was compressed,
+/// `EXT_meshopt_compression` (those views have no data but what the decoder makes).
+pub fn declare_extensions(doc: &mut Value, buf: &Buffer) {
+    let mut used = vec![
+        "EXT_mesh_features",
+        "EXT_structural_metadata",
+        "KHR_mesh_quantization",
+    ];
+    let mut required = vec!["KHR_mesh_quantization"];
+    if buf.compressed() {
+        used.push("EXT_meshopt_compression");
+        required.push("EXT_meshopt_compression");
+    }
+    doc["extensionsUsed"] = json!(used);
+    doc["extensionsRequired"] = json!(required);
 }
 
 /// The materials `used` (library ids, in first-use order) as glTF materials, with the

@@ -46,6 +46,19 @@ pub struct Part {
 }
 
 impl Part {
+    /// Appends vertex `v` of `from` to the triangle list (its position, colour and row, once:
+    /// `seen` maps `from`'s vertices to those added, `u32::MAX` for none yet).
+    fn keep(&mut self, from: &Part, v: u32, seen: &mut [u32]) {
+        let v = v as usize;
+        if seen[v] == u32::MAX {
+            seen[v] = self.positions.len() as u32;
+            self.positions.push(from.positions[v]);
+            self.colours.push(from.colours[v]);
+            self.ids.push(from.ids[v]);
+        }
+        self.indices.push(seen[v]);
+    }
+
     /// Appends `other`, its rows shifted by `rows`.
     fn append(&mut self, other: Part, rows: u32) {
         let base = self.positions.len() as u32;
@@ -164,14 +177,7 @@ fn split_buildings(solid: Part, features: &[Feature]) -> (Vec<Mass>, Part) {
             continue;
         }
         for &v in t {
-            let v = v as usize;
-            if seen[v] == u32::MAX {
-                seen[v] = rest.positions.len() as u32;
-                rest.positions.push(solid.positions[v]);
-                rest.colours.push(solid.colours[v]);
-                rest.ids.push(solid.ids[v]);
-            }
-            rest.indices.push(seen[v]);
+            rest.keep(&solid, v, &mut seen);
         }
     }
     let masses = buildings
@@ -229,14 +235,7 @@ fn simplify(part: Part, target: f64) -> (Part, f64) {
     let mut out = Part::default();
     let mut seen = vec![u32::MAX; welded.positions.len()];
     for &v in &kept {
-        let v = v as usize;
-        if seen[v] == u32::MAX {
-            seen[v] = out.positions.len() as u32;
-            out.positions.push(welded.positions[v]);
-            out.colours.push(welded.colours[v]);
-            out.ids.push(welded.ids[v]);
-        }
-        out.indices.push(seen[v]);
+        out.keep(&welded, v, &mut seen);
     }
     (out, error as f64)
 }

@@ -85,18 +85,7 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
     });
     if !primitives.is_empty() {
         let metadata = metadata::structural_metadata(&content.features, &mut buf);
-        let mut used = vec![
-            "EXT_mesh_features",
-            "EXT_structural_metadata",
-            "KHR_mesh_quantization",
-        ];
-        let mut required = vec!["KHR_mesh_quantization"];
-        if buf.compressed() {
-            used.push("EXT_meshopt_compression");
-            required.push("EXT_meshopt_compression");
-        }
-        doc["extensionsUsed"] = json!(used);
-        doc["extensionsRequired"] = json!(required);
+        crate::output::gltf::declare_extensions(&mut doc, &buf);
         doc["extensions"] = json!({"EXT_structural_metadata": metadata});
         doc["scenes"][0]["nodes"] = json!([0]);
         doc["nodes"] = json!([{
