@@ -308,13 +308,19 @@ pub fn tile_glb(
         doc["bufferViews"] = json!(buf.views);
         doc["accessors"] = json!(buf.accessors);
     }
+    add_images(&mut doc, images, textures);
+    buffer::glb(&doc, buf.bin)
+}
+
+/// The images and textures of a tile (leaf or parent), with the one sampler they share
+/// (linear, mipmapped, repeating); nothing when there are none.
+pub fn add_images(doc: &mut Value, images: Vec<Value>, textures: Vec<Value>) {
     if !images.is_empty() {
         doc["images"] = json!(images);
         doc["textures"] = json!(textures);
         doc["samplers"] =
             json!([{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]);
     }
-    buffer::glb(&doc, buf.bin)
 }
 
 /// `extensionsUsed` and `extensionsRequired` of a tile (a leaf or a parent): the metadata

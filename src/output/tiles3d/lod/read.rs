@@ -134,6 +134,13 @@ pub fn leaf(
 
 /// The largest side of the box around `points`.
 pub fn extent(points: &[[f64; 3]]) -> f64 {
+    let (lo, hi) = bounds(points);
+    (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
+}
+
+/// The lowest and highest corners of the box around `points` (infinities, lowest above
+/// highest, when there are none).
+pub fn bounds<'a>(points: impl IntoIterator<Item = &'a [f64; 3]>) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in points {
@@ -142,7 +149,7 @@ pub fn extent(points: &[[f64; 3]]) -> f64 {
             hi[k] = hi[k].max(p[k]);
         }
     }
-    (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
+    (lo, hi)
 }
 
 /// The rows of the GLB's property table, as the writer laid them out

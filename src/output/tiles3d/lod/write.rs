@@ -100,12 +100,7 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
         doc["buffers"] = buf.buffers_json();
         doc["bufferViews"] = json!(buf.views);
         doc["accessors"] = json!(buf.accessors);
-        if !images.is_empty() {
-            doc["images"] = json!(images);
-            doc["textures"] = json!(textures);
-            doc["samplers"] =
-                json!([{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]);
-        }
+        crate::output::gltf::add_images(&mut doc, images, textures);
     }
     buffer::glb(&doc, buf.bin)
 }
@@ -121,14 +116,7 @@ fn frame(content: &Content, solid: &Part) -> ([f64; 3], f64) {
             .values()
             .flat_map(|c| c.part.positions.iter()),
     );
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in all {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = super::read::bounds(all);
     if lo[0] > hi[0] {
         return ([0.0; 3], 1.0);
     }
