@@ -1,0 +1,119 @@
+//! The level-of-detail budget of the first view (issue 40), in counts, not times: a synthetic
+//! town with every feature on (grown trees, walking people), 60 m tiles so the tileset has
+//! two levels over its leaves, served by `edo-city serve` and opened in Debian's chromium
+//! (`viewer/test/first-view.mjs`, 1280 x 720). The overview of the whole town must come from
+//! the parent tiles alone, within the issue's budget of bytes, draw calls and triangles: a
+//! change that breaks the levels of detail (a parent without content, an error too small, a
+//! leaf fetched for the overview) fails here.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+
+use common::{build_ok, read_json};
+
+/// The issue's budget for the first overview of a whole city.
+const MAX_BYTES: f64 = 15.0e6;
+const MAX_DRAW_CALLS: f64 = 150.0;
+const MAX_TRIANGLES: f64 = 400_000.0;
+
+#[test]
+fn the_first_overview_comes_from_the_parents_within_the_budget() {
+    let viewer = Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer");
+    let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
+    assert!(
+        Path::new(&chromium).exists() && viewer.join("node_modules/playwright-core").is_dir(),
+        "chromium or playwright-core is missing: run `make viewer-deps`"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let (town, out) = (dir.path().join("town"), dir.path().join("out"));
+    common::synth(&town, 1500, 1);
+    let params = dir.path().join("every-feature.toml");
+    std::fs::write(
+        &params,
+        "tile_size = 60.0\n[trees]\nstyle = \"lsystem\"\n[people]\nmotion = \"boids\"\n",
+    )
+    .unwrap();
+    build_ok(
+        &town,
+        &out,
+        &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
+    );
+    let m = read_json(&out.join("manifest.json"));
+    let parents: Vec<&str> = m["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|f| f["path"].as_str())
+        .filter(|p| p.starts_with("tiles/lod/"))
+        .collect();
+    let levels = parents
+        .iter()
+        .filter_map(|p| p.trim_start_matches("tiles/lod/").split('_').next())
+        .collect::<std::collections::BTreeSet<_>>();
+    assert!(levels.len() >= 2, "two levels over the leaves: {parents:?}");
+
+    let mut serve = Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
+    serve.args(["serve", "--port", "0"]).arg(&out);
+    let (server, url) = common::start_server(serve);
+    let o = Command::new("node")
+        .current_dir(&viewer)
+        .arg("test/first-view.mjs")
+        .arg(&url)
+        .env("CHROMIUM", &chromium)
+        // The browser keeps the real clock (see tests/browser.rs).
+        .env_remove("LD_PRELOAD")
+        .env_remove("FAKETIME")
+        .output()
+        .expect("node runs");
+    drop(server);
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{text}");
+    let last = String::from_utf8_lossy(&o.stdout);
+    let got: serde_json::Value = serde_json::from_str(last.lines().last().unwrap()).unwrap();
+    eprintln!("first view: {}", got["overview"]);
+    assert_eq!(got["errors"], serde_json::json!([]), "{text}");
+
+    // Only parents: every tile fetched is one of the build's files under tiles/lod/.
+    let glbs: Vec<&str> = got["fetched"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|p| p.as_str())
+        .filter(|p| p.ends_with(".glb"))
+        .map(|p| p.splitn(4, '/').nth(3).unwrap_or(p))
+        .collect();
+    assert!(!glbs.is_empty(), "{text}");
+    for g in &glbs {
+        assert!(parents.contains(g), "the overview fetched a leaf: {g}");
+    }
+
+    let stats = &got["overview"];
+    let n = |k: &str| stats[k].as_f64().unwrap_or(-1.0);
+    assert!(n("tilesLoaded") >= 1.0, "{stats}");
+    assert!(n("triangles") >= 1000.0, "the overview is drawn: {stats}");
+    assert!(
+        n("drawCalls") >= 1.0 && n("drawCalls") <= MAX_DRAW_CALLS,
+        "{stats}"
+    );
+    assert!(n("triangles") <= MAX_TRIANGLES, "{stats}");
+    assert!(n("bytesFetched") <= MAX_BYTES, "{stats}");
+    // And within what the parents, the textures and the tileset weigh together (each
+    // fetched at most a few times: parents share the cut-out textures).
+    let on_disk: u64 = common::all_files(&out)
+        .iter()
+        .filter(|(p, _)| {
+            p.starts_with("tiles/lod/") || p.starts_with("tiles/textures/") || p.ends_with(".json")
+        })
+        .map(|(_, b)| b.len() as u64)
+        .sum();
+    assert!(
+        n("bytesFetched") <= 2.0 * on_disk as f64,
+        "{stats} vs {on_disk} bytes"
+    );
+}
