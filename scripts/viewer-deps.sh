@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what the viewer's tests need, on a fresh machine: the npm packages exactly as
-# viewer/package-lock.json pins them (three.js, 3d-tiles-renderer, gltf-validator,
+# viewer/package-lock.json pins them (three.js, 3d-tiles-renderer, CesiumJS, gltf-validator,
 # playwright-core; `npm ci`, no browser download), and Debian's chromium, which
 # playwright-core drives. Each step is skipped when it is already done.
 set -euo pipefail

@@ -2,8 +2,9 @@
 //! place (hypotheses, eras) on 127.0.0.1, with the right MIME types (the HTTP side in
 //! `serve/http.rs`: hyper and tower-http, with bounds on connections and time).
 //!
-//! Routes: `/` the viewer page; `/viewer/<file>` its scripts; `/node_modules/<pkg>/...` the
-//! npm packages it imports (three.js, 3d-tiles-renderer), from `viewer/node_modules`;
+//! Routes: `/` the viewer page; `/viewer/<file>` its scripts (and `cesium.html`, the build in
+//! CesiumJS); `/node_modules/<pkg>/...` the npm packages they import (three.js,
+//! 3d-tiles-renderer, CesiumJS), from `viewer/node_modules`;
 //! `/hypotheses.json` the builds, in the order given; `/h/<k>/<path>` a file of build k;
 //! `/api/gardens...` the rock-garden designer (`serve/api.rs`), which writes only the file
 //! `--designs` names. Nothing outside those directories is ever served.
@@ -197,6 +198,9 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
     let mut text = format!("serving {} build(s) at {url}\n", builds.len());
     for (k, b) in builds.iter().enumerate() {
         text += &format!("  {url}?h={k}  {} ({} tiles)\n", b.dir.display(), b.tiles);
+    }
+    if viewer.join("node_modules/cesium").is_dir() {
+        text += &format!("  in CesiumJS: {url}viewer/cesium.html?h=0\n");
     }
     if let Some(d) = &args.designs {
         text += &format!("  garden designs are kept in {}\n", d.display());
