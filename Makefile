@@ -2,7 +2,7 @@
 
 CARGO ?= cargo
 
-.PHONY: run test test-cluster test-future lint bench real textures fixtures clean pictures bad-input viewer-deps gis-deps
+.PHONY: run test test-cluster test-future lint bench crowd-fd real textures fixtures clean pictures bad-input viewer-deps gis-deps
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
@@ -49,6 +49,11 @@ real:
 ## Whole-Kyoto scale: 30,052 synthetic lots, three builds, per-stage timings.
 bench:
 	bash scripts/bench.sh
+
+## Our crowd's speed against density, next to JuPedSim and Weidmann (1993): the tables of
+## docs/crowds.md and docs/pictures/crowd-fd.png (JuPedSim and PedPy in a venv it makes).
+crowd-fd:
+	bash scripts/crowd_fd.sh
 
 ## The cluster path on a real Slurm: a throw-away single-node cluster (installs Debian's
 ## slurm-wlm and munge when missing; needs root), the sbatch array of deploy/slurm/ and its
