@@ -406,7 +406,29 @@ fn grown_trees_keep_the_tile_budget_and_the_same_bytes_for_any_threads_and_tiles
         .map(|v| v.as_u64().unwrap())
         .sum();
     assert_eq!(rows as u64, by_species);
-    assert!(csv.starts_with("id,tile,species,lot,x,y,z,rotation,scale,squeeze,style\n"));
+    assert!(csv.starts_with("id,tile,species,lot,x,y,z,rotation,scale,squeeze,style,variant\n"));
+    // Every grown tree is one of its species' 8 variants (trees.variants' default), and
+    // each variant a tree is has its mesh in species/.
+    let mut variants = std::collections::BTreeSet::new();
+    for row in csv.lines().skip(1) {
+        let f: Vec<&str> = row.split(',').collect();
+        assert_eq!(f[10], "lsystem", "{row}");
+        let k: u32 = f[11]
+            .parse()
+            .unwrap_or_else(|_| panic!("no variant: {row}"));
+        assert!(k < 8, "{row}");
+        variants.insert((f[2].to_string(), k));
+    }
+    assert!(variants.len() > 8, "{variants:?}");
+    for (species, k) in &variants {
+        let name = format!("species/{species}_{k}.obj");
+        assert!(a.contains_key(&name), "{name}");
+        let (models, _) = tobj::load_obj(one.join(&name), &tobj::LoadOptions::default()).unwrap();
+        assert!(
+            !models.is_empty() && !models[0].mesh.indices.is_empty(),
+            "{name}"
+        );
+    }
     for species in trees["by_species"].as_object().unwrap().keys() {
         let obj = one.join(format!("species/{species}.obj"));
         let (models, _) = tobj::load_obj(
@@ -437,6 +459,62 @@ fn grown_trees_keep_the_tile_budget_and_the_same_bytes_for_any_threads_and_tiles
         std::fs::read(one.join(format!("tiles/{first}.obj"))).unwrap(),
         before
     );
+}
+
+#[test]
+fn trees_variants_zero_grows_every_tree_its_own_and_too_many_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let town = dir.path().join("town");
+    synth(&town, 300, 3);
+    let own = style(dir.path(), "lsystem", "per_ha = 300.0\nvariants = 0\n");
+    let out = dir.path().join("own");
+    build_ok(&town, &out, &["--quiet", "--no-plan", "--params", &own]);
+    let csv = std::fs::read_to_string(out.join("species/placements.csv")).unwrap();
+    assert!(csv.lines().count() > 10, "{csv}");
+    for row in csv.lines().skip(1) {
+        assert!(
+            row.ends_with(",lsystem,"),
+            "no variant with variants = 0: {row}"
+        );
+    }
+    let names: Vec<String> = std::fs::read_dir(out.join("species"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        names.iter().all(|n| !n.contains('_')),
+        "no variant meshes: {names:?}"
+    );
+    // The same town with variants: other trees (a variant's branches, not each its own).
+    let with = dir.path().join("with");
+    let eight = style(dir.path(), "lsystem", "per_ha = 300.0\n");
+    let _ = std::fs::rename(&eight, dir.path().join("eight.toml"));
+    build_ok(
+        &town,
+        &with,
+        &[
+            "--quiet",
+            "--no-plan",
+            "--params",
+            dir.path().join("eight.toml").to_str().unwrap(),
+        ],
+    );
+    let tile = |d: &Path| {
+        let mut v: Vec<_> = std::fs::read_dir(d.join("tiles"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+            .collect();
+        v.sort();
+        v.iter()
+            .map(|p| std::fs::read(p).unwrap())
+            .collect::<Vec<_>>()
+    };
+    assert_ne!(tile(&out), tile(&with));
+
+    let bad = style(dir.path(), "lsystem", "variants = 5000\n");
+    let e = stderr_of_failure(&["build", town.to_str().unwrap(), "--params", &bad]);
+    assert!(e.contains("trees.variants") && e.contains("1024"), "{e}");
 }
 
 #[test]

@@ -1,7 +1,13 @@
 //! The grown trees of a tile (`trees.style = "lsystem"` or `"colonization"`): tallest first,
-//! each grown from its own skeleton (`feature_rng(seed, "tree", id)`) and meshed at LOD1 while
-//! the tile's `trees.max_tile_bytes` allows; a tree that does not fit is drawn as its
-//! species' billboard. All grown trees of a tile are one object, `trees_grown`.
+//! each meshed at LOD1 while the tile's `trees.max_tile_bytes` allows; a tree that does not
+//! fit is drawn as its species' billboard. All grown trees of a tile are one object,
+//! `trees_grown`.
+//!
+//! A tree's skeleton is one of its species' `trees.variants` (grown once per tile at the
+//! species' nominal height from the variant's own key, [`tree::grow_variant`]) scaled to the
+//! tree's height, which is what growing it at that height from the variant's key gives: a
+//! grower's skeleton is scaled to its height at the end. With `variants = 0` every tree is
+//! grown from its own key (`feature_rng(seed, "tree", id)`).
 //!
 //! The budget counts each tree's OBJ bytes as [`Mesh::obj_bytes_estimate`] estimates them
 //! (a little above what the writer prints), so a tile never holds more than
@@ -39,6 +45,11 @@ pub fn build<'a>(
     // Bytes per square metre of height of the trees of each species meshed so far: once the
     // budget is nearly spent, a tree expected not to fit is not grown at all.
     let mut density: std::collections::HashMap<&str, f64> = std::collections::HashMap::new();
+    // The species' variants grown so far in this tile (or why one cannot be).
+    let mut variants: std::collections::HashMap<
+        (&str, u32),
+        Result<crate::growers::skeleton::Skeleton, String>,
+    > = std::collections::HashMap::new();
     // One scratch mesh for every tree: its storage and maps are grown once, not per tree.
     let mut one = Mesh::new(String::new());
     for b in order {
@@ -54,9 +65,22 @@ pub fn build<'a>(
             rest.push(b);
             continue;
         }
-        let mut rng = crate::rng::feature_rng(params.seed, "tree", &b.id);
-        let mut grown = match species.grow_in_city(b.height, &mut rng) {
-            Ok(g) => g,
+        let grown = match tree::variant_of(params.seed, &b.id, params.trees.variants) {
+            Some(k) => variants
+                .entry((species.name.as_str(), k))
+                .or_insert_with(|| tree::grow_variant(species, params.seed, k))
+                .clone()
+                .map(|mut sk| {
+                    sk.scale(b.height / species.nominal_height());
+                    sk
+                }),
+            None => {
+                let mut rng = crate::rng::feature_rng(params.seed, "tree", &b.id);
+                species.grow_in_city(b.height, &mut rng).map(|g| g.skeleton)
+            }
+        };
+        let mut skeleton = match grown {
+            Ok(sk) => sk,
             Err(reason) => {
                 stats.skipped.push(Skipped {
                     layer: "trees".into(),
@@ -68,7 +92,7 @@ pub fn build<'a>(
                 continue;
             }
         };
-        grown.skeleton.squeeze(form.squeeze);
+        skeleton.squeeze(form.squeeze);
         one.clear();
         let place = Placement {
             at: b.at,
@@ -77,7 +101,7 @@ pub fn build<'a>(
         };
         let look = Look::of(species, b.height, &params.trees.season);
         tree::mesh_tree(
-            &grown.skeleton,
+            &skeleton,
             &species.mesh,
             look,
             Lod::Reduced,

@@ -76,6 +76,32 @@ impl Look {
     }
 }
 
+/// The variant (from 0) a tree of id `id` is, of `variants` per species; `None` when
+/// `variants` is 0 (every tree grown from its own skeleton). Drawn from the tree's own key,
+/// so it is the same in any tile, shard or thread, and in `placements.csv`.
+pub fn variant_of(seed: u64, id: &str, variants: u32) -> Option<u32> {
+    use rand::RngExt;
+    (variants > 0)
+        .then(|| crate::rng::feature_rng(seed, "tree/variant", id).random_range(0..variants))
+}
+
+/// Variant `k` of `species` at its nominal height, roots as the city shows them: grown from
+/// its own key (seed, species, k), whatever tree asks for it first.
+pub fn grow_variant(
+    species: &Species,
+    seed: u64,
+    k: u32,
+) -> Result<crate::growers::skeleton::Skeleton, String> {
+    let mut rng = crate::rng::feature_rng(
+        seed,
+        "tree/variant-growth",
+        &format!("{}/{k}", species.name),
+    );
+    Ok(species
+        .grow_in_city(species.nominal_height(), &mut rng)?
+        .skeleton)
+}
+
 /// Where a tree stands: the skeleton's origin goes to `at` on the ground, turned by
 /// `rotation` radians counter-clockwise.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -544,4 +570,46 @@ pub fn sample_lod0(species: &Species, season: &str) -> Result<(Mesh, (f64, f64))
     );
     let margin = look.leaf.map_or(0.0, |_| look.leaf_size);
     Ok((mesh.finish(), extent(&grown.skeleton, margin)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tree_is_one_of_the_variants_by_its_own_key_and_none_without_variants() {
+        assert_eq!(variant_of(1, "12/3", 0), None);
+        let ks: Vec<u32> = (0..400)
+            .map(|i| variant_of(1, &i.to_string(), 8).unwrap())
+            .collect();
+        assert!(ks.iter().all(|&k| k < 8));
+        // Every variant is used, none by more than twice its share.
+        for k in 0..8 {
+            let n = ks.iter().filter(|&&x| x == k).count();
+            assert!((10..=100).contains(&n), "variant {k}: {n} of 400");
+        }
+        assert_eq!(variant_of(1, "7", 8), variant_of(1, "7", 8));
+    }
+
+    #[test]
+    fn a_variant_scaled_to_a_height_is_the_variant_grown_at_that_height() {
+        // Growing scales the skeleton to its height at the end (roots exposed in
+        // proportion), so the shared variant scaled is what each tree would grow.
+        let catalog = crate::templates::Catalog::load(None).unwrap();
+        for species in catalog.species.values() {
+            let h = species.height[0];
+            let mut scaled = grow_variant(species, 5, 3).unwrap();
+            scaled.scale(h / species.nominal_height());
+            let mut rng =
+                crate::rng::feature_rng(5, "tree/variant-growth", &format!("{}/3", species.name));
+            let direct = species.grow_in_city(h, &mut rng).unwrap().skeleton;
+            assert_eq!(scaled.nodes.len(), direct.nodes.len(), "{}", species.name);
+            for (a, b) in scaled.nodes.iter().zip(&direct.nodes) {
+                for c in 0..3 {
+                    assert!((a.at[c] - b.at[c]).abs() < 1e-9, "{}", species.name);
+                }
+                assert!((a.radius - b.radius).abs() < 1e-9, "{}", species.name);
+            }
+        }
+    }
 }

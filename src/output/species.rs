@@ -2,8 +2,13 @@
 //! instances, a game engine), the LOD0 of every species the build planted, grown from its
 //! sample tree, and `placements.csv`: where each tree of the city stands, turned and scaled.
 //!
-//! The tiles' grown trees are each grown from their own skeleton; an instance of the
-//! sample is the same species at the same height and turn, not the same branches.
+//! With `trees.variants` (default 8) the tiles' grown trees are each one of their species'
+//! variants, scaled: `<name>_<k>.obj` is variant k at LOD1 (as the tiles mesh it) at the
+//! species' nominal height, and a placement's `variant`, `scale`, `squeeze` and `rotation`
+//! put it where the tile has it (the tiles' leaf cards grow with the square root of the
+//! height, an instance's with the height). With `variants = 0` each tree is grown from its
+//! own skeleton, and an instance of the sample is the same species at the same height and
+//! turn, not the same branches.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -73,14 +78,62 @@ pub fn write_species(
         )?;
         heights.insert(s.name.clone(), s.nominal_height());
     }
-    let mut csv = String::from("id,tile,species,lot,x,y,z,rotation,scale,squeeze,style\n");
+    let variant = |b: &crate::model::PlannedBillboard, t: &crate::model::TreeForm| {
+        t.grown
+            .then(|| tree::variant_of(params.seed, &b.id, params.trees.variants))
+            .flatten()
+    };
+    // Every variant a grown tree is, at LOD1 and the species' nominal height.
+    let variants: BTreeMap<(&str, u32), ()> = trees
+        .iter()
+        .filter_map(|(b, t)| Some(((t.species.as_str(), variant(b, t)?), ())))
+        .collect();
+    for &(name, k) in variants.keys() {
+        let Some(s) = catalog.species.get(name) else {
+            continue;
+        };
+        let Ok(sk) = tree::grow_variant(s, params.seed, k) else {
+            continue;
+        };
+        let h = s.nominal_height();
+        let mut mesh = crate::generate::mesh::Mesh::new(format!("{name}_{k}"));
+        let place = tree::Placement {
+            at: geo_types::Coord { x: 0.0, y: 0.0 },
+            ground: 0.0,
+            rotation: 0.0,
+        };
+        let look = tree::Look::of(s, h, &params.trees.season);
+        let frame = crate::generate::mesh::Frame { origin: [0.0, 0.0] };
+        tree::mesh_tree(
+            &sk,
+            &s.mesh,
+            look,
+            tree::Lod::Reduced,
+            place,
+            frame,
+            &mut mesh,
+        );
+        let mut buf = Vec::new();
+        obj::write_tile(
+            &mut buf,
+            &format!("{name}_{k}"),
+            [0.0, 0.0],
+            [&mesh.finish()],
+        );
+        put(format!("{name}_{k}.obj"), &buf)?;
+        put(
+            format!("{name}_{k}.mtl"),
+            obj::mtl::mtl_text_at("../tiles/textures/").as_bytes(),
+        )?;
+    }
+    let mut csv = String::from("id,tile,species,lot,x,y,z,rotation,scale,squeeze,style,variant\n");
     for (b, t) in &trees {
         let Some(h) = heights.get(&t.species) else {
             continue;
         };
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.3},{:.3},{:.3},{:.2},{:.4},{:.4},{}",
+            "{},{},{},{},{:.3},{:.3},{:.3},{:.2},{:.4},{:.4},{},{}",
             quote(&b.id),
             b.tile,
             t.species,
@@ -94,7 +147,8 @@ pub fn write_species(
             match catalog.species.get(&t.species) {
                 Some(s) if t.grown => s.method,
                 _ => "billboard",
-            }
+            },
+            variant(b, t).map_or(String::new(), |k| k.to_string()),
         );
     }
     put("placements.csv".into(), csv.as_bytes())?;

@@ -92,6 +92,10 @@ pub struct TreesParams {
     /// Bytes of grown-tree geometry one tile may hold: the tallest trees get meshes, the rest
     /// of the tile's trees billboards of their species.
     pub max_tile_bytes: u64,
+    /// Grown trees of a species come in this many variants, each grown once from its own
+    /// RNG key and every tree of the species one of them, scaled to its height (growth is
+    /// then per variant, not per tree); 0: every tree grown from its own skeleton.
+    pub variants: u32,
     /// Species weights per lot use (`machiya`, `buke`, ... or `default` for any other), the
     /// species drawn per tree (`[district.<id>.tree_species]`).
     pub species: BTreeMap<String, BTreeMap<String, f64>>,
@@ -139,6 +143,9 @@ pub const TREE_STYLES: [&str; 3] = ["billboard", "lsystem", "colonization"];
 /// The largest `trees.max_tile_bytes`: 1 GB.
 pub const MAX_TILE_BYTES: u64 = 1_000_000_000;
 
+/// The most tree variants per species (`trees.variants`).
+pub const MAX_VARIANTS: u32 = 1024;
+
 /// A tree style is one of [`TREE_STYLES`].
 pub fn check_style(key: &str, style: &str) -> Result<(), String> {
     if TREE_STYLES.contains(&style) {
@@ -183,6 +190,12 @@ impl TreesParams {
             return Err(format!(
                 "`trees.max_tile_bytes` must be at most {MAX_TILE_BYTES}, got {}",
                 self.max_tile_bytes
+            ));
+        }
+        if self.variants > MAX_VARIANTS {
+            return Err(format!(
+                "`trees.variants` must be from 0 to {MAX_VARIANTS}, got {}",
+                self.variants
             ));
         }
         check_species("trees.species", &self.species)?;
@@ -283,6 +296,7 @@ pub(super) mod partial {
         style: Option<String>,
         season: Option<String>,
         max_tile_bytes: Option<u64>,
+        variants: Option<u32>,
         species:
             Option<std::collections::BTreeMap<String, std::collections::BTreeMap<String, f64>>>,
     }
