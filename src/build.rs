@@ -509,6 +509,7 @@ fn write_city(
                 gen_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
                 let t = Instant::now();
                 let features = directory.features(&meshes.meshes);
+                let instance_features = directory.instance_features(&meshes.instanced);
                 let extent = output::sink::extent(&meshes.meshes);
                 let centre = output::sink::tile_centre(
                     id,
@@ -523,6 +524,8 @@ fn write_city(
                     centre,
                     meshes: &meshes.meshes,
                     features: &features,
+                    instanced: &meshes.instanced,
+                    instance_features: &instance_features,
                     palette: output::palette::Palette::new(&plan.palette),
                 };
                 let mut entry = report::ManifestTile {

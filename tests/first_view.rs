@@ -4,7 +4,8 @@
 //! (`viewer/test/first-view.mjs`, 1280 x 720). The overview of the whole town must come from
 //! the parent tiles alone, within the budget of bytes, draw calls and triangles: a
 //! change that breaks the levels of detail (a parent without content, an error too small, a
-//! leaf fetched for the overview) fails here.
+//! leaf fetched for the overview) fails here. Then, up close, a click on a grown tree (an
+//! instance of its variant, `EXT_mesh_gpu_instancing`) names that tree and its lot.
 
 mod common;
 
@@ -54,6 +55,28 @@ fn the_first_overview_comes_from_the_parents_within_the_budget() {
         .collect::<std::collections::BTreeSet<_>>();
     assert!(levels.len() >= 2, "two levels over the leaves: {parents:?}");
 
+    // The tallest grown tree (an instance of its variant in its tile's GLB), 4 m up its
+    // crown: a click there must name it.
+    let csv = std::fs::read_to_string(out.join("species/placements.csv")).unwrap();
+    let tree = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>())
+        .filter(|f| !f[11].is_empty())
+        .max_by(|a, b| {
+            a[8].parse::<f64>()
+                .unwrap()
+                .total_cmp(&b[8].parse().unwrap())
+        })
+        .expect("grown trees");
+    let at = |i: usize| tree[i].parse::<f64>().unwrap();
+    let click = dir.path().join("tree.json");
+    std::fs::write(
+        &click,
+        serde_json::json!({"east": at(4), "north": -at(6), "up": at(5) + 4.0}).to_string(),
+    )
+    .unwrap();
+
     let mut serve = Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
     serve.args(["serve", "--port", "0"]).arg(&out);
     let (server, url) = common::start_server(serve);
@@ -62,6 +85,7 @@ fn the_first_overview_comes_from_the_parents_within_the_budget() {
         .arg("test/first-view.mjs")
         .arg(&url)
         .env("CHROMIUM", &chromium)
+        .env("CLICK", &click)
         // The browser keeps the real clock (see tests/browser.rs).
         .env_remove("LD_PRELOAD")
         .env_remove("FAKETIME")
@@ -116,4 +140,14 @@ fn the_first_overview_comes_from_the_parents_within_the_budget() {
         n("bytesFetched") <= 2.0 * on_disk as f64,
         "{stats} vs {on_disk} bytes"
     );
+
+    // Up close, the tree is an instance of its variant, and a click names its own row.
+    assert!(
+        got["picked"]["instance"].is_u64(),
+        "an instance was clicked: {text}"
+    );
+    let clicked = &got["clicked"];
+    assert_eq!(clicked["kind"], "trees", "{clicked}");
+    assert_eq!(clicked["name"], format!("tree_{}", tree[0]), "{clicked}");
+    assert_eq!(clicked["lot"], tree[3].as_str(), "{clicked}");
 }

@@ -7,6 +7,7 @@ mod common;
 
 use std::path::Path;
 
+use common::glb::{glb_json, strings};
 use common::{build_ok, fixture, read_json};
 use edo_city::output::tiles3d::globe::{geodetic, Affine};
 use serde_json::Value;
@@ -16,14 +17,6 @@ fn build_example(out: &Path, extra: &[&str]) -> Value {
     let mut args = vec!["--quiet", "--no-plan"];
     args.extend_from_slice(extra);
     build_ok(&fixture("kyoto-small"), out, &args)
-}
-
-/// The JSON chunk of a GLB.
-fn glb_json(bytes: &[u8]) -> Value {
-    assert_eq!(&bytes[0..4], b"glTF");
-    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    assert_eq!(&bytes[16..20], b"JSON");
-    serde_json::from_slice(&bytes[20..20 + len]).unwrap()
 }
 
 /// A JSON array of numbers.
@@ -391,35 +384,6 @@ fn obj_objects_by_kind_keep_every_face_in_a_few_objects() {
         .unwrap();
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("obj_objects"));
-}
-
-/// The BIN chunk of a GLB and the bytes of one of its (plain) views.
-fn view_bytes<'a>(glb: &'a [u8], json: &Value, view: &Value) -> &'a [u8] {
-    let len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
-    let bin = &glb[20 + len + 8..];
-    let v = &json["bufferViews"][view.as_u64().unwrap() as usize];
-    assert_eq!(v["buffer"], 0, "metadata views are plain");
-    let o = v["byteOffset"].as_u64().unwrap_or(0) as usize;
-    &bin[o..o + v["byteLength"].as_u64().unwrap() as usize]
-}
-
-/// The strings of a string column of a GLB's property table.
-fn strings(glb: &[u8], json: &Value, key: &str) -> Vec<String> {
-    let t = &json["extensions"]["EXT_structural_metadata"]["propertyTables"][0];
-    let p = &t["properties"][key];
-    if p.is_null() {
-        // No row has one: the column is left out.
-        return vec![String::new(); t["count"].as_u64().unwrap() as usize];
-    }
-    let values = view_bytes(glb, json, &p["values"]);
-    let offsets: Vec<usize> = view_bytes(glb, json, &p["stringOffsets"])
-        .chunks_exact(4)
-        .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as usize)
-        .collect();
-    offsets
-        .windows(2)
-        .map(|w| String::from_utf8(values[w[0]..w[1]].to_vec()).unwrap())
-        .collect()
 }
 
 /// Triangles of a GLB (every primitive's index count / 3).

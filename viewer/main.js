@@ -407,11 +407,21 @@ function pick(event) {
     return;
   }
   const features = hit.object.userData.meshFeatures;
-  const metadata = hit.object.userData.structuralMetadata;
-  if (!features || !metadata) return;
-  const ids = features.getFeatures(hit.faceIndex, hit.barycoord);
-  const tables = features.getFeatureInfo().map((f) => f.propertyTable);
-  const rows = metadata.getPropertyTableData(tables, ids);
+  // An instanced mesh made by three.js' loader has no metadata of its own: the tile's
+  // (its scene's) table serves.
+  let metadata = null;
+  for (let o = hit.object; o && !metadata; o = o.parent) metadata = o.userData.structuralMetadata || null;
+  // An instanced tree (EXT_mesh_gpu_instancing): its row is its instance's feature id
+  // (EXT_instance_features; three.js keeps the instance attribute on the geometry).
+  const instanceIds = hit.object.isInstancedMesh && hit.object.geometry.getAttribute('_FEATURE_ID_0');
+  api.picked = { instance: hit.object.isInstancedMesh ? hit.instanceId : null };
+  if (!metadata || (!features && !instanceIds)) return;
+  const rows = instanceIds
+    ? metadata.getPropertyTableData([0], [instanceIds.getX(hit.instanceId)])
+    : metadata.getPropertyTableData(
+        features.getFeatureInfo().map((f) => f.propertyTable),
+        features.getFeatures(hit.faceIndex, hit.barycoord),
+      );
   const row = rows[0] || {};
   api.info = row;
   info.textContent = Object.entries(row)

@@ -14,8 +14,9 @@ use crate::templates::expr::Lot;
 use crate::templates::template::SiteInputs;
 use crate::templates::Catalog;
 
-/// Builds the people and the trees of a tile: up to two meshes, people first. A billboard
-/// whose template fails is skipped with the reason.
+/// Builds the people and the trees of a tile: up to three meshes (people, billboard trees,
+/// grown trees) and the grown trees by variant for formats that instance. A billboard whose
+/// template fails is skipped with the reason.
 pub fn build(
     billboards: &[PlannedBillboard],
     catalog: &Catalog,
@@ -23,7 +24,7 @@ pub fn build(
     frame: Frame,
     files: &super::LayerFiles,
     stats: &mut TileStats,
-) -> Vec<Mesh> {
+) -> (Vec<Mesh>, Vec<super::planted::Instanced>) {
     let mut out = Vec::new();
     let grown: Vec<&PlannedBillboard> = billboards
         .iter()
@@ -84,10 +85,9 @@ pub fn build(
             out.push(mesh.finish());
         }
     }
-    if let Some(m) = planted.and_then(|p| p.mesh) {
-        out.push(m);
-    }
-    out
+    let (mesh, instanced) = planted.map_or((None, Vec::new()), |p| (p.mesh, p.instanced));
+    out.extend(mesh);
+    (out, instanced)
 }
 
 /// A tree of a species drawn as its species' billboard: crossed quads the size of its crown.

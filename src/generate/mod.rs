@@ -34,6 +34,9 @@ pub struct TileMeshes {
     pub meshes: Vec<Mesh>,
     /// What the tile holds, for the report.
     pub stats: TileStats,
+    /// The grown trees by variant (their copies are in the `trees_grown` mesh too), for
+    /// formats that instance.
+    pub instanced: Vec<planted::Instanced>,
 }
 
 /// The files features came from, for skip reports.
@@ -203,7 +206,8 @@ pub fn generate_tile(
         files,
         &mut out.stats,
     );
-    out.meshes.extend(people_and_trees);
+    out.meshes.extend(people_and_trees.0);
+    out.instanced = people_and_trees.1;
     for g in tile.gardens {
         out.meshes.extend(garden::planned(g, params.seed, frame));
         out.stats.gardens += 1;

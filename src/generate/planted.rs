@@ -3,11 +3,15 @@
 //! fit is drawn as its species' billboard. All grown trees of a tile are one object,
 //! `trees_grown`.
 //!
-//! A tree's skeleton is one of its species' `trees.variants` (grown once per tile at the
-//! species' nominal height from the variant's own key, [`tree::grow_variant`]) scaled to the
-//! tree's height, which is what growing it at that height from the variant's key gives: a
-//! grower's skeleton is scaled to its height at the end. With `variants = 0` every tree is
-//! grown from its own key (`feature_rng(seed, "tree", id)`).
+//! A tree is one of its species' `trees.variants`: the variant is grown once per tile at the
+//! species' nominal height from its own key and meshed ([`tree::variant_model`]), and every
+//! tree of it is a copy scaled to the tree's height (its crown narrowed by the squeeze),
+//! turned and moved ([`tree::place_copy`]). The OBJ gets the copies (`trees_grown`); formats
+//! that instance (GLB) get each variant once with where its trees stand ([`Instanced`]).
+//! Growing scales a skeleton to its height at the end, so the variant scaled is what growing
+//! the tree at its height from the variant's key gives (the leaf cards then grow with the
+//! height, not its square root). With `variants = 0` every tree is grown from its own key
+//! (`feature_rng(seed, "tree", id)`) and meshed on its own; nothing is instanced.
 //!
 //! The budget counts each tree's OBJ bytes as [`Mesh::obj_bytes_estimate`] estimates them
 //! (a little above what the writer prints), so a tile never holds more than
@@ -15,15 +19,42 @@
 //! it would not fit is not grown (the most bytes per square metre of height seen).
 
 use super::mesh::{Frame, Mesh};
-use super::tree::{self, Lod, Look, Placement};
+use super::tree::{self, Lod, Look, Placement, Stance};
 use crate::model::{PlannedBillboard, Skipped, TileStats};
 use crate::params::Params;
 use crate::templates::Catalog;
 
+/// A tile's trees of one variant, for a format that draws a model many times (GLB's
+/// `EXT_mesh_gpu_instancing`): the variant's model once and where each tree stands.
+#[derive(Debug, Clone)]
+pub struct Instanced {
+    /// The variant at its species' nominal height ([`tree::variant_model`]), named
+    /// `<species>_<k>`, its foot at the origin.
+    pub model: Mesh,
+    /// Its trees, in the order they were meshed into `trees_grown`.
+    pub trees: Vec<InstancedTree>,
+}
+
+/// One tree of an [`Instanced`] variant.
+#[derive(Debug, Clone)]
+pub struct InstancedTree {
+    /// The tree's id (`tree_<id>` in the metadata).
+    pub id: String,
+    /// The lot it stands in, if any.
+    pub lot: Option<String>,
+    /// Where and how it stands.
+    pub stance: Stance,
+}
+
+/// A species' name and a variant of it.
+type VariantKey<'a> = (&'a str, u32);
+
 /// What became of a tile's grown trees.
 pub struct Planted<'a> {
-    /// Their meshes, one object.
+    /// Their meshes, one object (the instanced trees' copies among them).
     pub mesh: Option<Mesh>,
+    /// The trees of each variant, for formats that instance (empty with `variants = 0`).
+    pub instanced: Vec<Instanced>,
     /// The trees the budget left to billboards (in no particular order).
     pub billboards: Vec<&'a PlannedBillboard>,
 }
@@ -45,11 +76,9 @@ pub fn build<'a>(
     // Bytes per square metre of height of the trees of each species meshed so far: once the
     // budget is nearly spent, a tree expected not to fit is not grown at all.
     let mut density: std::collections::HashMap<&str, f64> = std::collections::HashMap::new();
-    // The species' variants grown so far in this tile (or why one cannot be).
-    let mut variants: std::collections::HashMap<
-        (&str, u32),
-        Result<crate::growers::skeleton::Skeleton, String>,
-    > = std::collections::HashMap::new();
+    // The variants met so far in this tile, by (species, k): the model (or why it cannot be
+    // grown) and its trees, in the order first met.
+    let mut variants: Vec<(VariantKey, Result<Instanced, String>)> = Vec::new();
     // One scratch mesh for every tree: its storage and maps are grown once, not per tree.
     let mut one = Mesh::new(String::new());
     for b in order {
@@ -65,22 +94,48 @@ pub fn build<'a>(
             rest.push(b);
             continue;
         }
-        let grown = match tree::variant_of(params.seed, &b.id, params.trees.variants) {
-            Some(k) => variants
-                .entry((species.name.as_str(), k))
-                .or_insert_with(|| tree::grow_variant(species, params.seed, k))
-                .clone()
-                .map(|mut sk| {
-                    sk.scale(b.height / species.nominal_height());
-                    sk
-                }),
-            None => {
-                let mut rng = crate::rng::feature_rng(params.seed, "tree", &b.id);
-                species.grow_in_city(b.height, &mut rng).map(|g| g.skeleton)
-            }
+        let place = Placement {
+            at: b.at,
+            ground: b.ground,
+            rotation: b.facing,
         };
-        let mut skeleton = match grown {
-            Ok(sk) => sk,
+        let stance = Stance {
+            place,
+            scale: b.height / species.nominal_height(),
+            squeeze: form.squeeze,
+        };
+        one.clear();
+        let variant = tree::variant_of(params.seed, &b.id, params.trees.variants);
+        let meshed =
+            match variant {
+                Some(k) => {
+                    let key = (species.name.as_str(), k);
+                    let at = match variants.iter().position(|(v, _)| *v == key) {
+                        Some(i) => i,
+                        None => {
+                            let model =
+                                tree::variant_model(species, params.seed, k, &params.trees.season)
+                                    .map(|model| Instanced {
+                                        model,
+                                        trees: Vec::new(),
+                                    });
+                            variants.push((key, model));
+                            variants.len() - 1
+                        }
+                    };
+                    match &variants[at].1 {
+                        Ok(v) => {
+                            tree::place_copy(&v.model, stance, frame, &mut one);
+                            Ok(Some(at))
+                        }
+                        Err(e) => Err(e.clone()),
+                    }
+                }
+                None => own_tree(b, species, params, place, form.squeeze, frame, &mut one)
+                    .map(|()| None),
+            };
+        let at = match meshed {
+            Ok(at) => at,
             Err(reason) => {
                 stats.skipped.push(Skipped {
                     layer: "trees".into(),
@@ -92,23 +147,6 @@ pub fn build<'a>(
                 continue;
             }
         };
-        skeleton.squeeze(form.squeeze);
-        one.clear();
-        let place = Placement {
-            at: b.at,
-            ground: b.ground,
-            rotation: b.facing,
-        };
-        let look = Look::of(species, b.height, &params.trees.season);
-        tree::mesh_tree(
-            &skeleton,
-            &species.mesh,
-            look,
-            Lod::Reduced,
-            place,
-            frame,
-            &mut one,
-        );
         let bytes = one.obj_bytes_estimate();
         if used + bytes > params.trees.max_tile_bytes {
             rest.push(b);
@@ -121,6 +159,13 @@ pub fn build<'a>(
             .and_modify(|x| *x = x.max(d))
             .or_insert(d);
         mesh.append(&one);
+        if let Some(Ok(v)) = at.map(|i| &mut variants[i].1) {
+            v.trees.push(InstancedTree {
+                id: b.id.clone(),
+                lot: form.lot.clone(),
+                stance,
+            });
+        }
         *stats
             .trees_by_species
             .entry(species.name.clone())
@@ -130,6 +175,37 @@ pub fn build<'a>(
     }
     Planted {
         mesh: (!mesh.faces.is_empty()).then(|| mesh.finish()),
+        instanced: variants
+            .into_iter()
+            .filter_map(|(_, v)| v.ok())
+            .filter(|v| !v.trees.is_empty())
+            .collect(),
         billboards: rest,
     }
+}
+
+/// A tree grown from its own key (`variants = 0`) and meshed into `one`.
+fn own_tree(
+    b: &PlannedBillboard,
+    species: &crate::templates::species::Species,
+    params: &Params,
+    place: Placement,
+    squeeze: f64,
+    frame: Frame,
+    one: &mut Mesh,
+) -> Result<(), String> {
+    let mut rng = crate::rng::feature_rng(params.seed, "tree", &b.id);
+    let mut skeleton = species.grow_in_city(b.height, &mut rng)?.skeleton;
+    skeleton.squeeze(squeeze);
+    let look = Look::of(species, b.height, &params.trees.season);
+    tree::mesh_tree(
+        &skeleton,
+        &species.mesh,
+        look,
+        Lod::Reduced,
+        place,
+        frame,
+        one,
+    );
+    Ok(())
 }

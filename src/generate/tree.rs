@@ -102,6 +102,72 @@ pub fn grow_variant(
         .skeleton)
 }
 
+/// Variant `k` of `species` meshed at LOD1 as the tiles show it, at the species' nominal
+/// height in `season`, its trunk's foot at the origin (millimetres, x east, y up, z south):
+/// the model every tree of the variant is a scaled, turned copy of (and `species/`'s file).
+pub fn variant_model(species: &Species, seed: u64, k: u32, season: &str) -> Result<Mesh, String> {
+    let sk = grow_variant(species, seed, k)?;
+    let mut mesh = Mesh::new(format!("{}_{k}", species.name));
+    let place = Placement {
+        at: Coord { x: 0.0, y: 0.0 },
+        ground: 0.0,
+        rotation: 0.0,
+    };
+    let look = Look::of(species, species.nominal_height(), season);
+    let frame = Frame { origin: [0.0, 0.0] };
+    mesh_tree(
+        &sk,
+        &species.mesh,
+        look,
+        Lod::Reduced,
+        place,
+        frame,
+        &mut mesh,
+    );
+    Ok(mesh.finish())
+}
+
+/// How a copy of a model stands: its foot at `place`, `scale` times as tall and
+/// `scale * squeeze` times as wide.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stance {
+    /// Where and how turned.
+    pub place: Placement,
+    /// Height over the model's.
+    pub scale: f64,
+    /// The crown's narrowing (both horizontal axes).
+    pub squeeze: f64,
+}
+
+/// Adds a copy of `model` (made by [`variant_model`]) standing as `stance` says to `mesh`:
+/// each position scaled, turned about the vertical, moved (what a GLB instance's
+/// translation, rotation and scale do to the model).
+pub fn place_copy(model: &Mesh, stance: Stance, frame: Frame, mesh: &mut Mesh) {
+    let put = Put::new(stance.place, frame);
+    let (w, h) = (stance.scale * stance.squeeze, stance.scale);
+    let pos: Vec<u32> = model
+        .positions
+        .iter()
+        .map(|p| {
+            let m = |v: i64| v as f64 / 1000.0;
+            put.vertex(mesh, [m(p[0]) * w, -m(p[2]) * w, m(p[1]) * h])
+        })
+        .collect();
+    let uv: Vec<u32> = model
+        .uvs
+        .iter()
+        .map(|t| mesh.uv(f64::from(t[0]) / 10_000.0, f64::from(t[1]) / 10_000.0))
+        .collect();
+    for f in &model.faces {
+        let corners = f
+            .corners
+            .iter()
+            .map(|&(p, t)| (pos[p as usize], uv[t as usize]))
+            .collect();
+        mesh.face(f.material, corners);
+    }
+}
+
 /// Where a tree stands: the skeleton's origin goes to `at` on the ground, turned by
 /// `rotation` radians counter-clockwise.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -85,6 +85,34 @@ impl<'a> Directory<'a> {
             .collect()
     }
 
+    /// One feature per instanced grown tree, variant by variant in the order given:
+    /// `tree_<id>`, kind `trees`, with its lot (a click on one tree names its lot).
+    pub fn instance_features(
+        &self,
+        groups: &[crate::generate::planted::Instanced],
+    ) -> Vec<Feature> {
+        groups
+            .iter()
+            .flat_map(|g| &g.trees)
+            .map(|t| {
+                let lot = t.lot.as_deref().and_then(|id| self.lots.get(id));
+                Feature {
+                    name: format!("tree_{}", t.id),
+                    kind: "trees".into(),
+                    lot: t.lot.clone().unwrap_or_default(),
+                    lot_use: lot.map_or(String::new(), |l| l.lot_use.name().to_string()),
+                    district: lot.and_then(|l| l.district.clone()).unwrap_or_default(),
+                    source: if self.given[1] {
+                        self.params.layers.trees.file.clone()
+                    } else {
+                        String::new()
+                    },
+                    ..Feature::default()
+                }
+            })
+            .collect()
+    }
+
     fn feature(&self, name: &str, with_kura: &HashSet<&str>) -> Feature {
         let l = &self.params.layers;
         let (kind, rest) = KINDS

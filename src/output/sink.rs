@@ -22,6 +22,11 @@ pub struct TileContent<'a> {
     pub meshes: &'a [Mesh],
     /// One description per mesh.
     pub features: &'a [Feature],
+    /// The grown trees by variant: the `trees_grown` mesh holds copies of them; a format
+    /// that instances draws each variant's model at its trees instead.
+    pub instanced: &'a [crate::generate::planted::Instanced],
+    /// One description per instanced tree, variant by variant.
+    pub instance_features: &'a [Feature],
     /// What the meshes' material ids name (the library, then the landmarks' materials).
     pub palette: super::palette::Palette<'a>,
 }

@@ -5,8 +5,7 @@
 //! With `trees.variants` (default 8) the tiles' grown trees are each one of their species'
 //! variants, scaled: `<name>_<k>.obj` is variant k at LOD1 (as the tiles mesh it) at the
 //! species' nominal height, and a placement's `variant`, `scale`, `squeeze` and `rotation`
-//! put it where the tile has it (the tiles' leaf cards grow with the square root of the
-//! height, an instance's with the height). With `variants = 0` each tree is grown from its
+//! put it where the tile has it: the tiles' trees are such copies. With `variants = 0` each tree is grown from its
 //! own skeleton, and an instance of the sample is the same species at the same height and
 //! turn, not the same branches.
 
@@ -92,34 +91,11 @@ pub fn write_species(
         let Some(s) = catalog.species.get(name) else {
             continue;
         };
-        let Ok(sk) = tree::grow_variant(s, params.seed, k) else {
+        let Ok(mesh) = tree::variant_model(s, params.seed, k, &params.trees.season) else {
             continue;
         };
-        let h = s.nominal_height();
-        let mut mesh = crate::generate::mesh::Mesh::new(format!("{name}_{k}"));
-        let place = tree::Placement {
-            at: geo_types::Coord { x: 0.0, y: 0.0 },
-            ground: 0.0,
-            rotation: 0.0,
-        };
-        let look = tree::Look::of(s, h, &params.trees.season);
-        let frame = crate::generate::mesh::Frame { origin: [0.0, 0.0] };
-        tree::mesh_tree(
-            &sk,
-            &s.mesh,
-            look,
-            tree::Lod::Reduced,
-            place,
-            frame,
-            &mut mesh,
-        );
         let mut buf = Vec::new();
-        obj::write_tile(
-            &mut buf,
-            &format!("{name}_{k}"),
-            [0.0, 0.0],
-            [&mesh.finish()],
-        );
+        obj::write_tile(&mut buf, &format!("{name}_{k}"), [0.0, 0.0], [&mesh]);
         put(format!("{name}_{k}.obj"), &buf)?;
         put(
             format!("{name}_{k}.mtl"),

@@ -3,6 +3,7 @@
 
 pub mod corpus;
 mod corpus_ledger;
+pub mod glb;
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};

@@ -5,7 +5,8 @@
 // point. Its times are for BENCHMARKS.md (issue 40); its counts are what tests/first_view.rs
 // holds to the level-of-detail budget.
 //
-// Usage: node test/first-view.mjs <url> [east north]
+// Usage: [CLICK=object.json] node test/first-view.mjs <url> [east north]
+import { readFile } from 'node:fs/promises';
 import { chromium } from 'playwright-core';
 
 const [url, east, north] = process.argv.slice(2);
@@ -48,6 +49,27 @@ try {
       .map((e) => new URL(e.name).pathname)
       .filter((p) => p.startsWith('/h/')),
   );
+  if (process.env.CLICK) {
+    // Close to a given object ({"east", "north", "up"}: map metres from the origin), a click
+    // there: what the info panel names (tests/first_view.rs clicks an instanced tree).
+    const t = JSON.parse(await readFile(process.env.CLICK, 'utf8'));
+    await page.evaluate((h) => window.edoCity.lookAt(h.east, h.north, h.up, 20), t);
+    await page.waitForTimeout(500);
+    await page.waitForFunction(() => window.edoCity.ready, null, { timeout: 600000, polling: 250 });
+    const at = await page.evaluate((h) => window.edoCity.screenOf(h.east, h.north, h.up), t);
+    // Until the leaf replaces its parent (both name the tree; only the leaf draws it as an
+    // instance), for at most a minute.
+    for (let i = 0; i < 120; i += 1) {
+      await page.evaluate(() => {
+        window.edoCity.info = null;
+      });
+      await page.mouse.click(at.x, at.y);
+      await page.waitForTimeout(500);
+      out.picked = await page.evaluate(() => window.edoCity.picked);
+      if (out.picked && out.picked.instance !== null) break;
+    }
+    out.clicked = await page.evaluate(() => window.edoCity.info);
+  }
   out.errors.push(...(await page.evaluate(() => window.edoCity.errors)));
   if (east !== undefined) {
     // Walk mode at the point; the tiles of the new view are given 20 s to stream in.

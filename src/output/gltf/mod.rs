@@ -13,6 +13,7 @@
 //! build, cached by a browser across tiles, loadable from any static server.
 
 pub mod buffer;
+mod instances;
 pub mod metadata;
 
 use serde_json::{json, Value};
@@ -204,18 +205,19 @@ pub fn linear(c: f32) -> f32 {
 }
 
 /// The GLB bytes of one tile. `shift` (millimetres, output frame) is the tile centre the
-/// positions are taken around; `features` has one entry per mesh.
-pub fn tile_glb(
-    tile: &str,
-    meshes: &[Mesh],
-    features: &[Feature],
-    shift: [i64; 3],
-    palette: Palette,
-    meshopt: bool,
-) -> buffer::Glb {
+/// positions are taken around; `features` has one entry per mesh. Grown trees come
+/// instanced when the tile has `instanced` variants (their copies in `trees_grown` are left
+/// out), each tree with its row of `instance_features` after the meshes' rows.
+pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffer::Glb {
+    let (meshes, features, shift, palette) =
+        (tile.meshes, tile.features, tile.centre, tile.palette);
+    let instanced = !tile.instanced.is_empty();
     // Node per kind, in order of first appearance; primitive per material, by material id.
     let mut kinds: Vec<(&str, std::collections::BTreeMap<u16, Primitive>)> = Vec::new();
     for (i, (mesh, f)) in meshes.iter().zip(features).enumerate() {
+        if instanced && mesh.name == "trees_grown" {
+            continue;
+        }
         let k = match kinds.iter().position(|(k, _)| *k == f.kind) {
             Some(k) => k,
             None => {
@@ -286,19 +288,45 @@ pub fn tile_glb(
         nodes.push(json!({"name": kind, "mesh": meshes_json.len(), "extras": {"kind": kind}}));
         meshes_json.push(json!({"name": kind, "primitives": primitives}));
     }
+    instances::add(
+        tile.instanced,
+        tile.origin,
+        shift,
+        features.len(),
+        &mut buf,
+        &mut used,
+        &mut meshes_json,
+        &mut nodes,
+    );
     let (materials, images, textures) = materials(&used, palette);
     let mut doc = json!({
         "asset": {
             "version": "2.0",
             "generator": format!("edo-city {}", env!("CARGO_PKG_VERSION")),
-            "extras": {"tile": tile},
+            "extras": {"tile": tile.id},
         },
         "scene": 0,
-        "scenes": [{"name": tile}],
+        "scenes": [{"name": tile.id}],
     });
     if !nodes.is_empty() {
-        let metadata = metadata::structural_metadata(features, &mut buf);
+        let rows: Vec<Feature> = features
+            .iter()
+            .chain(tile.instance_features)
+            .cloned()
+            .collect();
+        let metadata = metadata::structural_metadata(&rows, &mut buf);
         declare_extensions(&mut doc, &buf);
+        if instanced {
+            for (list, name) in [
+                ("extensionsUsed", "EXT_mesh_gpu_instancing"),
+                ("extensionsUsed", "EXT_instance_features"),
+                ("extensionsRequired", "EXT_mesh_gpu_instancing"),
+            ] {
+                if let Some(a) = doc[list].as_array_mut() {
+                    a.push(json!(name));
+                }
+            }
+        }
         doc["extensions"] = json!({"EXT_structural_metadata": metadata});
         doc["scenes"][0]["nodes"] = json!((0..nodes.len()).collect::<Vec<_>>());
         doc["nodes"] = json!(nodes);
@@ -388,14 +416,7 @@ impl crate::output::sink::Sink for GlbSink {
         out: &std::path::Path,
         tile: &crate::output::sink::TileContent,
     ) -> std::io::Result<crate::output::sink::TileFiles> {
-        let glb = tile_glb(
-            tile.id,
-            tile.meshes,
-            tile.features,
-            tile.centre,
-            tile.palette,
-            self.meshopt,
-        );
+        let glb = tile_glb(tile, self.meshopt);
         let path = format!("tiles/{}.glb", tile.id);
         Ok(crate::output::sink::TileFiles {
             files: vec![crate::output::write_listed(out, path, &glb.parts())?],

@@ -53,11 +53,35 @@ pub fn leaf(
     for node in g.document.nodes() {
         let Some(mesh) = node.mesh() else { continue };
         let kind = node.name().unwrap_or("");
+        // A node drawn at many places (instanced trees): each copy placed, with its own row.
+        let copies = instances(&node, &g.document, &get, shown)?;
         for prim in mesh.primitives() {
             let reader = prim.reader(get);
-            let positions: Vec<[f64; 3]> = match reader.read_positions() {
-                Some(p) => p.map(place).collect(),
+            let model: Vec<[f32; 3]> = match reader.read_positions() {
+                Some(p) => p.collect(),
                 None => continue,
+            };
+            let (positions, ids, indices) = match &copies {
+                None => (
+                    model.iter().map(|&p| place(p)).collect::<Vec<_>>(),
+                    None,
+                    None,
+                ),
+                Some(copies) => {
+                    let one: Vec<u32> = match reader.read_indices() {
+                        Some(i) => i.into_u32().collect(),
+                        None => (0..model.len() as u32).collect(),
+                    };
+                    let mut pos = Vec::with_capacity(model.len() * copies.len());
+                    let (mut ids, mut idx) = (Vec::new(), Vec::new());
+                    for c in copies {
+                        let base = pos.len() as u32;
+                        pos.extend(model.iter().map(|&p| place(c.apply(p))));
+                        ids.extend(std::iter::repeat_n(c.feature, model.len()));
+                        idx.extend(one.iter().map(|i| i + base));
+                    }
+                    (pos, Some(ids), Some(idx))
+                }
             };
             if LEFT_OUT.contains(&kind) {
                 // The size of the largest figure (a card or a mesh of its own), not of the
@@ -75,15 +99,17 @@ pub fn leaf(
                 }
                 continue;
             }
-            let ids: Vec<u32> = match prim.get(&Semantic::Extras("FEATURE_ID_0".into())) {
-                Some(a) => gltf::accessor::Iter::<f32>::new(a, get)
+            let ids: Vec<u32> = match (ids, prim.get(&Semantic::Extras("FEATURE_ID_0".into()))) {
+                (Some(ids), _) => ids,
+                (None, Some(a)) => gltf::accessor::Iter::<f32>::new(a, get)
                     .map(|it| it.map(|v| v as u32).collect())
                     .unwrap_or_default(),
-                None => vec![0; positions.len()],
+                (None, None) => vec![0; positions.len()],
             };
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..positions.len() as u32).collect(),
+            let indices: Vec<u32> = match (indices, reader.read_indices()) {
+                (Some(i), _) => i,
+                (None, Some(i)) => i.into_u32().collect(),
+                (None, None) => (0..positions.len() as u32).collect(),
             };
             if ids.len() != positions.len()
                 || indices.iter().any(|&i| i as usize >= positions.len())
@@ -130,6 +156,83 @@ pub fn leaf(
         }
     }
     Ok(content)
+}
+
+/// One copy of an instanced node (`EXT_mesh_gpu_instancing`): scale, then rotation, then
+/// translation, in the leaf's y-up frame; and its metadata row.
+struct Copy {
+    t: [f32; 3],
+    r: [f32; 4],
+    s: [f32; 3],
+    feature: u32,
+}
+
+impl Copy {
+    /// `p` of the model where this copy has it.
+    fn apply(&self, p: [f32; 3]) -> [f32; 3] {
+        let v = [p[0] * self.s[0], p[1] * self.s[1], p[2] * self.s[2]];
+        // v + 2w (q x v) + 2 q x (q x v), q the quaternion's vector part.
+        let [x, y, z, w] = self.r;
+        let cross = |a: [f32; 3], b: [f32; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let c1 = cross([x, y, z], v);
+        let c2 = cross([x, y, z], c1);
+        [0, 1, 2].map(|k| v[k] + 2.0 * w * c1[k] + 2.0 * c2[k] + self.t[k])
+    }
+}
+
+/// The copies of an instanced node, or `None` for a node drawn once.
+fn instances<'a>(
+    node: &gltf::Node,
+    doc: &'a gltf::Document,
+    get: &(impl Fn(gltf::Buffer<'a>) -> Option<&'a [u8]> + Clone),
+    shown: &str,
+) -> Result<Option<Vec<Copy>>, String> {
+    let Some(ext) = node.extension_value("EXT_mesh_gpu_instancing") else {
+        return Ok(None);
+    };
+    let bad = || format!("{shown}: an instanced node's attributes are unreadable");
+    // An attribute's values (none when the node does not give it).
+    fn read<'a, T: gltf::accessor::Item>(
+        ext: &serde_json::Value,
+        name: &str,
+        doc: &'a gltf::Document,
+        get: impl Fn(gltf::Buffer<'a>) -> Option<&'a [u8]> + Clone,
+    ) -> Option<Option<Vec<T>>> {
+        let Some(i) = ext["attributes"][name].as_u64() else {
+            return Some(None);
+        };
+        let a = doc.accessors().nth(i as usize)?;
+        Some(Some(gltf::accessor::Iter::<T>::new(a, get)?.collect()))
+    }
+    let t: Vec<[f32; 3]> = read(ext, "TRANSLATION", doc, get.clone())
+        .ok_or_else(bad)?
+        .unwrap_or_default();
+    let s: Vec<[f32; 3]> = read(ext, "SCALE", doc, get.clone())
+        .ok_or_else(bad)?
+        .unwrap_or_default();
+    let r: Vec<[f32; 4]> = read(ext, "ROTATION", doc, get.clone())
+        .ok_or_else(bad)?
+        .unwrap_or_default();
+    let ids: Vec<f32> = read(ext, "_FEATURE_ID_0", doc, get.clone())
+        .ok_or_else(bad)?
+        .unwrap_or_default();
+    let n = t.len().max(s.len()).max(r.len());
+    Ok(Some(
+        (0..n)
+            .map(|i| Copy {
+                t: t.get(i).copied().unwrap_or([0.0; 3]),
+                r: r.get(i).copied().unwrap_or([0.0, 0.0, 0.0, 1.0]),
+                s: s.get(i).copied().unwrap_or([1.0; 3]),
+                feature: ids.get(i).map_or(0, |&v| v as u32),
+            })
+            .collect(),
+    ))
 }
 
 /// The largest side of the box around `points`.
