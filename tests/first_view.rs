@@ -9,7 +9,6 @@
 
 mod common;
 
-use std::path::Path;
 use std::process::Command;
 
 use common::{build_ok, read_json};
@@ -21,12 +20,6 @@ const MAX_TRIANGLES: f64 = 400_000.0;
 
 #[test]
 fn the_first_overview_comes_from_the_parents_within_the_budget() {
-    let viewer = Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer");
-    let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
-    assert!(
-        Path::new(&chromium).exists() && viewer.join("node_modules/playwright-core").is_dir(),
-        "chromium or playwright-core is missing: run `make viewer-deps`"
-    );
     let dir = tempfile::tempdir().unwrap();
     let (town, out) = (dir.path().join("town"), dir.path().join("out"));
     common::synth(&town, 1500, 1);
@@ -80,26 +73,12 @@ fn the_first_overview_comes_from_the_parents_within_the_budget() {
     let mut serve = Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
     serve.args(["serve", "--port", "0"]).arg(&out);
     let (server, url) = common::start_server(serve);
-    let o = Command::new("node")
-        .current_dir(&viewer)
-        .arg("test/first-view.mjs")
-        .arg(&url)
-        .env("CHROMIUM", &chromium)
-        .env("CLICK", &click)
-        // The browser keeps the real clock (see tests/browser.rs).
-        .env_remove("LD_PRELOAD")
-        .env_remove("FAKETIME")
-        .output()
-        .expect("node runs");
-    drop(server);
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
+    let (got, text) = common::run_browser_script(
+        "first-view.mjs",
+        &[url.as_ref()],
+        &[("CLICK", click.as_os_str())],
     );
-    assert!(o.status.success(), "{text}");
-    let last = String::from_utf8_lossy(&o.stdout);
-    let got: serde_json::Value = serde_json::from_str(last.lines().last().unwrap()).unwrap();
+    drop(server);
     eprintln!("first view: {}", got["overview"]);
     assert_eq!(got["errors"], serde_json::json!([]), "{text}");
 

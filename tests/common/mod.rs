@@ -403,3 +403,41 @@ pub fn http(port: u16, method: &str, target: &str, body: &str) -> (u16, String) 
         .unwrap_or(0);
     (status, text)
 }
+
+/// Runs a viewer test script (`viewer/test/<script>`) under node in Debian's chromium
+/// (`$CHROMIUM`, default /usr/bin/chromium), with `args` and `envs`; fails the test with the
+/// script's output unless it succeeds. Returns its last stdout line as JSON and all its
+/// output. The browser keeps the real clock: under scripts/test-future.sh libfaketime would
+/// be preloaded into chromium's processes too, whose timers it stalls.
+pub fn run_browser_script(
+    script: &str,
+    args: &[&std::ffi::OsStr],
+    envs: &[(&str, &std::ffi::OsStr)],
+) -> (serde_json::Value, String) {
+    let viewer = Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer");
+    let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
+    assert!(
+        Path::new(&chromium).exists() && viewer.join("node_modules/playwright-core").is_dir(),
+        "chromium or the viewer's npm packages are missing: run `make viewer-deps`"
+    );
+    let mut cmd = std::process::Command::new("node");
+    cmd.current_dir(&viewer)
+        .arg(format!("test/{script}"))
+        .args(args)
+        .env("CHROMIUM", &chromium)
+        .env_remove("LD_PRELOAD")
+        .env_remove("FAKETIME");
+    for (k, v) in envs {
+        cmd.env(k, v);
+    }
+    let o = cmd.output().expect("node runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{text}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let last = stdout.lines().last().unwrap_or("null");
+    (serde_json::from_str(last).unwrap(), text)
+}
