@@ -18,6 +18,7 @@ pub mod mesh;
 pub mod planted;
 pub mod terrain;
 pub mod tree;
+pub mod variant;
 
 use crate::model::{
     FenceKind, KuraDecision, PlannedBillboard, PlannedFence, PlannedHouse, Skipped, TileStats,

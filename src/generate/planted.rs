@@ -4,9 +4,9 @@
 //! `trees_grown`.
 //!
 //! A tree is one of its species' `trees.variants`: the variant is grown once per tile at the
-//! species' nominal height from its own key and meshed ([`tree::variant_model`]), and every
+//! species' nominal height from its own key and meshed ([`variant::variant_model`]), and every
 //! tree of it is a copy scaled to the tree's height (its crown narrowed by the squeeze),
-//! turned and moved ([`tree::place_copy`]). The OBJ gets the copies (`trees_grown`); formats
+//! turned and moved ([`variant::place_copy`]). The OBJ gets the copies (`trees_grown`); formats
 //! that instance (GLB) get each variant once with where its trees stand ([`Instanced`]).
 //! Growing scales a skeleton to its height at the end, so the variant scaled is what growing
 //! the tree at its height from the variant's key gives (the leaf cards then grow with the
@@ -19,7 +19,8 @@
 //! it would not fit is not grown (the most bytes per square metre of height seen).
 
 use super::mesh::{Frame, Mesh};
-use super::tree::{self, Lod, Look, Placement, Stance};
+use super::tree::{self, Lod, Look, Placement};
+use super::variant::{self, Stance};
 use crate::model::{PlannedBillboard, Skipped, TileStats};
 use crate::params::Params;
 use crate::templates::Catalog;
@@ -28,7 +29,7 @@ use crate::templates::Catalog;
 /// `EXT_mesh_gpu_instancing`): the variant's model once and where each tree stands.
 #[derive(Debug, Clone)]
 pub struct Instanced {
-    /// The variant at its species' nominal height ([`tree::variant_model`]), named
+    /// The variant at its species' nominal height ([`variant::variant_model`]), named
     /// `<species>_<k>`, its foot at the origin.
     pub model: Mesh,
     /// Its trees, in the order they were meshed into `trees_grown`.
@@ -105,35 +106,35 @@ pub fn build<'a>(
             squeeze: form.squeeze,
         };
         one.clear();
-        let variant = tree::variant_of(params.seed, &b.id, params.trees.variants);
-        let meshed =
-            match variant {
-                Some(k) => {
-                    let key = (species.name.as_str(), k);
-                    let at = match variants.iter().position(|(v, _)| *v == key) {
-                        Some(i) => i,
-                        None => {
-                            let model =
-                                tree::variant_model(species, params.seed, k, &params.trees.season)
-                                    .map(|model| Instanced {
-                                        model,
-                                        trees: Vec::new(),
-                                    });
-                            variants.push((key, model));
-                            variants.len() - 1
-                        }
-                    };
-                    match &variants[at].1 {
-                        Ok(v) => {
-                            tree::place_copy(&v.model, stance, frame, &mut one);
-                            Ok(Some(at))
-                        }
-                        Err(e) => Err(e.clone()),
+        let variant = variant::variant_of(params.seed, &b.id, params.trees.variants);
+        let meshed = match variant {
+            Some(k) => {
+                let key = (species.name.as_str(), k);
+                let at = match variants.iter().position(|(v, _)| *v == key) {
+                    Some(i) => i,
+                    None => {
+                        let model =
+                            variant::variant_model(species, params.seed, k, &params.trees.season)
+                                .map(|model| Instanced {
+                                    model,
+                                    trees: Vec::new(),
+                                });
+                        variants.push((key, model));
+                        variants.len() - 1
                     }
+                };
+                match &variants[at].1 {
+                    Ok(v) => {
+                        variant::place_copy(&v.model, stance, frame, &mut one);
+                        Ok(Some(at))
+                    }
+                    Err(e) => Err(e.clone()),
                 }
-                None => own_tree(b, species, params, place, form.squeeze, frame, &mut one)
-                    .map(|()| None),
-            };
+            }
+            None => {
+                own_tree(b, species, params, place, form.squeeze, frame, &mut one).map(|()| None)
+            }
+        };
         let at = match meshed {
             Ok(at) => at,
             Err(reason) => {

@@ -15,7 +15,7 @@ use std::path::Path;
 
 use super::report::ManifestFile;
 use super::{atomic, obj};
-use crate::generate::tree;
+use crate::generate::{tree, variant};
 use crate::model::Plan;
 use crate::params::Params;
 use crate::templates::Catalog;
@@ -79,7 +79,7 @@ pub fn write_species(
     }
     let variant = |b: &crate::model::PlannedBillboard, t: &crate::model::TreeForm| {
         t.grown
-            .then(|| tree::variant_of(params.seed, &b.id, params.trees.variants))
+            .then(|| variant::variant_of(params.seed, &b.id, params.trees.variants))
             .flatten()
     };
     // Every variant a grown tree is, at LOD1 and the species' nominal height.
@@ -91,7 +91,7 @@ pub fn write_species(
         let Some(s) = catalog.species.get(name) else {
             continue;
         };
-        let Ok(mesh) = tree::variant_model(s, params.seed, k, &params.trees.season) else {
+        let Ok(mesh) = variant::variant_model(s, params.seed, k, &params.trees.season) else {
             continue;
         };
         let mut buf = Vec::new();

@@ -6,7 +6,7 @@
 //! grow with the variants, not the trees; three.js draws a node as one `InstancedMesh` per
 //! primitive, CesiumJS as instanced draws.
 //!
-//! The OBJ draws the same trees as copies (`trees_grown`, made by `tree::place_copy` with the
+//! The OBJ draws the same trees as copies (`trees_grown`, made by `variant::place_copy` with the
 //! same numbers), so both formats show the same branches; the GLB leaves that mesh out.
 
 use std::collections::BTreeMap;
@@ -104,7 +104,11 @@ pub(super) fn add(
 
 /// The trunk's foot in the tile's frame: y-up, x east, z south, metres from the tile
 /// centre (the model's foot is at its origin).
-fn translation(st: crate::generate::tree::Stance, origin: [f64; 2], shift: [i64; 3]) -> [f32; 3] {
+fn translation(
+    st: crate::generate::variant::Stance,
+    origin: [f64; 2],
+    shift: [i64; 3],
+) -> [f32; 3] {
     let p = [
         st.place.at.x - origin[0],
         st.place.ground,
