@@ -13,12 +13,6 @@ use common::{build_ok, read_json};
 
 #[test]
 fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
-    let viewer = Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer");
-    let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
-    assert!(
-        Path::new(&chromium).exists() && viewer.join("node_modules/playwright-core").is_dir(),
-        "chromium or playwright-core is missing: run `make viewer-deps`"
-    );
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("edo"), dir.path().join("other-seed"));
     // The example town with HTML in its lots' district and its links' titles: the viewer
@@ -63,30 +57,10 @@ fn the_viewer_shows_the_city_names_a_clicked_house_and_switches_hypotheses() {
     serve.args(["serve", "--port", "0"]).arg(&a).arg(&b);
     let (server, url) = common::start_server(serve);
 
-    let o = Command::new("node")
-        .current_dir(&viewer)
-        .arg("test/browser.mjs")
-        .arg(&url)
-        .arg(&house_file)
-        .env("CHROMIUM", &chromium)
-        // The browser runs on the real clock: under scripts/test-future.sh libfaketime would
-        // be preloaded into chromium's processes too, whose timers it stalls (the page never
-        // loads). Our own processes (the build, the server) keep the faked date.
-        .env_remove("LD_PRELOAD")
-        .env_remove("FAKETIME")
-        .output()
-        .expect("node runs");
+    let (out, text) =
+        common::run_browser_script("browser.mjs", &[url.as_ref(), house_file.as_os_str()], &[]);
     drop(server);
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert!(o.status.success(), "{text}");
-    let line = String::from_utf8_lossy(&o.stdout);
-    let last = line.lines().last().unwrap();
-    eprintln!("viewer measurements: {last}");
-    let out: serde_json::Value = serde_json::from_str(last).unwrap();
+    eprintln!("viewer measurements: {out}");
     assert_eq!(out["clicked"]["lot"], lot, "{text}");
     assert_eq!(out["clicked"]["kind"], "machiya");
     // Walking stands the eye 1.6 m over the tiles' ground.

@@ -8,7 +8,6 @@
 
 mod common;
 
-use std::path::Path;
 use std::process::Command;
 
 use common::{build_ok, fixture, read_json};
@@ -16,31 +15,9 @@ use edo_city::model::design::Design;
 
 /// Runs `viewer/test/garden.mjs <url> <args>`; its JSON line.
 fn garden_mjs(url: &str, args: &[&str]) -> serde_json::Value {
-    let viewer = Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer");
-    let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
-    assert!(
-        Path::new(&chromium).exists() && viewer.join("node_modules/playwright-core").is_dir(),
-        "chromium or playwright-core is missing: run `make viewer-deps`"
-    );
-    let o = Command::new("node")
-        .current_dir(&viewer)
-        .arg("test/garden.mjs")
-        .arg(url)
-        .args(args)
-        .env("CHROMIUM", &chromium)
-        // The browser runs on the real clock (see tests/browser.rs).
-        .env_remove("LD_PRELOAD")
-        .env_remove("FAKETIME")
-        .output()
-        .expect("node runs");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert!(o.status.success(), "{text}");
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    serde_json::from_str(stdout.lines().last().unwrap()).unwrap()
+    let mut all: Vec<&std::ffi::OsStr> = vec![url.as_ref()];
+    all.extend(args.iter().map(std::ffi::OsStr::new));
+    common::run_browser_script("garden.mjs", &all, &[]).0
 }
 
 #[test]
