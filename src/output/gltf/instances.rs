@@ -47,24 +47,7 @@ pub(super) fn add(
             if p.indices.is_empty() {
                 continue;
             }
-            let vertices = p.positions.len() / 3;
-            let pos = buf.floats(&p.positions, 3, true);
-            let nor = buf.unit_vectors(&p.normals);
-            let uv = buf.floats(&p.uvs, 2, false);
-            let ind = buf.indices(&p.indices, vertices);
-            let m = match used.iter().position(|&u| u == material) {
-                Some(m) => m,
-                None => {
-                    used.push(material);
-                    used.len() - 1
-                }
-            };
-            primitives.push(json!({
-                "attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv},
-                "indices": ind,
-                "material": m,
-                "mode": 4,
-            }));
+            primitives.push(super::primitive_json(p, material, false, buf, used));
         }
         if primitives.is_empty() {
             continue;

@@ -256,30 +256,7 @@ pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffe
             if p.indices.is_empty() {
                 continue;
             }
-            let vertices = p.positions.len() / 3;
-            let pos = buf.floats(&p.positions, 3, true);
-            let nor = buf.unit_vectors(&p.normals);
-            let uv = buf.floats(&p.uvs, 2, false);
-            let fid = buf.floats(&p.ids, 1, false);
-            let ind = buf.indices(&p.indices, vertices);
-            let m = match used.iter().position(|&u| u == material) {
-                Some(m) => m,
-                None => {
-                    used.push(material);
-                    used.len() - 1
-                }
-            };
-            primitives.push(json!({
-                "attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv, "_FEATURE_ID_0": fid},
-                "indices": ind,
-                "material": m,
-                "mode": 4,
-                "extensions": {"EXT_mesh_features": {"featureIds": [{
-                    "featureCount": p.features,
-                    "attribute": 0,
-                    "propertyTable": 0,
-                }]}},
-            }));
+            primitives.push(primitive_json(p, material, true, &mut buf, &mut used));
         }
         if primitives.is_empty() {
             continue;
@@ -338,6 +315,47 @@ pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffe
     }
     add_images(&mut doc, images, textures);
     buffer::glb(&doc, buf.bin)
+}
+
+/// A primitive's accessors written to `buf` (positions, normals, uvs, its objects' feature
+/// ids when `featured`, indices: in that order) and its JSON; its material is given its index
+/// in `used` (added at first use). An instanced model is not `featured`: its rows are its
+/// instances'.
+fn primitive_json(
+    p: &Primitive,
+    material: u16,
+    featured: bool,
+    buf: &mut Buffer,
+    used: &mut Vec<u16>,
+) -> Value {
+    let vertices = p.positions.len() / 3;
+    let pos = buf.floats(&p.positions, 3, true);
+    let nor = buf.unit_vectors(&p.normals);
+    let uv = buf.floats(&p.uvs, 2, false);
+    let fid = featured.then(|| buf.floats(&p.ids, 1, false));
+    let ind = buf.indices(&p.indices, vertices);
+    let m = match used.iter().position(|&u| u == material) {
+        Some(m) => m,
+        None => {
+            used.push(material);
+            used.len() - 1
+        }
+    };
+    let mut prim = json!({
+        "attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv},
+        "indices": ind,
+        "material": m,
+        "mode": 4,
+    });
+    if let Some(fid) = fid {
+        prim["attributes"]["_FEATURE_ID_0"] = json!(fid);
+        prim["extensions"] = json!({"EXT_mesh_features": {"featureIds": [{
+            "featureCount": p.features,
+            "attribute": 0,
+            "propertyTable": 0,
+        }]}});
+    }
+    prim
 }
 
 /// The images and textures of a tile (leaf or parent), with the one sampler they share
