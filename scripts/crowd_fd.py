@@ -1,7 +1,8 @@
 """The fundamental diagram of our crowd against real walking (issue 41), for `make crowd-fd`.
 
 The same corridor experiment twice, from the same start: `examples/crowd_corridor.rs` writes
-our boids' trajectories and their starting places and speeds; JuPedSim (collision-free speed
+our boids' trajectories, the city's street walkers' (the model people.motion = "boids" builds
+walk) and their starting places and speeds; JuPedSim (collision-free speed
 model, Tordeux et al. 2016) walks the same agents, from the same places at the same desired
 speeds, to the corridor's far end. PedPy measures both the same way: density (people in the
 measurement area / its area) and mean speed there, frame by frame. Weidmann's (1993)
@@ -103,20 +104,25 @@ def jupedsim_run(start, length, width, seconds, sqlite):
 def main():
     work, picture = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
     length, width, seconds = (float(a) for a in (sys.argv[3:6] if len(sys.argv) > 5 else (60, 4, 25)))
-    points = {"edo-city boids": [], "JuPedSim": []}
+    points = {"edo-city boids": [], "edo-city street walkers": [], "JuPedSim": []}
     overlaps = []
     for traj_file in sorted(work.glob("boids_*.txt"), key=lambda p: float(p.stem.split("_")[1])):
         rho = traj_file.stem.split("_")[1]
         ours = pedpy.load_trajectory_from_txt(
             trajectory_file=traj_file, default_frame_rate=FRAME_RATE, default_unit=pedpy.TrajectoryUnit.METER
         )
+        walkers = pedpy.load_trajectory_from_txt(
+            trajectory_file=work / f"walkers_{rho}.txt",
+            default_frame_rate=FRAME_RATE,
+            default_unit=pedpy.TrajectoryUnit.METER,
+        )
         with open(work / f"start_{rho}.csv", newline="") as f:
             start = list(csv.DictReader(f))
         sqlite = work / f"jupedsim_{rho}.sqlite"
         sqlite.unlink(missing_ok=True)
         theirs = jupedsim_run(start, length, width, seconds, sqlite)
-        overlaps.append((rho, overlapping(ours), overlapping(theirs)))
-        for name, traj in (("edo-city boids", ours), ("JuPedSim", theirs)):
+        overlaps.append((rho, overlapping(ours), overlapping(walkers), overlapping(theirs)))
+        for name, traj in (("edo-city boids", ours), ("edo-city street walkers", walkers), ("JuPedSim", theirs)):
             m = measure(traj, width)
             m["start"] = float(rho)
             points[name].append(m)
@@ -135,13 +141,13 @@ def main():
         print(f"| {lo}-{hi} | {weidmann(mid):.2f} | " + " | ".join(cells) + " |")
 
     print()
-    print(f"| start density (1/m2) | agent-frames nearer than {2 * RADIUS} m: boids | JuPedSim |")
-    print("|---|---|---|")
-    for rho, a, b in overlaps:
-        print(f"| {rho} | {100 * a:.1f} % | {100 * b:.1f} % |")
+    print(f"| start density (1/m2) | agent-frames nearer than {2 * RADIUS} m: boids | street walkers | JuPedSim |")
+    print("|---|---|---|---|")
+    for rho, a, w, b in overlaps:
+        print(f"| {rho} | {100 * a:.1f} % | {100 * w:.1f} % | {100 * b:.1f} % |")
 
     fig, ax = plt.subplots(figsize=(7, 4.5), dpi=110)
-    colours = {"edo-city boids": "#c0392b", "JuPedSim": "#2471a3"}
+    colours = {"edo-city boids": "#c0392b", "edo-city street walkers": "#e67e22", "JuPedSim": "#2471a3"}
     for name, f in frames.items():
         ax.scatter(f["density"], f["speed"], s=9, alpha=0.45, color=colours[name], label=f"{name} (PedPy)")
     rho = [0.1 + 0.05 * i for i in range(100)]

@@ -452,11 +452,20 @@ fn write_city(
     };
     let tiles_dir = opts.out.join("tiles");
     std::fs::create_dir_all(&tiles_dir).map_err(|e| write_err(&tiles_dir, e))?;
+    let crowds_dir = opts.out.join(output::crowds::DIR);
+    if !plan.walks.is_empty() {
+        std::fs::create_dir_all(&crowds_dir).map_err(|e| write_err(&crowds_dir, e))?;
+    }
     // A run killed before its renames leaves temporaries; they are never valid output. Shards
     // leave them (the shards beside them are writing theirs); a full build or merge sweeps.
     let alone = !opts.selection.is_shard();
     if alone {
-        for dir in [&opts.out, &tiles_dir, &opts.out.join(output::TEXTURE_DIR)] {
+        for dir in [
+            &opts.out,
+            &tiles_dir,
+            &opts.out.join(output::TEXTURE_DIR),
+            &crowds_dir,
+        ] {
             output::atomic::remove_leftover_temporaries(dir);
         }
     }
@@ -510,7 +519,10 @@ fn write_city(
                 let t = Instant::now();
                 let features = directory.features(&meshes.meshes);
                 let instance_features = directory.instance_features(&meshes.instanced);
-                let extent = output::sink::extent(&meshes.meshes);
+                let extent = output::sink::union(
+                    output::sink::extent(&meshes.meshes),
+                    meshes.crowd.as_ref().and_then(|c| c.reach(plan.origin)),
+                );
                 let centre = output::sink::tile_centre(
                     id,
                     plan.origin,
@@ -526,6 +538,7 @@ fn write_city(
                     features: &features,
                     instanced: &meshes.instanced,
                     instance_features: &instance_features,
+                    crowd: meshes.crowd.as_ref(),
                     palette: output::palette::Palette::new(&plan.palette),
                 };
                 let mut entry = report::ManifestTile {
@@ -533,6 +546,7 @@ fn write_city(
                     obj: None,
                     mtl: None,
                     glb: None,
+                    crowds: None,
                     bounds: extent.map(|(lo, hi)| {
                         // Output frame (x east, y up, z south) to east, north, up.
                         let m = |v: i64| v as f64 / 1000.0;
@@ -554,6 +568,17 @@ fn write_city(
                         Err(e) => {
                             progress.inc(1);
                             return Err(e);
+                        }
+                    }
+                }
+                if let Some(walks) = plan.walks.get(id.as_str()).filter(|w| !w.is_empty()) {
+                    let path = output::crowds::path(id);
+                    let text = output::crowds::csv(walks);
+                    match output::write_listed(&opts.out, path, &[text.as_bytes()]) {
+                        Ok(f) => entry.crowds = Some(f),
+                        Err(e) => {
+                            progress.inc(1);
+                            return Err(write_err(&opts.out.join(output::crowds::path(id)), e));
                         }
                     }
                 }

@@ -71,7 +71,7 @@ pub struct Comparison {
     /// The tiles that changed.
     pub tiles: TileDiff,
     /// The street crowds per district (`people.motion = "boids"`): walkers and the mean
-    /// lambda1-3 over the last steps, in each build.
+    /// lambda1-3 over the clip, in each build.
     pub crowds: Vec<CrowdRow>,
     /// Why the two builds' tiles are not the same places (another tile size, tile origin or
     /// CRS), when they are not: then a tile id names other ground in each.
@@ -86,7 +86,7 @@ pub struct CrowdRow {
     pub district: String,
     /// Walkers in build A and in build B.
     pub agents: [usize; 2],
-    /// Mean lambda1 over the last steps, A and B.
+    /// Mean lambda1 over the clip, A and B.
     pub lambda1: [f64; 2],
     /// Mean lambda2, A and B.
     pub lambda2: [f64; 2],
@@ -308,7 +308,11 @@ pub fn render(c: &Comparison) -> String {
         let _ = writeln!(
             s,
             "\n{:<24} {:>13} {:>15} {:>15} {:>15}",
-            "crowds (mean, last steps)", "walkers A/B", "lambda1 A/B", "lambda2 A/B", "lambda3 A/B"
+            "crowds (mean over the clip)",
+            "walkers A/B",
+            "lambda1 A/B",
+            "lambda2 A/B",
+            "lambda3 A/B"
         );
         for r in &c.crowds {
             let _ = writeln!(

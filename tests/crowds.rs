@@ -253,5 +253,5 @@ fn compare_shows_the_crowds_of_two_hypotheses_side_by_side() {
         .arg(&b)
         .output()
         .unwrap();
-    assert!(String::from_utf8_lossy(&text.stdout).contains("crowds (mean, last steps)"));
+    assert!(String::from_utf8_lossy(&text.stdout).contains("crowds (mean over the clip)"));
 }

@@ -13,6 +13,7 @@ import { TilesRenderer } from '3d-tiles-renderer';
 import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { createDesigner } from './garden.js';
+import { createCrowd, lambdaChart, nearestStretch } from './crowd.js';
 
 const SKY = 0xbcd6ea;
 const EYE = 1.6;
@@ -49,6 +50,9 @@ const api = (window.edoCity = {
     },
   },
 });
+// The walkers' clips: playing from the start, paused with the panel's button or P.
+const crowd = createCrowd();
+api.crowd = crowd.api;
 // Every tile's fetch stays counted (the browser keeps 250 entries by default).
 performance.setResourceTimingBufferSize(1000000);
 
@@ -105,6 +109,7 @@ const hidden = new Set();
 let split = false;
 let walking = false;
 let placement = null; // Matrix4: ECEF -> scene
+let sceneOrigin = [0, 0]; // map metres (east, north) of the scene's origin
 const cities = []; // per hypothesis: { tiles, models: Set, links: Group|null }
 const status = document.getElementById('status');
 
@@ -155,9 +160,13 @@ function city(k) {
       }
     });
     c.grounds.set(tile, under);
+    crowd.add(tile, model, tile.engineData && tile.engineData.metadata && tile.engineData.metadata.animations);
     if (k === api.current) api.tiles = c.models.size;
   });
-  tiles.addEventListener('dispose-model', ({ tile }) => c.grounds.delete(tile));
+  tiles.addEventListener('dispose-model', ({ tile }) => {
+    c.grounds.delete(tile);
+    crowd.remove(tile);
+  });
   tiles.addEventListener('load-error', ({ url, error }) => {
     api.errors.push(`${url}: ${error}`);
     console.error('tile failed to load', url, error);
@@ -414,7 +423,13 @@ function pick(event) {
   // An instanced tree (EXT_mesh_gpu_instancing): its row is its instance's feature id
   // (EXT_instance_features; three.js keeps the instance attribute on the geometry).
   const instanceIds = hit.object.isInstancedMesh && hit.object.geometry.getAttribute('_FEATURE_ID_0');
-  api.picked = { instance: hit.object.isInstancedMesh ? hit.instanceId : null };
+  // A walker (an animated node): its person and group from its node's extras.
+  let walker = null;
+  for (let o = hit.object; o && !walker; o = o.parent) if (o.userData.person !== undefined) walker = o.userData;
+  api.picked = {
+    instance: hit.object.isInstancedMesh ? hit.instanceId : null,
+    person: walker ? walker.person : null,
+  };
   if (!metadata || (!features && !instanceIds)) return;
   const rows = instanceIds
     ? metadata.getPropertyTableData([0], [instanceIds.getX(hit.instanceId)])
@@ -422,13 +437,37 @@ function pick(event) {
         features.getFeatureInfo().map((f) => f.propertyTable),
         features.getFeatures(hit.faceIndex, hit.barycoord),
       );
-  const row = rows[0] || {};
+  const row = { ...(rows[0] || {}) };
+  if (walker) Object.assign(row, { person: walker.person, group: walker.group });
   api.info = row;
   info.textContent = Object.entries(row)
     .filter(([, v]) => v !== '' && v !== null && v !== undefined)
     .map(([k, v]) => `${k}: ${v}`)
     .join('\n');
   offerDesign(row.lot);
+  if (row.kind === 'streets' || row.kind === 'ground') showLambdas(hit.point);
+}
+
+/** Under the info of a clicked street: its crowd's lambda1-3 over the clip (report.json's
+ * crowds of a `people.motion = "boids"` build), `window.edoCity.chart`. */
+const reports = new Map();
+async function showLambdas(p) {
+  const k = api.current;
+  if (!reports.has(k)) {
+    const base = api.hypotheses[k].base;
+    reports.set(k, fetch(`${base}report.json`).then((r) => (r.ok ? r.json() : null)).catch(() => null));
+  }
+  const report = await reports.get(k);
+  const streets = report && report.crowds && report.crowds.streets;
+  if (!streets) return;
+  // The scene is in the first build's frame: metres from its origin.
+  const [oe, on] = sceneOrigin;
+  const s = nearestStretch(streets, p.x + oe, -p.z + on);
+  api.chart = s ? { street: s.street, series: s.series } : null;
+  if (!s) return;
+  const info = document.getElementById('info');
+  info.append('\n');
+  info.appendChild(lambdaChart(s, crowd.api.time));
 }
 
 /** A "design this garden" button under the info of a lot that has a garden to design. */
@@ -449,6 +488,7 @@ async function main() {
   api.hypotheses = list;
   const first = await (await fetch(list[0].tileset)).json();
   placement = placementOf(first);
+  sceneOrigin = (first.extras && first.extras.origin) || [0, 0];
   // Frame the whole city: the root box's centre and size, in the scene.
   const b = first.root.boundingVolume.box;
   const centre = new THREE.Vector3(b[0], b[2], -b[1]);
@@ -464,6 +504,15 @@ async function main() {
   document.getElementById('next').onclick = () => show(api.current + 1);
   document.getElementById('split').onchange = (e) => setSplit(e.target.checked);
   document.getElementById('walk').onclick = toggleWalk;
+  const playButton = document.getElementById('crowd');
+  const showPlaying = () => {
+    playButton.textContent = crowd.api.playing ? 'pause crowd (P)' : 'play crowd (P)';
+  };
+  playButton.onclick = () => {
+    crowd.api.play();
+    showPlaying();
+  };
+  showPlaying();
   for (const box of document.querySelectorAll('#toggles input')) {
     box.onchange = () => {
       for (const k of box.dataset.kinds.split(',')) {
@@ -480,6 +529,7 @@ async function main() {
     if (k === ']' || k === 'h') show(api.current + 1);
     else if (k === '[') show(api.current - 1);
     else if (k === 'k') toggleWalk();
+    else if (k === 'p') playButton.click();
     else if (k === 's' && !walking) setSplit(!split);
     else keys.add(k);
   });
@@ -494,6 +544,7 @@ async function main() {
   const frames = [];
   renderer.setAnimationLoop((now) => {
     walkStep(Math.min((now - last) / 1000, 0.1));
+    crowd.advance(Math.min((now - last) / 1000, 0.1));
     last = now;
     if (!walking) controls.update();
     renderer.info.reset();

@@ -192,6 +192,11 @@ pub fn plan_billboards(
     }
     let near = Surroundings::new(data);
     let mut all = Vec::new();
+    let mut clips = std::collections::BTreeMap::new();
+    // Walkers placed, per stretch and district: the crowds' counts are of those written
+    // (the spacing, the tile cap and the built tiles leave some out after the walk).
+    let mut placed: std::collections::BTreeMap<String, std::collections::BTreeMap<String, usize>> =
+        std::collections::BTreeMap::new();
     for kind in [BillboardKind::Person, BillboardKind::Tree] {
         let k = Kind::of(kind, params);
         if !k.enabled {
@@ -239,23 +244,38 @@ pub fn plan_billboards(
         let walks = |d: Option<&str>| params.crowd_walks(d);
         let any_walk = walks(None) || params.district.keys().any(|d| walks(Some(d)));
         if kind == BillboardKind::Person && given.is_none() && any_walk {
-            let (walked, stats) =
-                super::crowds::walk(kept, data, params, &|c| near.at(c, None).1, &|c| {
-                    obstacles.hit(c, k.clearance)
-                });
-            kept = keep_spaced(walked, spacing);
-            plan.crowds = stats;
+            let walked = super::crowds::walk(kept, data, params, &|c| near.at(c, None).1, &|c| {
+                obstacles.hit(c, k.clearance)
+            });
+            kept = keep_spaced(walked.people, spacing);
+            plan.crowds = walked.stats;
+            plan.warnings.extend(walked.warnings);
+            clips = walked.walks;
         }
         let capped = cap_tiles(kept, &k, &mut plan.warnings);
         all.extend(capped.into_iter().map(|b| (b, given.is_some())));
     }
     for (b, given) in all {
+        if let Some(w) = clips.remove(&b.id) {
+            if given || plan.tiles.contains(&b.tile) {
+                *placed
+                    .entry(w.street.clone())
+                    .or_default()
+                    .entry(b.district.clone().unwrap_or_default())
+                    .or_default() += 1;
+                plan.walks.entry(b.tile.clone()).or_default().push(w);
+            }
+        }
         if given {
             plan.tiles.insert(b.tile.clone());
         } else if !plan.tiles.contains(&b.tile) {
             continue; // strayed over a tile border into a tile with nothing built
         }
         plan.billboards.entry(b.tile.clone()).or_default().push(b);
+    }
+    for stat in &mut plan.crowds {
+        stat.districts = placed.remove(&stat.street).unwrap_or_default();
+        stat.agents = stat.districts.values().sum();
     }
 }
 

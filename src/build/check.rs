@@ -40,6 +40,7 @@ pub fn check(
                 obj: None,
                 mtl: None,
                 glb: None,
+                crowds: None,
                 bounds: None,
                 centre: [0.0; 2],
                 stats: meshes.stats,

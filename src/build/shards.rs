@@ -282,12 +282,14 @@ pub fn remove_stale_tiles(out: &Path, manifest: &Manifest) {
         .flat_map(|t| t.files().map(|f| f.path.clone()).collect::<Vec<_>>())
         .chain(old.files.iter().map(|f| f.path.clone()));
     for path in old_files {
-        let safe = path.starts_with("tiles/") && !path.contains("..");
+        let ours = path.starts_with("tiles/") || path.starts_with(crate::output::crowds::DIR);
+        let safe = ours && !path.contains("..");
         if safe && !current.contains(path.as_str()) {
             let _ = std::fs::remove_file(out.join(&path));
         }
     }
     let _ = std::fs::remove_dir(out.join(crate::output::tiles3d::LOD_DIR));
+    let _ = std::fs::remove_dir(out.join(crate::output::crowds::DIR));
 }
 
 /// Merges the shard outputs in `dirs` into the first: tiles of the others are copied over,

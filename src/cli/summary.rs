@@ -321,7 +321,7 @@ fn print_billboards(r: &edo_city::output::report::Report) -> std::io::Result<()>
             })
             .collect();
         say!(
-            "  crowds     {walkers:>7}  walked on {} street stretches (means of the last steps: {})",
+            "  crowds     {walkers:>7}  walked on {} street stretches (means over the clip: {})",
             crowds.streets.len(),
             list.join("; ")
         );

@@ -14,18 +14,31 @@ use crate::templates::expr::Lot;
 use crate::templates::template::SiteInputs;
 use crate::templates::Catalog;
 
-/// Builds the people and the trees of a tile: up to three meshes (people, billboard trees,
-/// grown trees) and the grown trees by variant for formats that instance. A billboard whose
-/// template fails is skipped with the reason.
+/// What [`build`] made of a tile's people and trees.
+pub struct Built {
+    /// Up to four meshes: people, people walking (at time 0), billboard trees, grown trees.
+    pub meshes: Vec<Mesh>,
+    /// The grown trees by variant, for formats that instance.
+    pub instanced: Vec<super::planted::Instanced>,
+    /// The walkers with their clips, for formats that animate.
+    pub crowd: Option<super::crowd::Crowd>,
+}
+
+/// Builds the people and the trees of a tile: up to four meshes (people, people walking,
+/// billboard trees, grown trees), the grown trees by variant for formats that instance and
+/// the walkers for formats that animate. A billboard whose template fails is skipped with
+/// the reason.
 pub fn build(
     billboards: &[PlannedBillboard],
+    walks: &[crate::model::Walk],
     catalog: &Catalog,
     params: &Params,
     frame: Frame,
     files: &super::LayerFiles,
     stats: &mut TileStats,
-) -> (Vec<Mesh>, Vec<super::planted::Instanced>) {
+) -> Built {
     let mut out = Vec::new();
+    let walkers: std::collections::HashSet<&str> = walks.iter().map(|w| w.id.as_str()).collect();
     let grown: Vec<&PlannedBillboard> = billboards
         .iter()
         .filter(|b| b.tree.as_ref().is_some_and(|t| t.grown))
@@ -41,14 +54,19 @@ pub fn build(
             BillboardKind::Person => (&params.people.template, &files.people),
             BillboardKind::Tree => (&params.trees.template, &files.trees),
         };
-        let mut mesh = Mesh::new(kind.layer().to_string());
+        let mut still = Mesh::new(kind.layer().to_string());
+        let mut walking = Mesh::new(WALKING.to_string());
         for b in billboards.iter().filter(|b| b.kind == kind) {
+            let mesh = match kind == BillboardKind::Person && walkers.contains(b.id.as_str()) {
+                true => &mut walking,
+                false => &mut still,
+            };
             let meshed = b.tree.as_ref().is_some_and(|t| t.grown)
                 && !left.contains(&(b as *const PlannedBillboard));
             let built = match &b.tree {
                 _ if meshed => Ok(()),
                 Some(form) => {
-                    species_billboard(b, form, catalog, frame, &mut mesh);
+                    species_billboard(b, form, catalog, frame, mesh);
                     *stats
                         .trees_by_species
                         .entry(form.species.clone())
@@ -57,7 +75,7 @@ pub fn build(
                         .or_default() += 1;
                     Ok(())
                 }
-                None => build_one(b, template, catalog, params.seed, frame, &mut mesh),
+                None => build_one(b, template, catalog, params.seed, frame, mesh),
             };
             match built {
                 Ok(()) => {
@@ -81,14 +99,28 @@ pub fn build(
                 }),
             }
         }
-        if !mesh.faces.is_empty() {
-            out.push(mesh.finish());
+        for mesh in [still, walking] {
+            if !mesh.faces.is_empty() {
+                out.push(mesh.finish());
+            }
         }
     }
     let (mesh, instanced) = planted.map_or((None, Vec::new()), |p| (p.mesh, p.instanced));
     out.extend(mesh);
-    (out, instanced)
+    let people: Vec<&PlannedBillboard> = billboards
+        .iter()
+        .filter(|b| b.kind == BillboardKind::Person && walkers.contains(b.id.as_str()))
+        .collect();
+    Built {
+        meshes: out,
+        instanced,
+        crowd: super::crowd::build(&people, walks, catalog, params),
+    }
 }
+
+/// The object of the people who walk, where they stand at time 0: the OBJ's; a format that
+/// animates draws [`super::crowd::Crowd`] instead.
+pub const WALKING: &str = "people_walking";
 
 /// A tree of a species drawn as its species' billboard: crossed quads the size of its crown.
 fn species_billboard(
@@ -112,7 +144,7 @@ fn species_billboard(
 
 /// One billboard into `mesh`: the template on a site whose v axis is the facing direction,
 /// centred on the point, its picture slot given the billboard's texture.
-fn build_one(
+pub(super) fn build_one(
     b: &PlannedBillboard,
     template: &str,
     catalog: &Catalog,

@@ -5,6 +5,7 @@
 
 pub mod billboards;
 pub mod clip;
+pub mod crowd;
 pub mod envelope;
 pub mod fences;
 pub mod garden;
@@ -38,6 +39,9 @@ pub struct TileMeshes {
     /// The grown trees by variant (their copies are in the `trees_grown` mesh too), for
     /// formats that instance.
     pub instanced: Vec<planted::Instanced>,
+    /// The walkers (their copies at time 0 are the `people_walking` mesh), for formats that
+    /// animate.
+    pub crowd: Option<crowd::Crowd>,
 }
 
 /// The files features came from, for skip reports.
@@ -64,6 +68,8 @@ pub struct TilePlan<'a> {
     pub fences: &'a [PlannedFence],
     /// The tile's people and trees.
     pub billboards: &'a [PlannedBillboard],
+    /// The clips of the tile's walking people.
+    pub walks: &'a [crate::model::Walk],
     /// The tile's rock gardens.
     pub gardens: &'a [crate::model::PlannedGarden],
     /// The tile's halls.
@@ -83,6 +89,7 @@ impl<'a> TilePlan<'a> {
             lots: plan.houses.get(id).map_or(&[][..], Vec::as_slice),
             fences: plan.fences.get(id).map_or(&[][..], Vec::as_slice),
             billboards: plan.billboards.get(id).map_or(&[][..], Vec::as_slice),
+            walks: plan.walks.get(id).map_or(&[][..], Vec::as_slice),
             gardens: plan.gardens.get(id).map_or(&[][..], Vec::as_slice),
             halls: plan.halls.get(id).map_or(&[][..], Vec::as_slice),
             landmarks: plan.landmarks.get(id).map_or(&[][..], Vec::as_slice),
@@ -201,14 +208,16 @@ pub fn generate_tile(
     build_fences(tile.fences, catalog, params, frame, files, &mut out);
     let people_and_trees = billboards::build(
         tile.billboards,
+        tile.walks,
         catalog,
         params,
         frame,
         files,
         &mut out.stats,
     );
-    out.meshes.extend(people_and_trees.0);
-    out.instanced = people_and_trees.1;
+    out.meshes.extend(people_and_trees.meshes);
+    out.instanced = people_and_trees.instanced;
+    out.crowd = people_and_trees.crowd;
     for g in tile.gardens {
         out.meshes.extend(garden::planned(g, params.seed, frame));
         out.stats.gardens += 1;

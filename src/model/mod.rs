@@ -403,7 +403,7 @@ impl Frontage {
 }
 
 /// A tile id `<col>_<row>` on the fixed grid.
-pub use crowd::{CrowdStat, MeanLambdas};
+pub use crowd::{CrowdStat, MeanLambdas, Walk, WalkKey};
 pub use landmark::{LandmarkRecord, LandmarkReport, Model, PlannedLandmark};
 pub use precinct::{GardenStat, GroundHeight, HallStat, PlannedGarden, PlannedGround, PlannedHall};
 pub use tile::TileId;
@@ -693,6 +693,9 @@ pub struct Plan {
     /// The street crowds' order parameters, per street stretch (`people.motion = "boids"`).
     #[serde(with = "as_json")]
     pub crowds: Vec<CrowdStat>,
+    /// The walkers' clips per tile (the tile each stands in at time 0), each tile's in the
+    /// order of its people in `billboards`.
+    pub walks: BTreeMap<TileId, Vec<Walk>>,
     /// The rock gardens, per tile (the tile of their lot).
     pub gardens: BTreeMap<TileId, Vec<PlannedGarden>>,
     /// What became of every lot that could have had a garden.

@@ -35,6 +35,7 @@ pub struct Feature {
 /// The kinds an object name can start with, longest first where one is a prefix of another.
 const KINDS: &[(&str, &str)] = &[
     ("trees_grown", "trees"),
+    ("people_walking", "people"),
     ("fenceline_", "fence"),
     ("gateline_", "gate"),
     ("machiya_", "machiya"),

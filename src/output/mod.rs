@@ -8,6 +8,7 @@
 pub mod accounting;
 pub mod atomic;
 pub mod chart;
+pub mod crowds;
 pub mod cutout;
 pub mod features;
 pub mod gltf;

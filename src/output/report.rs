@@ -278,13 +278,13 @@ impl Crowds {
 pub struct DistrictCrowd {
     /// Walkers simulated in the district.
     pub agents: usize,
-    /// lambda1 after the last step, weighted by walkers.
+    /// lambda1 at time 0, weighted by walkers.
     pub lambda1: f64,
-    /// lambda2 after the last step.
+    /// lambda2 at time 0.
     pub lambda2: f64,
-    /// lambda3 after the last step.
+    /// lambda3 at time 0.
     pub lambda3: f64,
-    /// The same averaged over the last steps.
+    /// The same averaged over the clip.
     pub mean: crate::model::MeanLambdas,
 }
 
@@ -507,6 +507,9 @@ pub struct ManifestTile {
     /// Its GLB file (format `glb`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub glb: Option<ManifestFile>,
+    /// Its walkers' clips, `crowds/<id>.csv` (`people.motion = "boids"`, any format).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crowds: Option<ManifestFile>,
     /// The extent of its content, metres relative to the origin: `[east_min, north_min,
     /// up_min, east_max, north_max, up_max]` (for the tileset's bounding boxes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -522,7 +525,9 @@ pub struct ManifestTile {
 impl ManifestTile {
     /// Every file of the tile, whatever the format, in a fixed order.
     pub fn files(&self) -> impl Iterator<Item = &ManifestFile> {
-        [&self.obj, &self.mtl, &self.glb].into_iter().flatten()
+        [&self.obj, &self.mtl, &self.glb, &self.crowds]
+            .into_iter()
+            .flatten()
     }
 
     /// Files a sink wrote, each put in its slot by its extension.
@@ -531,6 +536,7 @@ impl ManifestTile {
             let slot = match f.path.rsplit('.').next() {
                 Some("obj") => &mut self.obj,
                 Some("mtl") => &mut self.mtl,
+                Some("csv") => &mut self.crowds,
                 _ => &mut self.glb,
             };
             *slot = Some(f);

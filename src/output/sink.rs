@@ -27,6 +27,9 @@ pub struct TileContent<'a> {
     pub instanced: &'a [crate::generate::planted::Instanced],
     /// One description per instanced tree, variant by variant.
     pub instance_features: &'a [Feature],
+    /// The walkers: the `people_walking` mesh holds them at time 0; a format that animates
+    /// draws them walking instead.
+    pub crowd: Option<&'a crate::generate::crowd::Crowd>,
     /// What the meshes' material ids name (the library, then the landmarks' materials).
     pub palette: super::palette::Palette<'a>,
 }
@@ -99,6 +102,20 @@ pub fn tile_centre(
             Some((lo, hi)) => [(lo[0] + hi[0]) / 2, 0, (lo[2] + hi[2]) / 2],
             None => [0, 0, 0],
         },
+    }
+}
+
+/// The box holding two boxes (either may be missing).
+pub fn union(
+    a: Option<([i64; 3], [i64; 3])>,
+    b: Option<([i64; 3], [i64; 3])>,
+) -> Option<([i64; 3], [i64; 3])> {
+    match (a, b) {
+        (Some((a0, a1)), Some((b0, b1))) => Some((
+            [0, 1, 2].map(|k| a0[k].min(b0[k])),
+            [0, 1, 2].map(|k| a1[k].max(b1[k])),
+        )),
+        (a, b) => a.or(b),
     }
 }
 

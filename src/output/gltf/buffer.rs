@@ -74,7 +74,7 @@ impl Buffer {
         stride: usize,
         mode: Mode,
         indices: &[u32],
-        target: u32,
+        target: Option<u32>,
     ) -> Option<usize> {
         let count = raw.len() / stride;
         let encoded = match mode {
@@ -92,7 +92,6 @@ impl Buffer {
             "buffer": 1,
             "byteOffset": offset,
             "byteLength": raw.len(),
-            "target": target,
             "extensions": {"EXT_meshopt_compression": {
                 "buffer": 0,
                 "byteOffset": start,
@@ -102,8 +101,12 @@ impl Buffer {
                 "mode": match mode { Mode::Attributes => "ATTRIBUTES", Mode::Triangles => "TRIANGLES" },
             }},
         });
-        if let Mode::Attributes = mode {
-            v["byteStride"] = json!(stride);
+        if let Some(t) = target {
+            v["target"] = json!(t);
+            // Only vertex attribute views have a stride of their own (animation data not).
+            if let Mode::Attributes = mode {
+                v["byteStride"] = json!(stride);
+            }
         }
         self.views.push(v);
         Some(self.views.len() - 1)
@@ -147,11 +150,28 @@ impl Buffer {
     ) -> usize {
         if self.meshopt && !data.is_empty() {
             let raw: Vec<u8> = data.iter().flat_map(|&x| bytes(x)).collect();
-            if let Some(v) = self.compressed_view(&raw, N, Mode::Attributes, &[], VERTICES) {
+            if let Some(v) = self.compressed_view(&raw, N, Mode::Attributes, &[], Some(VERTICES)) {
                 return v;
             }
         }
         self.numbers(data, bytes, Some(VERTICES))
+    }
+
+    /// Appends animation data (a sampler's times, positions or rotations), `N` bytes an
+    /// element, as a view with no target, compressed by meshopt's vertex codec when meshopt
+    /// is on (as gltfpack stores animation).
+    pub fn animation<T: Copy, const N: usize>(
+        &mut self,
+        data: &[T],
+        bytes: impl Fn(T) -> [u8; N],
+    ) -> usize {
+        if self.meshopt && !data.is_empty() {
+            let raw: Vec<u8> = data.iter().flat_map(|&x| bytes(x)).collect();
+            if let Some(v) = self.compressed_view(&raw, N, Mode::Attributes, &[], None) {
+                return v;
+            }
+        }
+        self.numbers(data, bytes, None)
     }
 
     /// Appends `data` little-endian as a view, written straight into the buffer (a tile's
@@ -280,7 +300,7 @@ impl Buffer {
                     idx.iter().flat_map(|&i| i.to_le_bytes()).collect()
                 };
                 let stride = if short { 2 } else { 4 };
-                self.compressed_view(&raw, stride, Mode::Triangles, idx, INDICES)
+                self.compressed_view(&raw, stride, Mode::Triangles, idx, Some(INDICES))
             })
             .flatten();
         let (view, ctype) = match (compressed, short) {

@@ -12,6 +12,7 @@
 //! Textures are the shared library by relative URI (`textures/<file>`, in `tiles/`): one copy per
 //! build, cached by a browser across tiles, loadable from any static server.
 
+mod animation;
 pub mod buffer;
 mod instances;
 pub mod metadata;
@@ -212,10 +213,17 @@ pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffe
     let (meshes, features, shift, palette) =
         (tile.meshes, tile.features, tile.centre, tile.palette);
     let instanced = !tile.instanced.is_empty();
+    // Walkers come animated: their standing copies are left out, their figures carry the
+    // copies' row.
+    let walking = tile.crowd.and_then(|_| {
+        meshes
+            .iter()
+            .position(|m| m.name == crate::generate::billboards::WALKING)
+    });
     // Node per kind, in order of first appearance; primitive per material, by material id.
     let mut kinds: Vec<(&str, std::collections::BTreeMap<u16, Primitive>)> = Vec::new();
     for (i, (mesh, f)) in meshes.iter().zip(features).enumerate() {
-        if instanced && mesh.name == "trees_grown" {
+        if (instanced && mesh.name == "trees_grown") || walking == Some(i) {
             continue;
         }
         let k = match kinds.iter().position(|(k, _)| *k == f.kind) {
@@ -275,6 +283,19 @@ pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffe
         &mut meshes_json,
         &mut nodes,
     );
+    let clip = match (tile.crowd, walking) {
+        (Some(crowd), Some(row)) => animation::add(
+            crowd,
+            tile.origin,
+            shift,
+            row as u32,
+            &mut buf,
+            &mut used,
+            &mut meshes_json,
+            &mut nodes,
+        ),
+        _ => None,
+    };
     let (materials, images, textures) = materials(&used, palette);
     let mut doc = json!({
         "asset": {
@@ -312,6 +333,9 @@ pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffe
         doc["buffers"] = buf.buffers_json();
         doc["bufferViews"] = json!(buf.views);
         doc["accessors"] = json!(buf.accessors);
+        if let Some(clip) = clip {
+            doc["animations"] = json!([clip]);
+        }
     }
     add_images(&mut doc, images, textures);
     buffer::glb(&doc, buf.bin)

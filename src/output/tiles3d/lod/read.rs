@@ -52,7 +52,16 @@ pub fn leaf(
     let place = |p: [f32; 3]| transform.apply([p[0] as f64, -p[2] as f64, p[1] as f64]);
     for node in g.document.nodes() {
         let Some(mesh) = node.mesh() else { continue };
-        let kind = node.name().unwrap_or("");
+        // A walker (an animated node: its figure at the origin, moved by its clip) is people.
+        let walker = node.extras().as_ref().is_some_and(|e| {
+            serde_json::from_str::<serde_json::Value>(e.get())
+                .is_ok_and(|v| v.get("person").is_some())
+        });
+        let kind = if walker {
+            "people"
+        } else {
+            node.name().unwrap_or("")
+        };
         // A node drawn at many places (instanced trees): each copy placed, with its own row.
         let copies = instances(&node, &g.document, &get, shown)?;
         for prim in mesh.primitives() {
@@ -84,6 +93,7 @@ pub fn leaf(
                 }
             };
             if LEFT_OUT.contains(&kind) {
+                let scale = f64::from(node.transform().decomposed().2[1]);
                 // The size of the largest figure (a card or a mesh of its own), not of the
                 // crowd: a tile's people are one object.
                 let indices: Vec<u32> = reader
@@ -94,7 +104,9 @@ pub fn leaf(
                     for part in super::components(&indices, positions.len()) {
                         let p: Vec<[f64; 3]> =
                             part.iter().map(|&v| positions[v as usize]).collect();
-                        content.dropped = content.dropped.max(extent(&p));
+                        // A walker's figure is 1 m tall, drawn at its node's scale.
+                        let size = extent(&p) * if walker { scale } else { 1.0 };
+                        content.dropped = content.dropped.max(size);
                     }
                 }
                 continue;
