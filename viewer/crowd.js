@@ -102,7 +102,7 @@ export function nearestStretch(streets, east, north, reach = 30) {
 /** A small chart of a stretch's lambda1-3 over the clip (one value a second), with the
  * crowd's time marked: a canvas for the info panel. */
 export function lambdaChart(stretch, time) {
-  const w = 260;
+  const w = 228;
   const h = 110;
   const canvas = document.createElement('canvas');
   canvas.id = 'lambdas';
@@ -136,7 +136,7 @@ export function lambdaChart(stretch, time) {
     g.fillText(`λ${k + 1}`, pad.l + 4 + 26 * k, 10);
   });
   g.fillStyle = '#555';
-  g.fillText(`${stretch.street}, ${series.length} s`, pad.l + 90, 10);
+  g.fillText(`${stretch.street}, ${series.length} s`, pad.l + 84, 10);
   if (series.length > 1 && time !== undefined) {
     const t = x(Math.min(series.length - 1, time));
     g.strokeStyle = '#000';

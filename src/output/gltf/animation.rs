@@ -68,7 +68,11 @@ pub(super) fn add(
             meshes.len() - 1
         }));
     }
-    let (mut channels, mut samplers) = (Vec::new(), Vec::new());
+    // Every walker's keys in three views for the tile (times, translations, rotations),
+    // each walker's accessors at its offset: a view and its JSON per walker and channel took
+    // twice the bytes of the keys themselves.
+    let (mut times, mut moves, mut turns) = (Vec::new(), Vec::new(), Vec::new());
+    let mut animated: Vec<(usize, usize, usize)> = Vec::new(); // node, first key, keys
     for w in &crowd.walkers {
         let Some(mesh) = figure_mesh[w.figure] else {
             continue;
@@ -79,65 +83,69 @@ pub(super) fn add(
             [0, 1, 2].map(|i| (p[i] - shift[i] as f64 / 1000.0) as f32)
         };
         let h = w.height as f32;
-        let node = nodes.len();
+        animated.push((nodes.len(), times.len(), 0));
+        // The pose before the clip plays (a client that does not animate), in millimetres
+        // and a rotation to 1e-5: a float's seventeen digits were a third of a node's JSON.
+        let round = |v: f32, k: f32| f64::from((v * k).round()) / f64::from(k);
+        let h = round(h, 1000.0);
         nodes.push(json!({
             "name": format!("person_{}", w.walk.id),
             "mesh": mesh,
-            "translation": place(&keys[0]),
-            "rotation": rotation(keys[0].heading),
+            "translation": place(&keys[0]).map(|v| round(v, 1000.0)),
+            "rotation": rotation(keys[0].heading).map(|v| round(v, 1e5)),
             "scale": [h, h, h],
             "extras": {"kind": "people", "person": w.walk.id, "group": w.walk.group},
         }));
         let idx = kept(keys);
         let dt = w.walk.dt as f32;
-        let times: Vec<f32> = idx.iter().map(|&k| k as f32 * dt).collect();
-        let view = buf.animation(&times, f32::to_le_bytes);
-        let input = accessor(buf, view, &times);
-        for path in ["translation", "rotation"] {
-            let output = match path {
-                "translation" => {
-                    let p: Vec<[f32; 3]> = idx.iter().map(|&k| place(&keys[k])).collect();
-                    let view = buf.animation(&p, flat12);
-                    buf.accessors.push(json!({
-                        "bufferView": view, "componentType": 5126,
-                        "count": p.len(), "type": "VEC3",
-                    }));
-                    buf.accessors.len() - 1
-                }
-                _ => {
-                    let q = continuous(idx.iter().map(|&k| rotation(keys[k].heading)));
-                    let shorts: Vec<[i16; 4]> = q.iter().map(|r| r.map(short)).collect();
-                    let view = buf.animation(&shorts, |v| {
-                        let mut b = [0u8; 8];
-                        for (k, x) in v.iter().enumerate() {
-                            b[2 * k..2 * k + 2].copy_from_slice(&x.to_le_bytes());
-                        }
-                        b
-                    });
-                    buf.accessors.push(json!({
-                        "bufferView": view, "componentType": 5122, "normalized": true,
-                        "count": shorts.len(), "type": "VEC4",
-                    }));
-                    buf.accessors.len() - 1
-                }
-            };
-            channels
-                .push(json!({"sampler": samplers.len(), "target": {"node": node, "path": path}}));
+        times.extend(idx.iter().map(|&k| k as f32 * dt));
+        moves.extend(idx.iter().map(|&k| place(&keys[k])));
+        let q = continuous(idx.iter().map(|&k| rotation(keys[k].heading)));
+        turns.extend(q.iter().map(|r| r.map(short)));
+        if let Some(last) = animated.last_mut() {
+            last.2 = idx.len();
+        }
+    }
+    if animated.is_empty() {
+        return None;
+    }
+    let views = [
+        buf.animation(&times, f32::to_le_bytes),
+        buf.animation(&moves, flat12),
+        buf.animation(&turns, |v: [i16; 4]| {
+            let mut b = [0u8; 8];
+            for (k, x) in v.iter().enumerate() {
+                b[2 * k..2 * k + 2].copy_from_slice(&x.to_le_bytes());
+            }
+            b
+        }),
+    ];
+    let (mut channels, mut samplers) = (Vec::new(), Vec::new());
+    for (node, first, n) in animated {
+        let t = &times[first..first + n];
+        let input = push(buf, json!({
+            "bufferView": views[0], "byteOffset": 4 * first, "componentType": 5126,
+            "count": n, "type": "SCALAR", "min": [t[0]], "max": [t[n - 1]],
+        }));
+        let moved = push(buf, json!({
+            "bufferView": views[1], "byteOffset": 12 * first, "componentType": 5126,
+            "count": n, "type": "VEC3",
+        }));
+        let turned = push(buf, json!({
+            "bufferView": views[2], "byteOffset": 8 * first, "componentType": 5122,
+            "normalized": true, "count": n, "type": "VEC4",
+        }));
+        for (path, output) in [("translation", moved), ("rotation", turned)] {
+            channels.push(json!({"sampler": samplers.len(), "target": {"node": node, "path": path}}));
             samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
         }
     }
-    (!channels.is_empty())
-        .then(|| json!({"name": CLIP, "channels": channels, "samplers": samplers}))
+    Some(json!({"name": CLIP, "channels": channels, "samplers": samplers}))
 }
 
-/// The time accessor over `view` (`min` and `max` are required of animation inputs).
-fn accessor(buf: &mut Buffer, view: usize, times: &[f32]) -> usize {
-    let lo = times.first().copied().unwrap_or(0.0);
-    let hi = times.last().copied().unwrap_or(0.0);
-    buf.accessors.push(json!({
-        "bufferView": view, "componentType": 5126, "count": times.len(),
-        "type": "SCALAR", "min": [lo], "max": [hi],
-    }));
+/// Adds an accessor; returns its index.
+fn push(buf: &mut Buffer, accessor: Value) -> usize {
+    buf.accessors.push(accessor);
     buf.accessors.len() - 1
 }
 
