@@ -123,20 +123,30 @@ pub(super) fn add(
     let (mut channels, mut samplers) = (Vec::new(), Vec::new());
     for (node, first, n) in animated {
         let t = &times[first..first + n];
-        let input = push(buf, json!({
-            "bufferView": views[0], "byteOffset": 4 * first, "componentType": 5126,
-            "count": n, "type": "SCALAR", "min": [t[0]], "max": [t[n - 1]],
-        }));
-        let moved = push(buf, json!({
-            "bufferView": views[1], "byteOffset": 12 * first, "componentType": 5126,
-            "count": n, "type": "VEC3",
-        }));
-        let turned = push(buf, json!({
-            "bufferView": views[2], "byteOffset": 8 * first, "componentType": 5122,
-            "normalized": true, "count": n, "type": "VEC4",
-        }));
+        let input = push(
+            buf,
+            json!({
+                "bufferView": views[0], "byteOffset": 4 * first, "componentType": 5126,
+                "count": n, "type": "SCALAR", "min": [t[0]], "max": [t[n - 1]],
+            }),
+        );
+        let moved = push(
+            buf,
+            json!({
+                "bufferView": views[1], "byteOffset": 12 * first, "componentType": 5126,
+                "count": n, "type": "VEC3",
+            }),
+        );
+        let turned = push(
+            buf,
+            json!({
+                "bufferView": views[2], "byteOffset": 8 * first, "componentType": 5122,
+                "normalized": true, "count": n, "type": "VEC4",
+            }),
+        );
         for (path, output) in [("translation", moved), ("rotation", turned)] {
-            channels.push(json!({"sampler": samplers.len(), "target": {"node": node, "path": path}}));
+            channels
+                .push(json!({"sampler": samplers.len(), "target": {"node": node, "path": path}}));
             samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
         }
     }
