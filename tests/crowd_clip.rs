@@ -199,19 +199,7 @@ fn the_glb_clip_moves_each_walker_through_its_csv_places_in_the_file_and_in_thre
     );
     let (keys, _) = clips(&out);
     // Khronos' validator reads the animation (uncompressed here) without an error or warning.
-    let viewer = Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer");
-    let o = std::process::Command::new("node")
-        .current_dir(&viewer)
-        .arg("test/validate.mjs")
-        .arg(&out)
-        .output()
-        .expect("node runs");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert!(text.contains("0 with errors or warnings"), "{text}");
+    common::validate_glbs(&out);
     let m = read_json(&out.join("manifest.json"));
     let tile = m["tiles"]
         .as_array()

@@ -441,3 +441,28 @@ pub fn run_browser_script(
     let last = stdout.lines().last().unwrap_or("null");
     (serde_json::from_str(last).unwrap(), text)
 }
+
+/// Khronos' glTF-Validator over every GLB of the build in `out` (`viewer/test/validate.mjs`):
+/// its output, after asserting it ran and found no error or warning.
+#[allow(dead_code)]
+pub fn validate_glbs(out: &Path) -> String {
+    let viewer = Path::new(env!("CARGO_MANIFEST_DIR")).join("viewer");
+    assert!(
+        viewer.join("node_modules/gltf-validator").is_dir(),
+        "viewer/node_modules is missing: run `make viewer-deps` (npm ci in viewer/)"
+    );
+    let o = std::process::Command::new("node")
+        .current_dir(&viewer)
+        .arg("test/validate.mjs")
+        .arg(out)
+        .output()
+        .expect("node runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{text}");
+    assert!(text.contains("0 with errors or warnings"), "{text}");
+    text
+}

@@ -148,13 +148,7 @@ impl Buffer {
         data: &[T],
         bytes: impl Fn(T) -> [u8; N],
     ) -> usize {
-        if self.meshopt && !data.is_empty() {
-            let raw: Vec<u8> = data.iter().flat_map(|&x| bytes(x)).collect();
-            if let Some(v) = self.compressed_view(&raw, N, Mode::Attributes, &[], Some(VERTICES)) {
-                return v;
-            }
-        }
-        self.numbers(data, bytes, Some(VERTICES))
+        self.elements(data, bytes, Some(VERTICES))
     }
 
     /// Appends animation data (a sampler's times, positions or rotations), `N` bytes an
@@ -165,13 +159,24 @@ impl Buffer {
         data: &[T],
         bytes: impl Fn(T) -> [u8; N],
     ) -> usize {
+        self.elements(data, bytes, None)
+    }
+
+    /// Elements of `N` bytes as a view with `target`, through meshopt's vertex codec when
+    /// meshopt is on (plain if it refuses them).
+    fn elements<T: Copy, const N: usize>(
+        &mut self,
+        data: &[T],
+        bytes: impl Fn(T) -> [u8; N],
+        target: Option<u32>,
+    ) -> usize {
         if self.meshopt && !data.is_empty() {
             let raw: Vec<u8> = data.iter().flat_map(|&x| bytes(x)).collect();
-            if let Some(v) = self.compressed_view(&raw, N, Mode::Attributes, &[], None) {
+            if let Some(v) = self.compressed_view(&raw, N, Mode::Attributes, &[], target) {
                 return v;
             }
         }
-        self.numbers(data, bytes, None)
+        self.numbers(data, bytes, target)
     }
 
     /// Appends `data` little-endian as a view, written straight into the buffer (a tile's
