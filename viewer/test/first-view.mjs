@@ -2,8 +2,9 @@
 // (window.edoCity.stats) in Debian's chromium (headless, SwiftShader), 1280 x 720: time to
 // ready, bytes fetched, draw calls and triangles a frame, frames per second over 3 s, the
 // build's files fetched and any error; then the same at street level in walk mode at a given
-// point. Its times are for BENCHMARKS.md (issue 40); its counts are what tests/first_view.rs
-// holds to the level-of-detail budget.
+// point (and there again with the street crowd paused, when the build has walkers). Its times
+// are for BENCHMARKS.md (issues 40, 41); its counts are what tests/first_view.rs holds to
+// the level-of-detail budget.
 //
 // Usage: [CLICK=object.json] node test/first-view.mjs <url> [east north]
 import { readFile } from 'node:fs/promises';
@@ -77,6 +78,13 @@ try {
     await page.keyboard.press('k');
     await page.waitForTimeout(20000);
     out.street = await measure();
+    // With walkers, the same view with the crowd paused (issue 41: frames a second playing
+    // against paused).
+    out.walkers = await page.evaluate(() => window.edoCity.crowd.walkers);
+    if (out.walkers > 0) {
+      await page.evaluate(() => window.edoCity.crowd.play(false));
+      out.street_paused = await measure();
+    }
   }
 } finally {
   await browser.close();
