@@ -11,8 +11,9 @@
 //! is walked together, in the analysis (which `--tiles` and `--shard` share), so a walker's
 //! neighbours are the same whichever tiles are written; a walker is written in the tile it
 //! stands in at time 0 (its clip may take it into the next). A walker whose clip ever takes
-//! it into a building, kura or fence is left out (with a warning), and a stretch asked for
-//! more walkers than [`MAX_DENSITY`] allows is thinned (with a warning).
+//! it into a building, kura or fence walks its errand's centreline instead, or if that too
+//! crosses one is left out (with a warning); a stretch asked for more walkers than
+//! [`MAX_DENSITY`] allows is thinned (with a warning).
 
 pub mod network;
 pub mod route;
@@ -77,7 +78,8 @@ pub fn walk(
     ground_at: &(dyn Fn(Coord<f64>) -> f64 + Sync),
     blocked: &(dyn Fn(Coord<f64>) -> bool + Sync),
 ) -> Walked {
-    let net = network::network(data, p.people.edge_margin);
+    let mut net = network::network(data, p.people.edge_margin);
+    net.close_blocked(blocked);
     let mut by_stretch: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
     for (i, l) in net.links.iter().enumerate() {
         by_stretch.entry(&l.stretch).or_default().push(i);
@@ -128,11 +130,24 @@ pub fn walk(
         .collect();
     let walkers: Vec<Walker> = settings.iter().map(|s| s.walker.clone()).collect();
     let keys = p.crowd.keys();
-    let tracks = walk::simulate(&net, &walkers, &p.crowd.model(), p.crowd.dt, keys);
-    let ok: Vec<bool> = tracks
-        .par_iter()
-        .map(|t| !t.at.iter().any(|&c| blocked(c)))
+    let mut tracks = walk::simulate(&net, &walkers, &p.crowd.model(), p.crowd.dt, keys);
+    let inside = |t: &Track| !t.at.iter().any(|&c| blocked(c));
+    // A walker pushed into a building (mostly cutting a corner at a junction, or off a lane
+    // of a street narrower than its lots leave it) walks its errand's centreline instead;
+    // one whose centreline crosses a building too is left out.
+    let mut ok: Vec<bool> = tracks.par_iter().map(inside).collect();
+    let fixed: Vec<(usize, Track)> = (ok.iter().enumerate())
+        .filter(|(_, ok)| !**ok)
+        .map(|(i, _)| i)
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .map(|i| (i, walk::centreline(&walkers[i], &net, p.crowd.dt, keys)))
+        .filter(|(_, t)| inside(t))
         .collect();
+    for (i, t) in fixed {
+        tracks[i] = t;
+        ok[i] = true;
+    }
     let left_out = ok.iter().filter(|k| !**k).count();
     if left_out > 0 {
         out.warnings.push(

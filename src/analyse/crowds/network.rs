@@ -66,6 +66,26 @@ pub struct Network {
     pub nodes: Vec<Node>,
 }
 
+impl Network {
+    /// Takes the links whose centreline `blocked` anywhere (every half metre) out of their
+    /// junctions: no errand turns into them (a street drawn through a building, as real
+    /// layers have, would take every walker that went that way into it). A walker set out
+    /// on one still walks it, from where it stands.
+    pub fn close_blocked(&mut self, blocked: &(dyn Fn(Coord<f64>) -> bool + Sync)) {
+        let open: Vec<bool> = self
+            .links
+            .par_iter()
+            .map(|l| {
+                let steps = (l.len / 0.5).ceil().max(1.0) as usize;
+                (0..=steps).all(|k| !blocked(l.a + l.dir() * (l.len * k as f64 / steps as f64)))
+            })
+            .collect();
+        for n in &mut self.nodes {
+            n.links.retain(|&l| open[l]);
+        }
+    }
+}
+
 /// One straight piece of a centreline before it is cut.
 struct Piece {
     stretch: String,
@@ -278,6 +298,20 @@ mod tests {
         assert_eq!(n.links.len(), 1);
         assert_eq!(n.links[0].stretch, "i/1");
         assert!(n.nodes.iter().all(|x| x.links.len() == 1));
+    }
+
+    #[test]
+    fn a_street_through_a_building_is_closed_to_errands() {
+        let mut n = net(vec![
+            street("a", &[[0.0, 50.0], [100.0, 50.0]]),
+            street("b", &[[50.0, 0.0], [50.0, 100.0]]),
+        ]);
+        // A building across b's northern half.
+        n.close_blocked(&|c| c.x > 45.0 && c.x < 55.0 && c.y > 70.0 && c.y < 80.0);
+        let hub = n.nodes.iter().find(|x| x.links.len() == 3).unwrap();
+        assert!(hub.links.iter().all(|&l| n.links[l].stretch != "b/1"
+            || n.links[l].a.y < 50.0
+            || n.links[l].b.y < 50.0));
     }
 
     #[test]

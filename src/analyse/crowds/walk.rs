@@ -177,6 +177,24 @@ pub fn run(
     out
 }
 
+/// A walker's errand alone, on the centreline (lane 0, nobody else): the track of a walker
+/// the crowd pushed into a building. Periodic as the errand is.
+pub fn centreline(w: &Walker, net: &Network, dt: f64, keys: usize) -> Track {
+    let alone = Walker {
+        lane: 0.0,
+        ..w.clone()
+    };
+    let duration = dt * keys as f64;
+    let mut tr = Track {
+        at: (0..=keys)
+            .map(|k| alone.target(net, k as f64 * dt, duration).at)
+            .collect(),
+        ..Track::default()
+    };
+    close_loop(&alone, &mut tr, net, dt, keys);
+    tr
+}
+
 /// One walker's next position and velocity.
 fn step_one(
     state: &[(Coord<f64>, Coord<f64>)],
