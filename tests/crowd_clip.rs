@@ -340,7 +340,7 @@ fn a_street_asked_for_more_walkers_than_it_holds_is_thinned_with_a_warning() {
     let p = dir.path().join("busy.toml");
     std::fs::write(
         &p,
-        "[people]\nmotion = \"boids\"\nper_100m = 1000.0\nmin_spacing = 0.3\nmax_points_per_tile = 100000\n",
+        "[people]\nmotion = \"boids\"\nper_100m = 200.0\nmin_spacing = 0.3\nedge_margin = 3.0\n",
     )
     .unwrap();
     let r = build_ok(
