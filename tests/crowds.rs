@@ -1,7 +1,8 @@
-//! Street crowds (`people.motion = "boids"`): the people walk as a crowd along their street
-//! before they are placed; they stay on the street, apart and out of buildings, keep the
-//! density of section 4.4 on average, and the report gives each street's and district's
-//! order parameters. Byte-identical for any thread count and for `--tiles`.
+//! Street crowds (`people.motion = "boids"`): the people walk as a crowd through the street
+//! network (tests/crowd_clip.rs tests the clip); at time 0 they stand on the street, apart
+//! and out of buildings, keep the density of section 4.4 on average, and the report gives
+//! each street's and district's order parameters. Tiles and clips are byte-identical for any
+//! thread count and for `--tiles`.
 
 mod common;
 
@@ -159,10 +160,14 @@ fn crowds_are_byte_identical_for_any_thread_count_and_for_single_tiles() {
     let tiles = |d: &Path| {
         all_files(d)
             .into_iter()
-            .filter(|(k, _)| k.starts_with("tiles/"))
+            .filter(|(k, _)| k.starts_with("tiles/") || k.starts_with("crowds/"))
             .collect::<Vec<_>>()
     };
     assert_eq!(tiles(&a), tiles(&b));
+    assert!(
+        tiles(&a).iter().any(|(k, _)| k.starts_with("crowds/")),
+        "the walkers' clips are compared too"
+    );
     let m = read_json(&a.join("manifest.json"));
     let id = m["tiles"][0]["id"].as_str().unwrap().to_string();
     let before = tiles(&a);
