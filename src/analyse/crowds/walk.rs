@@ -209,12 +209,13 @@ fn step_one(
     let pace = aim.vel.x.hypot(aim.vel.y);
     let top = pace * CATCH_UP;
     let want = limit(aim.vel + (aim.at - x) * PULL, top);
-    let a = (want - v) * RELAX + zones(state, grid, i, m);
+    let way = unit(want);
+    let (push, ahead) = zones(state, grid, i, way, m);
+    let a = (want - v) * RELAX + push;
     let mut v = limit(v + a * h, top);
     // No faster toward someone ahead than the gap allows (the collision-free speed model's
     // rule); sideways it may still step round them.
-    let way = unit(want);
-    let room = ((headway(state, grid, i, way) - BODY) / TIME_GAP).max(0.0);
+    let room = ((ahead - BODY) / TIME_GAP).max(0.0);
     let along = v.x * way.x + v.y * way.y;
     if along > room {
         v = v - way * (along - room);
@@ -222,32 +223,22 @@ fn step_one(
     (inside(x + v * h, &net.links[aim.link]), v)
 }
 
-/// How far ahead along `way` the nearest walker within half a body's width either side
-/// of walker `i`'s line is, metres (infinite when none is within the grid's reach).
-fn headway(state: &[(Coord<f64>, Coord<f64>)], grid: &Grid, i: usize, way: Coord<f64>) -> f64 {
-    let x = state[i].0;
-    let mut best = f64::INFINITY;
-    grid.near(x, |j| {
-        if j == i {
-            return;
-        }
-        let d = state[j].0 - x;
-        let ahead = d.x * way.x + d.y * way.y;
-        let side = (d.x * way.y - d.y * way.x).abs();
-        if ahead > 0.0 && side < BODY && ahead < best {
-            best = ahead;
-        }
-    });
-    best
-}
-
 /// The seed's steering of walker `i`: away from those within `r0`, toward the heading of
 /// those walking its way within `r1`, toward their centre within `r2`; and one rule of
 /// people the seed has no need of: someone coming the other way within `r1` ahead makes a
 /// walker step to its left (both do, so they pass keeping left; without it two walkers on
-/// one line met head-on and pushed through each other).
-fn zones(state: &[(Coord<f64>, Coord<f64>)], grid: &Grid, i: usize, m: &BoidParams) -> Coord<f64> {
+/// one line met head-on and pushed through each other). Also how far ahead along `way`
+/// the nearest walker within a body's width of the walker's line is (infinite when none is
+/// within the grid's reach): one pass over the neighbours for both.
+fn zones(
+    state: &[(Coord<f64>, Coord<f64>)],
+    grid: &Grid,
+    i: usize,
+    way: Coord<f64>,
+    m: &BoidParams,
+) -> (Coord<f64>, f64) {
     let (x, v) = state[i];
+    let mut ahead = f64::INFINITY;
     let zero = Coord { x: 0.0, y: 0.0 };
     let (mut sep, mut ali, mut coh) = (zero, zero, zero);
     let (mut n_ali, mut n_coh) = (0usize, 0usize);
@@ -258,6 +249,10 @@ fn zones(state: &[(Coord<f64>, Coord<f64>)], grid: &Grid, i: usize, m: &BoidPara
         }
         let (y, w) = state[j];
         let d = y - x;
+        let along = d.x * way.x + d.y * way.y;
+        if along > 0.0 && along < ahead && (d.x * way.y - d.y * way.x).abs() < BODY {
+            ahead = along;
+        }
         let r = d.x.hypot(d.y);
         if r > m.r2 {
             return;
@@ -281,10 +276,10 @@ fn zones(state: &[(Coord<f64>, Coord<f64>)], grid: &Grid, i: usize, m: &BoidPara
         }
     });
     let mut a = sep * (m.separation * m.max_speed);
-    let way = unit(v);
+    let going = unit(v);
     a = a + Coord {
-        x: -way.y,
-        y: way.x,
+        x: -going.y,
+        y: going.x,
     } * (evade * m.separation * m.max_speed * 0.5);
     if n_ali > 0 {
         let speed = v.x.hypot(v.y);
@@ -293,7 +288,7 @@ fn zones(state: &[(Coord<f64>, Coord<f64>)], grid: &Grid, i: usize, m: &BoidPara
     if n_coh > 0 {
         a = a + coh * (m.cohesion / n_coh as f64);
     }
-    a
+    (a, ahead)
 }
 
 /// `v`, shortened to `top` if longer.
@@ -364,13 +359,16 @@ fn close_loop(w: &Walker, tr: &mut Track, net: &Network, dt: f64, keys: usize) {
 /// The walkers in cells of `r2`, each cell's in index order.
 struct Grid {
     cell: f64,
-    cells: HashMap<(i64, i64), Vec<usize>>,
+    // Looked up, never iterated: the hasher changes no result (foldhash: 18 lookups a walker
+    // a step).
+    cells: HashMap<(i64, i64), Vec<usize>, foldhash::fast::FixedState>,
 }
 
 impl Grid {
     fn new(state: &[(Coord<f64>, Coord<f64>)], r2: f64) -> Grid {
         let cell = r2.max(0.1);
-        let mut cells: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+        let mut cells: HashMap<(i64, i64), Vec<usize>, foldhash::fast::FixedState> =
+            HashMap::default();
         for (i, (x, _)) in state.iter().enumerate() {
             cells.entry(Grid::key(*x, cell)).or_default().push(i);
         }
