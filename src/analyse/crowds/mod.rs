@@ -128,8 +128,9 @@ pub fn walk(
         .into_par_iter()
         .flat_map_iter(|(s, people)| set_out(&s, people, &by_stretch[s.as_str()], &net, p))
         .collect();
-    let walkers: Vec<Walker> = settings.iter().map(|s| s.walker.clone()).collect();
     let keys = p.crowd.keys();
+    let settings = bounded(settings, keys, &mut out.warnings);
+    let walkers: Vec<Walker> = settings.iter().map(|s| s.walker.clone()).collect();
     let mut tracks = walk::simulate(&net, &walkers, &p.crowd.model(), p.crowd.dt, keys);
     let inside = |t: &Track| !t.at.iter().any(|&c| blocked(c));
     // A walker pushed into a building (mostly cutting a corner at a junction, or off a lane
@@ -175,6 +176,39 @@ pub fn walk(
         out.people.push(b);
     }
     out
+}
+
+/// The most walker-keys a build holds (walkers x keys): each is a position in memory, in the
+/// GLB and a row of `crowds/*.csv` (about 60 bytes); 10 million is 5,000 walkers on a clip of
+/// 2,000 keys (the default clip has 121).
+pub const MAX_WALKER_KEYS: usize = 10_000_000;
+
+/// `settings`, thinned evenly (with a warning) when their walkers times the clip's `keys`
+/// would pass [`MAX_WALKER_KEYS`].
+fn bounded<T>(settings: Vec<T>, keys: usize, warnings: &mut Vec<crate::model::Warning>) -> Vec<T> {
+    let most = MAX_WALKER_KEYS / (keys + 1);
+    let n = settings.len();
+    if n <= most {
+        return settings;
+    }
+    warnings.push(
+        crate::model::Warning::new(
+            crate::model::WarningClass::Billboards,
+            format!(
+                "people: {n} walkers on a clip of {} keys would be more than {MAX_WALKER_KEYS} \
+                 positions; {most} walkers kept (shorten crowd.duration or lengthen crowd.dt)",
+                keys + 1
+            ),
+        )
+        .for_key("crowd.duration"),
+    );
+    let keep: std::collections::BTreeSet<usize> = (0..most).map(|k| k * n / most).collect();
+    settings
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| keep.contains(i))
+        .map(|(_, s)| s)
+        .collect()
 }
 
 /// The errands of one stretch's people, in groups.
@@ -407,6 +441,19 @@ fn measure(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn walkers_past_the_bound_of_positions_are_thinned_evenly_with_a_warning() {
+        let mut w = Vec::new();
+        let kept = bounded((0..100).collect::<Vec<usize>>(), 99, &mut w);
+        assert_eq!(kept.len(), 100);
+        assert!(w.is_empty());
+        // 20,000 keys a walker: 499 walkers fit in 10 million positions.
+        let kept = bounded((0..1000).collect::<Vec<usize>>(), 20_000, &mut w);
+        assert_eq!(kept.len(), MAX_WALKER_KEYS / 20_001);
+        assert_eq!((kept[0], kept[1]), (0, 2));
+        assert!(w[0].message.contains("crowd.duration"), "{:?}", w[0]);
+    }
 
     #[test]
     fn a_person_belongs_to_the_stretch_its_id_begins_with() {
