@@ -28,6 +28,7 @@ use crate::templates::{Catalog, Kind, TemplateError};
 
 pub mod cache;
 mod check;
+mod names;
 mod plan_files;
 pub mod shards;
 mod writing;
@@ -218,8 +219,8 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
             )));
         }
     }
-    check_billboards(&catalog, params)?;
-    check_halls_and_ground(&catalog, params)?;
+    names::check_billboards(&catalog, params)?;
+    names::check_halls_and_ground(&catalog, params)?;
     let mixes = std::iter::once(("type_mix".to_string(), &params.type_mix)).chain(
         params
             .district
@@ -726,71 +727,6 @@ fn terrain_of<'a>(
     let dem = data.dem.as_ref().filter(|_| params.terrain)?;
     let b = crate::model::tile::tile_bounds(tile, params.tile_size, params.tile_origin)?;
     Some((dem, tile, b))
-}
-
-/// `halls.uses` names hall templates, and `ground.materials` library materials.
-fn check_halls_and_ground(catalog: &Catalog, params: &Params) -> Result<(), BuildError> {
-    if params.halls.enabled {
-        for (u, names) in &params.halls.uses {
-            for name in names {
-                if catalog
-                    .get(name)
-                    .is_none_or(|t| t.kind != Kind::Hall || t.is_abstract)
-                {
-                    return Err(BuildError::Config(format!(
-                        "halls.uses.{u} names `{name}`, which is not a hall template (hall \
-                         templates: {})",
-                        catalog.names_of(Kind::Hall).join(", ")
-                    )));
-                }
-            }
-        }
-    }
-    for (u, m) in &params.ground.materials {
-        if crate::materials::find(m).is_none() {
-            return Err(BuildError::Config(format!(
-                "ground.materials.{u} names `{m}`, which is not a library material (e.g. \
-                 ground, gravel, street, water, moss, stone)"
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// `people.template` / `trees.template` name templates of their kind, and every texture
-/// they list is in the library.
-fn check_billboards(catalog: &Catalog, params: &Params) -> Result<(), BuildError> {
-    let p = &params.people;
-    let t = &params.trees;
-    for (table, enabled, template, kind, textures) in [
-        ("people", p.enabled, &p.template, Kind::Person, &p.textures),
-        ("trees", t.enabled, &t.template, Kind::Tree, &t.textures),
-    ] {
-        if !enabled {
-            continue;
-        }
-        if catalog
-            .get(template)
-            .is_none_or(|t| t.kind != kind || t.is_abstract)
-        {
-            return Err(BuildError::Config(format!(
-                "{table}.template names `{template}`, which is not a {} template ({} templates: {})",
-                kind.name(),
-                kind.name(),
-                catalog.names_of(kind).join(", ")
-            )));
-        }
-        if let Some(bad) = textures
-            .iter()
-            .find(|n| crate::materials::find(n).is_none())
-        {
-            return Err(BuildError::Config(format!(
-                "{table}.textures names `{bad}`, which is not in the texture library ({})",
-                crate::materials::names().join(", ")
-            )));
-        }
-    }
-    Ok(())
 }
 
 /// The files each layer's features come from, for skip reports.
