@@ -9,6 +9,7 @@
 
 use std::fmt::Write as _;
 
+use super::species::quote;
 use crate::model::Walk;
 
 /// The directory of the files, relative to the output directory.
@@ -39,15 +40,6 @@ pub fn csv(walks: &[Walk]) -> String {
         }
     }
     out
-}
-
-/// A CSV field, quoted when it holds a comma, a quote or a line break.
-fn quote(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 #[cfg(test)]

@@ -131,8 +131,9 @@ pub fn write_species(
     Ok(files)
 }
 
-/// A CSV field, quoted when it holds a comma, a quote or a line break.
-fn quote(s: &str) -> String {
+/// A CSV field, quoted when it holds a comma, a quote or a line break (placements.csv and
+/// crowds/*.csv).
+pub(crate) fn quote(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
