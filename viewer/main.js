@@ -261,6 +261,9 @@ function point(east, north, up) {
 }
 
 function lookAt(east, north, up = 0, height = 60) {
+  // Not ready until the tiles of the new view are in (the animation loop marks it again):
+  // a caller that waits for `ready` after moving must not see the old view's flag.
+  api.ready = false;
   const p = point(east, north, up);
   camera.position.set(p.x, p.y + height, p.z + height * 0.02);
   controls.target.copy(p);
@@ -270,6 +273,7 @@ function lookAt(east, north, up = 0, height = 60) {
 
 /** A view of a point from 18 m away at 45 degrees azimuth, 8 m above it. */
 function lookFrom(east, north, up = 0) {
+  api.ready = false;
   const p = point(east, north, up);
   camera.position.set(p.x + 13, p.y + 8, p.z + 13);
   controls.target.copy(p);
