@@ -2,15 +2,16 @@
 
 CARGO ?= cargo
 
-.PHONY: run test test-cluster test-future lint bench crowd-fd real textures fixtures clean pictures bad-input viewer-deps gis-deps
+.PHONY: run test test-cluster test-future lint bench crowd-fd real textures fixtures clean pictures bad-input viewer-deps gis-deps blender-deps
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
 	$(CARGO) run --release -- build fixtures/kyoto-small --out out
 
 ## Unit, property, end-to-end and doc tests; the glTF validator and the browser test need
-## the viewer's npm packages, the GeoPackage tests GDAL (installed first when missing).
-test: viewer-deps gis-deps
+## the viewer's npm packages, the GeoPackage tests GDAL, the crowd's clip Blender (each
+## installed first when missing).
+test: viewer-deps gis-deps blender-deps
 	$(CARGO) test --all-targets
 	$(CARGO) test --doc
 
@@ -18,6 +19,10 @@ test: viewer-deps gis-deps
 ## exactly as viewer/package-lock.json pins them, and Debian's chromium for the browser test.
 viewer-deps:
 	bash scripts/viewer-deps.sh
+
+## Debian's blender, whose glTF importer tests/crowd_clip.rs runs on the walkers' clip.
+blender-deps:
+	bash scripts/blender-deps.sh
 
 ## Debian's gdal-bin and python3-gdal, with which tests/gpkg.rs reads plan.gpkg.
 gis-deps:

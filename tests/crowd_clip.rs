@@ -182,21 +182,28 @@ fn node_clip(glb: &[u8], json: &serde_json::Value, person: &str) -> Vec<(f32, [f
         .collect()
 }
 
-#[test]
-fn the_glb_clip_moves_each_walker_through_its_csv_places_in_the_file_and_in_three_js() {
-    let dir = tempfile::tempdir().unwrap();
-    let params = dir.path().join("p.toml");
+/// The example town with walkers, its GLB uncompressed (Blender 3.4 and the validator read
+/// no meshopt), built into `dir/out`.
+fn walking_town(dir: &Path) -> std::path::PathBuf {
+    let params = dir.join("p.toml");
     std::fs::write(
         &params,
         "[people]\nmotion = \"boids\"\nper_100m = 12.0\n[output]\nglb_compression = \"none\"\n",
     )
     .unwrap();
-    let out = dir.path().join("out");
+    let out = dir.join("out");
     build_ok(
         &fixture("kyoto-small"),
         &out,
         &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
     );
+    out
+}
+
+#[test]
+fn the_glb_clip_moves_each_walker_through_its_csv_places_in_the_file_and_in_three_js() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = walking_town(dir.path());
     let (keys, _) = clips(&out);
     // Khronos' validator reads the animation (uncompressed here) without an error or warning.
     common::validate_glbs(&out);
@@ -306,6 +313,131 @@ fn the_glb_clip_moves_each_walker_through_its_csv_places_in_the_file_and_in_thre
         .unwrap()
         .iter()
         .any(|s| s["street"] == chart["street"]));
+}
+
+/// Debian's Blender on tests/blender/clip.py: its JSON line (every `person_<id>` object's
+/// world place and yaw at each of `times`). Blender, like rustc, stalls under the libfaketime
+/// that scripts/test-future.sh preloads (recursive clock_gettime in its allocator): it runs
+/// on the real clock, as the browser does; it only reads the file a build wrote.
+fn blender_clip(glb: &Path, times: &[f64], home: &Path) -> serde_json::Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/clip.py");
+    assert!(
+        Path::new("/usr/bin/blender").exists(),
+        "Debian's blender is missing: run `make blender-deps`"
+    );
+    // `timeout`: a hung Blender fails the test instead of holding the suite.
+    let o = std::process::Command::new("timeout")
+        .args(["300", "/usr/bin/blender", "-b", "--factory-startup"])
+        .args(["--python-exit-code", "1", "--python"])
+        .arg(&script)
+        .arg("--")
+        .arg(glb)
+        .args(times.iter().map(|t| t.to_string()))
+        .env_remove("LD_PRELOAD")
+        .env_remove("FAKETIME")
+        .env("HOME", home)
+        .env("BLENDER_USER_CONFIG", home)
+        .env("BLENDER_USER_SCRIPTS", home)
+        .output()
+        .expect("blender runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{text}");
+    let line = text
+        .lines()
+        .find_map(|l| l.strip_prefix("EDO_CITY_JSON "))
+        .unwrap_or_else(|| panic!("no EDO_CITY_JSON line: {text}"));
+    serde_json::from_str(line).unwrap()
+}
+
+/// The difference of two angles in radians, folded into 0..=pi.
+fn angle_between(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(std::f64::consts::TAU);
+    d.min(std::f64::consts::TAU - d)
+}
+
+#[test]
+fn blenders_gltf_importer_plays_the_same_clip_as_the_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = walking_town(dir.path());
+    let (keys, _) = clips(&out);
+    let m = read_json(&out.join("manifest.json"));
+    let origin = [
+        m["origin"][0].as_f64().unwrap(),
+        m["origin"][1].as_f64().unwrap(),
+    ];
+    let mut walkers = 0;
+    let mut turned = 0;
+    // Every tile with walkers, each walker at every key of its CSV (every 0.5 s, 0-60 s).
+    for tile in m["tiles"].as_array().unwrap() {
+        let Some(csv) = tile["crowds"]["path"].as_str() else {
+            continue;
+        };
+        let text = std::fs::read_to_string(out.join(csv)).unwrap();
+        let in_tile: std::collections::BTreeSet<&str> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(1).unwrap())
+            .collect();
+        let glb = out.join(tile["glb"]["path"].as_str().unwrap());
+        // A tile's GLB is about its centre (the tileset's transform puts it in place).
+        let centre = [
+            origin[0] + tile["centre"][0].as_f64().unwrap(),
+            origin[1] + tile["centre"][1].as_f64().unwrap(),
+        ];
+        let times: Vec<f64> = keys[*in_tile.first().unwrap()]
+            .iter()
+            .map(|k| k[0])
+            .collect();
+        assert_eq!(times.len(), 121);
+        let got = blender_clip(&glb, &times, dir.path());
+        // The importer's clock: 24 frames a second, time 0 at frame 0.
+        assert_eq!(got["fps"], 24.0, "{got}");
+        let at = got["at"].as_object().unwrap();
+        assert_eq!(
+            at.keys().map(String::as_str).collect::<Vec<_>>(),
+            in_tile.iter().copied().collect::<Vec<_>>(),
+            "one Blender object per walker of {csv}"
+        );
+        for (id, places) in at {
+            let k = &keys[id];
+            let places = places.as_array().unwrap();
+            assert_eq!(places.len(), k.len());
+            for (p, key) in places.iter().zip(k) {
+                let f = |i: usize| p[i].as_f64().unwrap();
+                // Blender turns glTF's Y up into Z up: x east, y north of the tile's
+                // centre. Within the 2 cm the clip's thinning allows, and the CSV's mm.
+                let off = (f(0) - (key[1] - centre[0])).hypot(f(1) - (key[2] - centre[1]));
+                assert!(
+                    off < 0.025,
+                    "{id} at {} s: Blender {:?}, CSV {key:?}",
+                    key[0],
+                    p
+                );
+                assert!((f(2) - key[3]).abs() < 0.025, "{id} at {} s: {p:?}", key[0]);
+                // Its yaw about Z is the CSV's heading (the thinning's 0.02 rad, nlerp).
+                let yaw = angle_between(f(3), key[4].to_radians());
+                assert!(
+                    yaw < 0.03,
+                    "{id} at {} s: yaw {} vs heading {}",
+                    key[0],
+                    f(3),
+                    key[4]
+                );
+            }
+            if angle_between(k[0][4].to_radians(), k[k.len() / 2][4].to_radians()) > 0.5 {
+                turned += 1;
+            }
+            walkers += 1;
+        }
+    }
+    assert!(
+        walkers > 100 && turned > 10,
+        "{walkers} walkers, {turned} turned"
+    );
 }
 
 #[test]
