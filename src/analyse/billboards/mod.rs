@@ -28,6 +28,11 @@ use crate::model::{
 use crate::params::Params;
 use crate::rng::feature_rng;
 use crate::templates::Catalog;
+use kind::Kind;
+use thinning::{cap_tiles, keep_spaced, thin};
+
+mod kind;
+mod thinning;
 
 /// Streets are cut into pieces no longer than this, each a source of its own.
 const PIECE: f64 = 20.0;
@@ -276,98 +281,6 @@ pub fn plan_billboards(
     for stat in &mut plan.crowds {
         stat.districts = placed.remove(&stat.street).unwrap_or_default();
         stat.agents = stat.districts.values().sum();
-    }
-}
-
-/// The settings of one kind of billboard.
-struct Kind<'a> {
-    kind: BillboardKind,
-    enabled: bool,
-    layer: &'static str,
-    file: &'a str,
-    height: [f64; 2],
-    textures: &'a [String],
-    min_spacing: f64,
-    clearance: f64,
-    max_per_tile: usize,
-    max_turn: f64,
-    /// The parameter that sets the density, for messages.
-    density_key: &'static str,
-}
-
-impl<'a> Kind<'a> {
-    fn of(kind: BillboardKind, p: &'a Params) -> Kind<'a> {
-        match kind {
-            BillboardKind::Person => Kind {
-                kind,
-                enabled: p.people.enabled,
-                layer: "people",
-                file: &p.layers.people.file,
-                height: p.people.height,
-                textures: &p.people.textures,
-                min_spacing: p.people.min_spacing,
-                clearance: p.people.clearance,
-                max_per_tile: p.people.max_points_per_tile,
-                max_turn: p.people.max_turn_deg.to_radians(),
-                density_key: "people.per_100m",
-            },
-            BillboardKind::Tree => Kind {
-                kind,
-                enabled: p.trees.enabled,
-                layer: "trees",
-                file: &p.layers.trees.file,
-                height: p.trees.height,
-                textures: &p.trees.textures,
-                min_spacing: p.trees.min_spacing,
-                clearance: p.trees.clearance,
-                max_per_tile: p.trees.max_points_per_tile,
-                max_turn: std::f64::consts::PI,
-                density_key: "trees.per_ha / trees.per_ha_machiya",
-            },
-        }
-    }
-
-    /// Height, texture, facing and key of a point, drawn from `rng` (or taken from the point).
-    fn dress(
-        &self,
-        rng: &mut impl rand::Rng,
-        id: String,
-        at: Coord<f64>,
-        along: f64,
-        (district, ground): (Option<String>, f64),
-        tile_of: impl Fn(Coord<f64>) -> String,
-    ) -> Candidate {
-        let [lo, hi] = self.height;
-        let height = lo + rng.random::<f64>() * (hi - lo);
-        let texture = self.textures[rng.random_range(0..self.textures.len())].clone();
-        // A person walks either way along the street, turned by at most max_turn; a tree
-        // turns freely (its two quads repeat every quarter turn).
-        let facing = match self.kind {
-            BillboardKind::Person => {
-                let back = if rng.random_bool(0.5) {
-                    std::f64::consts::PI
-                } else {
-                    0.0
-                };
-                along + back + (2.0 * rng.random::<f64>() - 1.0) * self.max_turn
-            }
-            BillboardKind::Tree => rng.random::<f64>() * std::f64::consts::FRAC_PI_2,
-        };
-        Candidate {
-            key: rng.random::<u64>(),
-            b: PlannedBillboard {
-                kind: self.kind,
-                id,
-                at,
-                facing,
-                height,
-                texture,
-                ground,
-                district,
-                tile: tile_of(at),
-                tree: None,
-            },
-        }
     }
 }
 
@@ -689,85 +602,6 @@ fn texture_of(raw: &str, textures: &[String]) -> Option<String> {
     crate::materials::find(raw).map(|_| raw.to_string())
 }
 
-/// Hard-core thinning: in the order of the points' random keys, a point is kept when no kept
-/// point lies within `spacing`. The result is in key order, so it does not depend on the
-/// order the points were made in.
-fn thin(mut points: Vec<Candidate>, spacing: f64) -> Vec<PlannedBillboard> {
-    points.sort_by(|a, b| a.key.cmp(&b.key).then_with(|| a.b.id.cmp(&b.b.id)));
-    keep_spaced(points.into_iter().map(|c| c.b).collect(), spacing)
-}
-
-/// The points in the order given, each kept when no kept point is nearer than `spacing`.
-fn keep_spaced(points: Vec<PlannedBillboard>, spacing: f64) -> Vec<PlannedBillboard> {
-    if spacing <= 0.0 {
-        return points;
-    }
-    let cell = |c: Coord<f64>| {
-        (
-            (c.x / spacing).floor() as i64,
-            (c.y / spacing).floor() as i64,
-        )
-    };
-    // Looked up, never iterated: the hasher changes no result (foldhash: SipHash showed up).
-    let mut grid: HashMap<(i64, i64), Vec<Coord<f64>>, foldhash::fast::FixedState> =
-        HashMap::default();
-    let mut kept = Vec::new();
-    for b in points {
-        let (i, j) = cell(b.at);
-        // A spacing of 1e-300 m puts every point in a cell at the ends of i64: saturate.
-        let crowded = (i.saturating_sub(1)..=i.saturating_add(1)).any(|x| {
-            (j.saturating_sub(1)..=j.saturating_add(1)).any(|y| {
-                grid.get(&(x, y)).is_some_and(|v| {
-                    v.iter()
-                        .any(|q| (q.x - b.at.x).hypot(q.y - b.at.y) < spacing)
-                })
-            })
-        });
-        if !crowded {
-            grid.entry((i, j)).or_default().push(b.at);
-            kept.push(b);
-        }
-    }
-    kept
-}
-
-/// At most `max_points_per_tile` per tile (the densities were scaled to that, but a Poisson
-/// draw can exceed it): the first in key order stay. Each tile's points are then put in id
-/// order.
-fn cap_tiles(
-    points: Vec<PlannedBillboard>,
-    k: &Kind,
-    warnings: &mut Vec<crate::model::Warning>,
-) -> Vec<PlannedBillboard> {
-    let mut per_tile: BTreeMap<String, Vec<PlannedBillboard>> = BTreeMap::new();
-    for b in points {
-        per_tile.entry(b.tile.clone()).or_default().push(b);
-    }
-    let mut out = Vec::new();
-    for (tile, mut v) in per_tile {
-        if v.len() > k.max_per_tile {
-            warnings.push(
-                crate::model::Warning::new(
-                    crate::model::WarningClass::Billboards,
-                    format!(
-                "{}: tile {tile} has {} points, more than max_points_per_tile = {}; the first \
-                 {} were kept",
-                k.layer,
-                v.len(),
-                k.max_per_tile,
-                k.max_per_tile
-            ),
-                )
-                .for_key(&format!("{}.max_points_per_tile", k.layer)),
-            );
-            v.truncate(k.max_per_tile);
-        }
-        v.sort_by(|a, b| a.id.cmp(&b.id));
-        out.extend(v);
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -793,44 +627,6 @@ mod tests {
         // A box over a whole country (damaged data) goes to its centroid's tile alone.
         let huge = geo_types::Rect::new(Coord { x: 0.0, y: 0.0 }, Coord { x: 1e7, y: 1e7 });
         assert_eq!(tiles_under(huge, Coord { x: 5.0, y: 5.0 }, &p).len(), 1);
-    }
-
-    fn candidate(key: u64, x: f64) -> Candidate {
-        Candidate {
-            key,
-            b: PlannedBillboard {
-                kind: BillboardKind::Tree,
-                id: format!("{key}"),
-                at: Coord { x, y: 0.0 },
-                facing: 0.0,
-                height: 5.0,
-                texture: "tree_01".into(),
-                ground: 0.0,
-                district: None,
-                tile: "0_0".into(),
-                tree: None,
-            },
-        }
-    }
-
-    #[test]
-    fn thinning_keeps_the_lowest_key_of_close_points_whatever_their_order() {
-        let make = || {
-            vec![
-                candidate(9, 0.0),
-                candidate(3, 1.0),
-                candidate(5, 2.5),
-                candidate(1, 10.0),
-            ]
-        };
-        let kept: Vec<String> = thin(make(), 2.0).into_iter().map(|b| b.id).collect();
-        // 1 (alone), 3 (beats 9 at 1 m), 5 is 1.5 m from 3: dropped; 9 is 1 m from 3: dropped.
-        assert_eq!(kept, ["1", "3"]);
-        let mut reversed = make();
-        reversed.reverse();
-        let again: Vec<String> = thin(reversed, 2.0).into_iter().map(|b| b.id).collect();
-        assert_eq!(kept, again);
-        assert_eq!(thin(make(), 0.0).len(), 4);
     }
 
     #[test]
