@@ -9,7 +9,7 @@
 //   house.json: {"lot": "12", "east": 10.5, "north": 20.1, "up": 9.3} (map metres from the
 //   build's origin; a point on the house's roof)
 import { readFile } from 'node:fs/promises';
-import { chromium } from 'playwright-core';
+import { launchChromium } from './launch.mjs';
 
 const [url, houseFile, shot] = process.argv.slice(2);
 if (!url || !houseFile) {
@@ -20,20 +20,7 @@ const house = JSON.parse(await readFile(houseFile, 'utf8'));
 const problems = [];
 const fail = (m) => problems.push(m);
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  headless: true,
-  args: [
-    '--use-angle=swiftshader',
-    '--enable-unsafe-swiftshader',
-    '--no-sandbox',
-    '--disable-background-networking',
-    '--disable-component-update',
-    '--disable-sync',
-    '--no-first-run',
-    '--disable-quic',
-  ],
-});
+const browser = await launchChromium();
 const out = {};
 try {
   const page = await browser.newPage({ viewport: { width: 1024, height: 640 } });

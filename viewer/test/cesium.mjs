@@ -6,7 +6,7 @@
 // the middle of the picture, the time to ready.
 //
 // Usage: node test/cesium.mjs <url> [screenshot.png]
-import { chromium } from 'playwright-core';
+import { launchChromium } from './launch.mjs';
 
 const [url, shot] = process.argv.slice(2);
 if (!url) {
@@ -15,12 +15,7 @@ if (!url) {
 }
 const problems = [];
 const fail = (m) => problems.push(m);
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  headless: true,
-  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic'],
-});
+const browser = await launchChromium();
 const out = {};
 try {
   const page = await browser.newPage({ viewport: { width: 1024, height: 640 } });

@@ -10,7 +10,7 @@
 //     reloads the viewer after a rebuild and prints the garden as the build lists it now.
 //   node test/garden.mjs <url> time <lot> <population> <generations>
 //     times "next generation" (server + transfer, then drawing the candidates).
-import { chromium } from 'playwright-core';
+import { launchChromium } from './launch.mjs';
 
 const [url, phase, lot, arg4, arg5] = process.argv.slice(2);
 if (!url || !phase || !lot) {
@@ -20,12 +20,7 @@ if (!url || !phase || !lot) {
 const problems = [];
 const fail = (m) => problems.push(m);
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  headless: true,
-  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic'],
-});
+const browser = await launchChromium();
 const out = { phase };
 try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 720 } });

@@ -2,13 +2,19 @@
 // the server's, each console error, page error and HTTP error collected in `errors`.
 import { chromium } from 'playwright-core';
 
-export async function openPage(viewport = { width: 1280, height: 720 }) {
-  const browser = await chromium.launch({
+/** Debian's chromium (`$CHROMIUM`, default /usr/bin/chromium), headless, WebGL on SwiftShader,
+ * with nothing of its own reaching for the network (this machine's network is closed). */
+export function launchChromium() {
+  return chromium.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
     headless: true,
     args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-background-networking',
       '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic'],
   });
+}
+
+export async function openPage(viewport = { width: 1280, height: 720 }) {
+  const browser = await launchChromium();
   const errors = [];
   const page = await browser.newPage({ viewport });
   page.on('pageerror', (e) => errors.push(`page error: ${e.message}`));
