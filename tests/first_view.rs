@@ -120,6 +120,19 @@ fn the_first_overview_comes_from_the_parents_within_the_budget() {
         "{stats} vs {on_disk} bytes"
     );
 
+    // The trees' toggle reaches the parents: their trees (a node of kind `trees`) go with
+    // their triangles, and come back.
+    let toggle = &got["toggle"];
+    let f = |k: &str, v: &str| toggle[k][v].as_f64().unwrap();
+    assert!(f("on", "treeNodesShown") >= 1.0, "{toggle}");
+    assert_eq!(f("off", "treeNodesShown"), 0.0, "{toggle}");
+    assert!(
+        f("off", "triangles") < f("on", "triangles")
+            && toggle["off"]["hash"] != toggle["on"]["hash"],
+        "{toggle}"
+    );
+    assert_eq!(toggle["again"], toggle["on"], "{toggle}");
+
     // Up close, the tree is an instance of its variant, and a click names its own row.
     assert!(
         got["picked"]["instance"].is_u64(),

@@ -450,24 +450,43 @@ fn parents_hold_the_city_coarser_and_still_name_every_lot() {
             here > 0 && here < below,
             "{uri}: {here} triangles against {below} below"
         );
-        // One node: its translation and scale place the quantized positions in the box.
-        let n = &g["nodes"][0];
-        assert_eq!(n["name"], "lod");
-        let t = floats(&n["translation"]);
-        let sc = floats(&n["scale"])[0];
-        for p in g["meshes"][0]["primitives"].as_array().unwrap() {
-            let a = &g["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
-            for m in [&a["min"], &a["max"]] {
-                let v = floats(m);
-                let y_up = [t[0] + sc * v[0], t[1] + sc * v[1], t[2] + sc * v[2]];
-                assert!(
-                    inside(
-                        &node["boundingVolume"]["box"],
-                        [y_up[0], -y_up[2], y_up[1]],
-                        0.1
-                    ),
-                    "{uri}: a vertex outside its box"
-                );
+        // A node per kind of object (so the viewer's kind toggles reach the parents), named
+        // and marked as the leaves' nodes are; the houses among them. Each node's
+        // translation and scale place its quantized positions in the box.
+        let nodes = g["nodes"].as_array().unwrap();
+        let kinds: Vec<&str> = nodes
+            .iter()
+            .map(|n| n["extras"]["kind"].as_str().unwrap())
+            .collect();
+        assert!(kinds.windows(2).all(|w| w[0] < w[1]), "{uri}: {kinds:?}");
+        assert!(
+            kinds.contains(&"machiya") && kinds.len() > 3,
+            "{uri}: {kinds:?}"
+        );
+        for n in nodes {
+            assert_eq!(
+                n["name"],
+                format!("lod_{}", n["extras"]["kind"].as_str().unwrap())
+            );
+        }
+        for n in nodes {
+            let t = floats(&n["translation"]);
+            let sc = floats(&n["scale"])[0];
+            let mesh = &g["meshes"][n["mesh"].as_u64().unwrap() as usize];
+            for p in mesh["primitives"].as_array().unwrap() {
+                let a = &g["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
+                for m in [&a["min"], &a["max"]] {
+                    let v = floats(m);
+                    let y_up = [t[0] + sc * v[0], t[1] + sc * v[1], t[2] + sc * v[2]];
+                    assert!(
+                        inside(
+                            &node["boundingVolume"]["box"],
+                            [y_up[0], -y_up[2], y_up[1]],
+                            0.1
+                        ),
+                        "{uri}: a vertex outside its box"
+                    );
+                }
             }
         }
         assert!(

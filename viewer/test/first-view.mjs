@@ -38,6 +38,28 @@ try {
         }),
     );
   out.overview = await measure();
+  // The panel's kind toggles on the overview's parents: trees off, then on again (the
+  // triangles drawn and the picture, and the tree nodes still shown).
+  const toggled = () =>
+    page.evaluate(() => {
+      window.edoCity.stats.triangles = 0;
+      return new Promise((resolve) =>
+        requestAnimationFrame(() =>
+          requestAnimationFrame(() => {
+            let shown = 0;
+            window.edoCity.scene.traverse((o) => {
+              if (o.userData.kind === 'trees' && o.visible) shown += 1;
+            });
+            resolve({ triangles: window.edoCity.stats.triangles, hash: window.edoCity.sample().hash, treeNodesShown: shown });
+          }),
+        ),
+      );
+    });
+  out.toggle = { on: await toggled() };
+  await page.click('#toggles input[data-kinds="trees"]');
+  out.toggle.off = await toggled();
+  await page.click('#toggles input[data-kinds="trees"]');
+  out.toggle.again = await toggled();
   // What the first view fetched: each of the builds' files (path under the build) and its bytes.
   out.fetched = await page.evaluate(() =>
     performance

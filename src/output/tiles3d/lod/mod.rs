@@ -46,14 +46,16 @@ pub struct Part {
 }
 
 impl Part {
-    /// Appends vertex `v` of `from` to the triangle list (its position, colour and row, once:
-    /// `seen` maps `from`'s vertices to those added, `u32::MAX` for none yet).
+    /// Appends vertex `v` of `from` to the triangle list (its position, colour or texture
+    /// coordinates, whichever `from` has, and row, once: `seen` maps `from`'s vertices to
+    /// those added, `u32::MAX` for none yet).
     fn keep(&mut self, from: &Part, v: u32, seen: &mut [u32]) {
         let v = v as usize;
         if seen[v] == u32::MAX {
             seen[v] = self.positions.len() as u32;
             self.positions.push(from.positions[v]);
-            self.colours.push(from.colours[v]);
+            self.colours.extend(from.colours.get(v));
+            self.uvs.extend(from.uvs.get(v));
             self.ids.push(from.ids[v]);
         }
         self.indices.push(seen[v]);

@@ -1,10 +1,12 @@
-//! A parent's content as GLB: one node placed at the content's centre (in the root's frame,
-//! y up as glTF has it) holding one mesh: a primitive of every opaque surface coloured per
+//! A parent's content as GLB: a node per kind of object (`machiya`, `trees`, `ground`, ...:
+//! the metadata's `kind`, in `extras.kind` as the leaves have it, so a viewer's kind toggles
+//! work at every level), each placed at the content's centre (in the root's frame, y up as
+//! glTF has it) and holding one mesh: a primitive of the kind's opaque surfaces coloured per
 //! vertex (`COLOR_0`, no texture), and one per cut-out material with its texture. No normals:
 //! clients shade a primitive without them flat, as glTF asks, and massing is all flat faces.
 //! The metadata table is the leaves' rows, so a feature id still names its lot.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 use serde_json::{json, Value};
 
@@ -43,16 +45,17 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
     }
     let (centre, step) = frame(content, &solid);
     let mut buf = Buffer::new(meshopt);
-    let mut primitives = Vec::new();
     let mut materials = vec![json!({
         "name": "massing",
         "pbrMetallicRoughness": {"metallicFactor": 0.0, "roughnessFactor": 0.9},
     })];
     let (mut images, mut textures) = (Vec::new(), Vec::new());
-    if !solid.indices.is_empty() {
-        let mut p = primitive(&mut buf, &solid, centre, step, 0, false);
-        p["attributes"]["COLOR_0"] = json!(buf.colours(&solid.colours));
-        primitives.push(p);
+    // Each kind's primitives, in kind order: its solid surfaces, then its cut-outs.
+    let mut kinds: BTreeMap<String, Vec<Value>> = BTreeMap::new();
+    for (kind, part) in by_kind(&solid, &content.features) {
+        let mut p = primitive(&mut buf, &part, centre, step, 0, false);
+        p["attributes"]["COLOR_0"] = json!(buf.colours(&part.colours));
+        kinds.entry(kind).or_default().push(p);
     }
     for (name, cut) in &content.cutouts {
         if cut.part.indices.is_empty() {
@@ -71,8 +74,10 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
             "alphaCutoff": 0.5,
             "doubleSided": true,
         }));
-        let p = primitive(&mut buf, &cut.part, centre, step, materials.len() - 1, true);
-        primitives.push(p);
+        for (kind, part) in by_kind(&cut.part, &content.features) {
+            let p = primitive(&mut buf, &part, centre, step, materials.len() - 1, true);
+            kinds.entry(kind).or_default().push(p);
+        }
     }
     let mut doc = json!({
         "asset": {
@@ -83,19 +88,30 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
         "scene": 0,
         "scenes": [{"name": name}],
     });
-    if !primitives.is_empty() {
+    if !kinds.is_empty() {
         let metadata = metadata::structural_metadata(&content.features, &mut buf);
         crate::output::gltf::declare_extensions(&mut doc, &buf);
         doc["extensions"] = json!({"EXT_structural_metadata": metadata});
-        doc["scenes"][0]["nodes"] = json!([0]);
-        doc["nodes"] = json!([{
-            "name": "lod",
-            "mesh": 0,
-            "translation": [centre[0], centre[2], -centre[1]],
-            "scale": [step, step, step],
-            "extras": {"kind": "lod"},
-        }]);
-        doc["meshes"] = json!([{"name": "lod", "primitives": primitives}]);
+        doc["scenes"][0]["nodes"] = json!((0..kinds.len()).collect::<Vec<_>>());
+        let nodes: Vec<Value> = kinds
+            .keys()
+            .enumerate()
+            .map(|(i, kind)| {
+                json!({
+                    "name": format!("lod_{kind}"),
+                    "mesh": i,
+                    "translation": [centre[0], centre[2], -centre[1]],
+                    "scale": [step, step, step],
+                    "extras": {"kind": kind},
+                })
+            })
+            .collect();
+        let meshes: Vec<Value> = kinds
+            .into_iter()
+            .map(|(kind, primitives)| json!({"name": format!("lod_{kind}"), "primitives": primitives}))
+            .collect();
+        doc["nodes"] = json!(nodes);
+        doc["meshes"] = json!(meshes);
         doc["materials"] = json!(materials);
         doc["buffers"] = buf.buffers_json();
         doc["bufferViews"] = json!(buf.views);
@@ -103,6 +119,33 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
         crate::output::gltf::add_images(&mut doc, images, textures);
     }
     buffer::glb(&doc, buf.bin)
+}
+
+/// The triangles of `part` by the kind of their feature (the metadata row of their first
+/// vertex; a row out of range is `other`), each with only the vertices it uses, in kind order.
+fn by_kind(part: &Part, features: &[crate::output::features::Feature]) -> Vec<(String, Part)> {
+    let kind_of = |v: u32| {
+        features
+            .get(part.ids[v as usize] as usize)
+            .map_or("other", |f| f.kind.as_str())
+    };
+    let mut triangles: BTreeMap<&str, Vec<&[u32]>> = BTreeMap::new();
+    for t in part.indices.chunks_exact(3) {
+        triangles.entry(kind_of(t[0])).or_default().push(t);
+    }
+    // One map of vertices for every kind, cleared between them.
+    let mut seen = vec![u32::MAX; part.positions.len()];
+    triangles
+        .into_iter()
+        .map(|(kind, tris)| {
+            seen.fill(u32::MAX);
+            let mut into = Part::default();
+            for &v in tris.iter().flat_map(|t| t.iter()) {
+                into.keep(part, v, &mut seen);
+            }
+            (kind.to_string(), into)
+        })
+        .collect()
 }
 
 /// The point the content's positions are taken around (the middle of its box, whole
@@ -208,5 +251,40 @@ fn reordered(part: &Part) -> Part {
         uvs: permute(&part.uvs, &remap, used),
         ids: permute(&part.ids, &remap, used),
         indices: indices.iter().map(|&i| remap[i as usize]).collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::output::features::Feature;
+
+    #[test]
+    fn triangles_are_grouped_by_their_features_kind_with_their_own_vertices() {
+        let feature = |kind: &str| Feature {
+            kind: kind.into(),
+            ..Feature::default()
+        };
+        let features = [feature("trees"), feature("machiya")];
+        // Two triangles of a tree sharing an edge, one house, one of a row out of range.
+        let part = Part {
+            positions: (0..8).map(|i| [i as f64, 0.0, 0.0]).collect(),
+            colours: Vec::new(),
+            uvs: (0..8).map(|i| [i as f32 / 8.0, 0.5]).collect(),
+            ids: vec![0, 0, 0, 0, 1, 1, 1, 9],
+            indices: vec![4, 5, 6, 0, 1, 2, 2, 1, 3, 7, 7, 7],
+        };
+        let groups = by_kind(&part, &features);
+        let kinds: Vec<&str> = groups.iter().map(|(k, _)| k.as_str()).collect();
+        assert_eq!(kinds, ["machiya", "other", "trees"]);
+        let trees = &groups[2].1;
+        assert_eq!(trees.indices, [0, 1, 2, 2, 1, 3]);
+        assert_eq!(trees.positions.len(), 4);
+        assert_eq!(trees.uvs, part.uvs[..4]);
+        assert!(trees.colours.is_empty());
+        assert_eq!(groups[0].1.positions[0], [4.0, 0.0, 0.0]);
+        assert_eq!(groups[0].1.ids, [1, 1, 1]);
+        let total: usize = groups.iter().map(|(_, p)| p.indices.len()).sum();
+        assert_eq!(total, part.indices.len());
     }
 }
