@@ -340,12 +340,7 @@ fn blender_clip(glb: &Path, times: &[f64], home: &Path) -> serde_json::Value {
         .env("BLENDER_USER_SCRIPTS", home)
         .output()
         .expect("blender runs");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert!(o.status.success(), "{text}");
+    let text = common::succeeded(&o);
     let line = text
         .lines()
         .find_map(|l| l.strip_prefix("EDO_CITY_JSON "))

@@ -431,12 +431,7 @@ pub fn run_browser_script(
         cmd.env(k, v);
     }
     let o = cmd.output().expect("node runs");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert!(o.status.success(), "{text}");
+    let text = succeeded(&o);
     let stdout = String::from_utf8_lossy(&o.stdout);
     let last = stdout.lines().last().unwrap_or("null");
     (serde_json::from_str(last).unwrap(), text)
@@ -457,12 +452,19 @@ pub fn validate_glbs(out: &Path) -> String {
         .arg(out)
         .output()
         .expect("node runs");
+    let text = succeeded(&o);
+    assert!(text.contains("0 with errors or warnings"), "{text}");
+    text
+}
+
+/// A finished tool's stdout and stderr together, after failing the test with them unless it
+/// succeeded.
+pub fn succeeded(o: &std::process::Output) -> String {
     let text = format!(
         "{}{}",
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     );
     assert!(o.status.success(), "{text}");
-    assert!(text.contains("0 with errors or warnings"), "{text}");
     text
 }

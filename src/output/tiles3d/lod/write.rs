@@ -93,23 +93,18 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
         crate::output::gltf::declare_extensions(&mut doc, &buf);
         doc["extensions"] = json!({"EXT_structural_metadata": metadata});
         doc["scenes"][0]["nodes"] = json!((0..kinds.len()).collect::<Vec<_>>());
-        let nodes: Vec<Value> = kinds
-            .keys()
-            .enumerate()
-            .map(|(i, kind)| {
-                json!({
-                    "name": format!("lod_{kind}"),
-                    "mesh": i,
-                    "translation": [centre[0], centre[2], -centre[1]],
-                    "scale": [step, step, step],
-                    "extras": {"kind": kind},
-                })
-            })
-            .collect();
-        let meshes: Vec<Value> = kinds
-            .into_iter()
-            .map(|(kind, primitives)| json!({"name": format!("lod_{kind}"), "primitives": primitives}))
-            .collect();
+        let (mut nodes, mut meshes) = (Vec::new(), Vec::new());
+        for (i, (kind, primitives)) in kinds.into_iter().enumerate() {
+            let name = format!("lod_{kind}");
+            nodes.push(json!({
+                "name": name,
+                "mesh": i,
+                "translation": [centre[0], centre[2], -centre[1]],
+                "scale": [step, step, step],
+                "extras": {"kind": kind},
+            }));
+            meshes.push(json!({"name": name, "primitives": primitives}));
+        }
         doc["nodes"] = json!(nodes);
         doc["meshes"] = json!(meshes);
         doc["materials"] = json!(materials);
