@@ -287,11 +287,21 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcom
         // template is still the error named first.
         let (catalog, textures) = rayon::join(
             || load_catalog(&opts.params, opts.templates.as_deref()),
-            || output::texture_library(&opts.params.textures).and_then(output::with_masks),
+            || {
+                let glb = opts.params.output.formats.iter().any(|f| f == "glb");
+                output::texture_library(&opts.params.textures)
+                    .and_then(output::with_masks)
+                    .and_then(|lib| output::atlas::with_atlas(lib, glb))
+            },
         );
         let catalog = catalog?;
-        let textures = textures.map_err(BuildError::Config)?;
-        run(opts, &catalog, &textures, progress, t0)
+        let (textures, atlas, no_atlas) = textures.map_err(BuildError::Config)?;
+        let library = Library {
+            textures: &textures,
+            atlas: atlas.as_ref(),
+            no_atlas,
+        };
+        run(opts, &catalog, &library, progress, t0)
     })
 }
 
@@ -316,10 +326,18 @@ fn write_err(path: &Path, cause: std::io::Error) -> BuildError {
     }
 }
 
+/// The textures a build writes, and the cut-out atlas among them for the GLB tiles.
+struct Library<'a> {
+    textures: &'a [output::Texture],
+    atlas: Option<&'a output::atlas::Atlas>,
+    /// Why the cut-outs have no atlas (too large), for the report's warnings.
+    no_atlas: Option<String>,
+}
+
 fn run(
     opts: &BuildOptions,
     catalog: &Catalog,
-    texture_set: &[output::Texture],
+    library: &Library,
     progress: &dyn Progress,
     t0: Instant,
 ) -> Result<BuildOutcome, BuildError> {
@@ -386,15 +404,7 @@ fn run(
                 s.spawn(|| cache::store(file, key, &data, &plan));
             }
             write_city(
-                opts,
-                catalog,
-                texture_set,
-                progress,
-                &data,
-                &plan,
-                timings,
-                t0,
-                reused,
+                opts, catalog, library, progress, &data, &plan, timings, t0, reused,
             )
         })
     });
@@ -432,7 +442,7 @@ fn run(
 fn write_city(
     opts: &BuildOptions,
     catalog: &Catalog,
-    texture_set: &[output::Texture],
+    library: &Library,
     progress: &dyn Progress,
     data: &Dataset,
     plan: &Plan,
@@ -470,7 +480,7 @@ fn write_city(
             output::atomic::remove_leftover_temporaries(dir);
         }
     }
-    let mut textures = output::write_textures(&opts.out, texture_set)
+    let mut textures = output::write_textures(&opts.out, library.textures)
         .map_err(|e| write_err(&opts.out.join(output::TEXTURE_DIR), e))?;
     textures.extend(
         output::write_model_textures(&opts.out, &plan.model_textures)
@@ -480,7 +490,7 @@ fn write_city(
         .map_err(|e| write_err(&opts.out.join("species"), e))?;
 
     let files = layer_files(&opts.input, params);
-    let sinks = output::sink::sinks(&params.output);
+    let sinks = output::sink::sinks(&params.output, library.atlas);
     let directory = output::features::Directory::of(data, plan, params);
     let tiles: Vec<&String> = plan
         .tiles
@@ -678,6 +688,12 @@ fn write_city(
         species,
     };
     let mut manifest = manifest;
+    if let Some(why) = &library.no_atlas {
+        manifest.input.warnings.push(crate::model::Warning::new(
+            crate::model::WarningClass::Build,
+            why.clone(),
+        ));
+    }
     let links = output::links::write_links(&opts.out, data, plan.origin)
         .map_err(|e| write_err(&opts.out.join("links.json"), e))?;
     manifest.files.extend(links);

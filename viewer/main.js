@@ -36,7 +36,9 @@ const api = (window.edoCity = {
   setSplit: (on) => setSplit(on),
   // The viewer's own numbers, for the level-of-detail budgets (issue 40): the last frame's
   // draw calls and triangles, the tiles loaded of the current build, the bytes of the
-  // builds' files fetched so far (bodies as sent) and the frames a second (over the last second, or the last frame when it took longer).
+  // builds' files fetched so far (bodies that came over the network: a response from the
+  // browser's cache, or a 304 revalidation, sends none; every tile's loader asks for the
+  // shared textures again) and the frames a second (over the last second, or the last frame when it took longer).
   stats: {
     drawCalls: 0,
     triangles: 0,
@@ -46,6 +48,7 @@ const api = (window.edoCity = {
       return performance
         .getEntriesByType('resource')
         .filter((e) => new URL(e.name).pathname.startsWith('/h/'))
+        .filter((e) => e.transferSize >= e.encodedBodySize)
         .reduce((sum, e) => sum + (e.encodedBodySize || 0), 0);
     },
   },

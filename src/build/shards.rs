@@ -457,7 +457,8 @@ pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildEr
         formats: manifest.formats.clone(),
         ..manifest.params.output.clone()
     };
-    for sink in crate::output::sink::sinks(&output) {
+    // The whole-build steps draw no tile: no atlas needed.
+    for sink in crate::output::sink::sinks(&output, None) {
         let files = sink
             .finish(out, manifest, &mut warnings)
             .map_err(|e| write_err(out, e))?;

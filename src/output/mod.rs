@@ -6,6 +6,7 @@
 //! manifest always describes complete tiles.
 
 pub mod accounting;
+pub mod atlas;
 pub mod atomic;
 pub mod chart;
 pub mod crowds;

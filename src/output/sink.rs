@@ -62,7 +62,11 @@ pub trait Sink: Sync {
 
 /// The sinks of `output.formats` (names as [`crate::params::output::FORMATS`] has them), in
 /// the order given; unknown names were refused when the parameters were read.
-pub fn sinks(output: &crate::params::OutputParams) -> Vec<Box<dyn Sink>> {
+/// `atlas` is the cut-out atlas the build wrote beside the textures, for the GLB tiles.
+pub fn sinks(
+    output: &crate::params::OutputParams,
+    atlas: Option<&super::atlas::Atlas>,
+) -> Vec<Box<dyn Sink>> {
     let mut out: Vec<Box<dyn Sink>> = Vec::new();
     for f in &output.formats {
         let s: Box<dyn Sink> = match f.as_str() {
@@ -71,6 +75,7 @@ pub fn sinks(output: &crate::params::OutputParams) -> Vec<Box<dyn Sink>> {
             }),
             "glb" => Box::new(super::gltf::GlbSink {
                 meshopt: output.glb_compression == "meshopt",
+                atlas: atlas.cloned(),
             }),
             _ => continue,
         };

@@ -18,7 +18,7 @@ use std::collections::BTreeMap;
 use serde_json::{json, Value};
 
 use super::buffer::Buffer;
-use super::Primitive;
+use super::{Primitive, Slot};
 use crate::generate::crowd::Crowd;
 use crate::model::WalkKey;
 
@@ -39,6 +39,7 @@ pub const CLIP: &str = "crowd";
 #[allow(clippy::too_many_arguments)]
 pub(super) fn add(
     crowd: &Crowd,
+    atlas: Option<&crate::output::atlas::Atlas>,
     origin: [f64; 2],
     shift: [i64; 3],
     feature: u32,
@@ -51,10 +52,11 @@ pub(super) fn add(
     for f in &crowd.figures {
         let mut prims: BTreeMap<u16, Primitive> = BTreeMap::new();
         for face in &f.faces {
+            let slot = Slot::of(atlas, face.material);
             prims
-                .entry(face.material)
+                .entry(slot.key)
                 .or_default()
-                .face(feature, f, &face.corners, [0, 0, 0]);
+                .face(feature, f, &face.corners, [0, 0, 0], slot);
         }
         let mut primitives = Vec::new();
         for (&material, p) in prims.iter_mut() {

@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use serde_json::{json, Value};
 
 use super::buffer::Buffer;
-use super::Primitive;
+use super::{Primitive, Slot};
 use crate::generate::planted::Instanced;
 
 /// The mesh and the node of each variant, appended to `meshes` and `nodes` (the node's mesh
@@ -24,6 +24,7 @@ use crate::generate::planted::Instanced;
 #[allow(clippy::too_many_arguments)]
 pub(super) fn add(
     groups: &[Instanced],
+    atlas: Option<&crate::output::atlas::Atlas>,
     origin: [f64; 2],
     shift: [i64; 3],
     first_feature: usize,
@@ -36,10 +37,11 @@ pub(super) fn add(
     for g in groups.iter().filter(|g| !g.trees.is_empty()) {
         let mut prims: BTreeMap<u16, Primitive> = BTreeMap::new();
         for f in &g.model.faces {
+            let slot = Slot::of(atlas, f.material);
             prims
-                .entry(f.material)
+                .entry(slot.key)
                 .or_default()
-                .face(0, &g.model, &f.corners, [0, 0, 0]);
+                .face(0, &g.model, &f.corners, [0, 0, 0], slot);
         }
         let mut primitives = Vec::new();
         for (&material, p) in prims.iter_mut() {

@@ -20,6 +20,7 @@ pub mod metadata;
 use serde_json::{json, Value};
 
 use crate::generate::mesh::Mesh;
+use crate::output::atlas::{self, Atlas};
 use crate::output::features::Feature;
 use crate::output::palette::{mime_type, Palette};
 use buffer::Buffer;
@@ -54,14 +55,15 @@ struct Vertices {
     heads: Vec<(u32, u32)>,
     /// Per vertex: the next vertex + 1 made from the same position, 0 at the end.
     next: Vec<u32>,
-    /// Per vertex: its uv index and normal bits.
-    keys: Vec<(u32, [u32; 3])>,
+    /// Per vertex: its uv index (above bit 32 its material: cut-outs of several textures share
+    /// the atlas's primitive) and normal bits.
+    keys: Vec<(u64, [u32; 3])>,
 }
 
 impl Vertices {
     /// The vertex of `object`'s position `p` with uv `t` and normal `n`, or `None` with the
     /// vertex it would be added as registered by [`Vertices::add`].
-    fn find(&mut self, object: u32, p: u32, t: u32, n: [u32; 3], positions: usize) -> Option<u32> {
+    fn find(&mut self, object: u32, p: u32, t: u64, n: [u32; 3], positions: usize) -> Option<u32> {
         let p = p as usize;
         if self.heads.len() <= p {
             self.heads.resize(positions.max(p + 1), (0, 0));
@@ -80,7 +82,7 @@ impl Vertices {
     }
 
     /// Registers vertex `v` (the next one) as `object`'s position `p` with uv `t`, normal `n`.
-    fn add(&mut self, v: u32, object: u32, p: u32, t: u32, n: [u32; 3]) {
+    fn add(&mut self, v: u32, object: u32, p: u32, t: u64, n: [u32; 3]) {
         let slot = &mut self.heads[p as usize];
         let rest = if slot.0 == object + 1 { slot.1 } else { 0 };
         *slot = (object + 1, v + 1);
@@ -105,10 +107,46 @@ fn normal(mesh: &Mesh, corners: &[(u32, u32)]) -> Option<[f32; 3]> {
     (len > 1e-9).then(|| n.map(|v| (v / len) as f32))
 }
 
+/// Where a face's texture is drawn from: its material's own, or a cell of the cut-out atlas.
+#[derive(Clone, Copy)]
+pub(super) struct Slot<'a> {
+    /// The material's key among the tile's primitives ([`atlas::MATERIAL`] for the atlas).
+    key: u16,
+    /// The atlas and the material's cell in it.
+    cell: Option<(&'a Atlas, &'a atlas::Cell)>,
+    /// The face's own material (told apart within the atlas's primitive).
+    material: u16,
+}
+
+impl<'a> Slot<'a> {
+    /// The slot of `material`: the atlas's when it has a cell for it.
+    fn of(atlas: Option<&'a Atlas>, material: u16) -> Slot<'a> {
+        match atlas.and_then(|a| a.cell(material).map(|c| (a, c))) {
+            Some(cell) => Slot {
+                key: atlas::MATERIAL,
+                cell: Some(cell),
+                material,
+            },
+            None => Slot {
+                key: material,
+                cell: None,
+                material,
+            },
+        }
+    }
+}
+
 impl Primitive {
     /// Adds one face of object `object` of `mesh`, as a fan of triangles (the OBJ's faces
     /// are convex or drawn so that clients fan them).
-    fn face(&mut self, object: u32, mesh: &Mesh, corners: &[(u32, u32)], shift: [i64; 3]) {
+    fn face(
+        &mut self,
+        object: u32,
+        mesh: &Mesh,
+        corners: &[(u32, u32)],
+        shift: [i64; 3],
+        slot: Slot,
+    ) {
         let Some(n) = normal(mesh, corners) else {
             return;
         };
@@ -120,11 +158,12 @@ impl Primitive {
         let mut idx = std::mem::take(&mut self.corners);
         idx.clear();
         for &(p, t) in corners {
-            let v = match self.seen.find(object, p, t, nb, mesh.positions.len()) {
+            let tk = u64::from(t) | u64::from(slot.material) << 32;
+            let v = match self.seen.find(object, p, tk, nb, mesh.positions.len()) {
                 Some(v) => v,
                 None => {
                     let v = (self.positions.len() / 3) as u32;
-                    self.seen.add(v, object, p, t, nb);
+                    self.seen.add(v, object, p, tk, nb);
                     let q = mesh.positions[p as usize];
                     for k in 0..3 {
                         self.positions
@@ -132,8 +171,12 @@ impl Primitive {
                     }
                     self.normals.extend_from_slice(&n);
                     let uv = mesh.uvs.get(t as usize).copied().unwrap_or([0, 0]);
-                    self.uvs.push(snap(uv[0] as f64 / 10_000.0, UV_STEPS));
-                    self.uvs.push(snap(1.0 - uv[1] as f64 / 10_000.0, UV_STEPS));
+                    let mut uv = [uv[0] as f64 / 10_000.0, 1.0 - uv[1] as f64 / 10_000.0];
+                    if let Some((atlas, cell)) = slot.cell {
+                        uv = atlas.uv(cell, uv);
+                    }
+                    self.uvs.push(snap(uv[0], UV_STEPS));
+                    self.uvs.push(snap(uv[1], UV_STEPS));
                     self.ids.push(object as f32);
                     v
                 }
@@ -209,7 +252,11 @@ pub fn linear(c: f32) -> f32 {
 /// positions are taken around; `features` has one entry per mesh. Grown trees come
 /// instanced when the tile has `instanced` variants (their copies in `trees_grown` are left
 /// out), each tree with its row of `instance_features` after the meshes' rows.
-pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffer::Glb {
+pub fn tile_glb(
+    tile: &crate::output::sink::TileContent,
+    meshopt: bool,
+    atlas: Option<&Atlas>,
+) -> buffer::Glb {
     let (meshes, features, shift, palette) =
         (tile.meshes, tile.features, tile.centre, tile.palette);
     let instanced = !tile.instanced.is_empty();
@@ -234,11 +281,14 @@ pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffe
             }
         };
         for face in &mesh.faces {
-            kinds[k]
-                .1
-                .entry(face.material)
-                .or_default()
-                .face(i as u32, mesh, &face.corners, shift);
+            let slot = Slot::of(atlas, face.material);
+            kinds[k].1.entry(slot.key).or_default().face(
+                i as u32,
+                mesh,
+                &face.corners,
+                shift,
+                slot,
+            );
         }
     }
     for p in kinds.iter_mut().flat_map(|(_, p)| p.values_mut()) {
@@ -275,6 +325,7 @@ pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffe
     }
     instances::add(
         tile.instanced,
+        atlas,
         tile.origin,
         shift,
         features.len(),
@@ -286,6 +337,7 @@ pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffe
     let clip = match (tile.crowd, walking) {
         (Some(crowd), Some(row)) => animation::add(
             crowd,
+            atlas,
             tile.origin,
             shift,
             row as u32,
@@ -296,7 +348,7 @@ pub fn tile_glb(tile: &crate::output::sink::TileContent, meshopt: bool) -> buffe
         ),
         _ => None,
     };
-    let (materials, images, textures) = materials(&used, palette);
+    let (materials, images, textures) = materials(&used, palette, atlas);
     let mut doc = json!({
         "asset": {
             "version": "2.0",
@@ -412,12 +464,25 @@ pub fn declare_extensions(doc: &mut Value, buf: &Buffer) {
     doc["extensionsRequired"] = json!(required);
 }
 
-/// The materials `used` (library ids, in first-use order) as glTF materials, with the
-/// images and textures the textured ones need.
-fn materials(used: &[u16], palette: Palette) -> (Vec<Value>, Vec<Value>, Vec<Value>) {
+/// The materials `used` (library ids, in first-use order; [`atlas::MATERIAL`] the cut-out
+/// atlas) as glTF materials, with the images and textures the textured ones need.
+fn materials(
+    used: &[u16],
+    palette: Palette,
+    atlas: Option<&Atlas>,
+) -> (Vec<Value>, Vec<Value>, Vec<Value>) {
     let (mut out, mut images, mut textures) = (Vec::new(), Vec::new(), Vec::new());
     for &id in used {
-        let m = palette.get(id);
+        let m = match id {
+            atlas::MATERIAL => crate::output::palette::Entry {
+                name: atlas::NAME,
+                kd: [1.0; 3],
+                texture: Some(atlas::FILE),
+                alpha: true,
+                mask: None,
+            },
+            _ => palette.get(id),
+        };
         let mut pbr = json!({"metallicFactor": 0.0, "roughnessFactor": 0.9});
         match m.texture {
             Some(file) => {
@@ -432,6 +497,9 @@ fn materials(used: &[u16], palette: Palette) -> (Vec<Value>, Vec<Value>, Vec<Val
             }
         }
         let mut mat = json!({"name": m.name, "pbrMetallicRoughness": pbr});
+        if let (atlas::MATERIAL, Some(a)) = (id, atlas) {
+            mat["extras"] = a.extras();
+        }
         if m.alpha {
             mat["alphaMode"] = json!("MASK");
             mat["alphaCutoff"] = json!(0.5);
@@ -446,6 +514,8 @@ fn materials(used: &[u16], palette: Palette) -> (Vec<Value>, Vec<Value>, Vec<Val
 pub struct GlbSink {
     /// `output.glb_compression = "meshopt"`.
     pub meshopt: bool,
+    /// The cut-out atlas the build wrote (`tiles/textures/cutouts.png`), if any.
+    pub atlas: Option<Atlas>,
 }
 
 impl crate::output::sink::Sink for GlbSink {
@@ -458,7 +528,7 @@ impl crate::output::sink::Sink for GlbSink {
         out: &std::path::Path,
         tile: &crate::output::sink::TileContent,
     ) -> std::io::Result<crate::output::sink::TileFiles> {
-        let glb = tile_glb(tile, self.meshopt);
+        let glb = tile_glb(tile, self.meshopt, self.atlas.as_ref());
         let path = format!("tiles/{}.glb", tile.id);
         Ok(crate::output::sink::TileFiles {
             files: vec![crate::output::write_listed(out, path, &glb.parts())?],
