@@ -478,6 +478,12 @@ pub fn id(name: &str) -> u16 {
     find(name).unwrap_or_else(|| panic!("built-in material `{name}` missing from MATERIALS"))
 }
 
+/// Whether a library file is a cut-out material's colour texture (bled when replaced,
+/// packed into the GLB tiles' atlas).
+pub fn is_cut_out_texture(file: &str) -> bool {
+    MATERIALS.iter().any(|m| m.alpha && m.texture == Some(file))
+}
+
 /// Every material's name, for messages that list them.
 pub fn names() -> Vec<&'static str> {
     MATERIALS.iter().map(|m| m.name).collect()

@@ -79,7 +79,7 @@ impl Atlas {
     pub fn layout(library: &[Texture]) -> Result<Option<Atlas>, AtlasError> {
         let mut sizes: Vec<(&'static str, [u32; 2])> = Vec::new();
         for (name, bytes) in library {
-            if !is_cut_out(name) {
+            if !crate::materials::is_cut_out_texture(name) {
                 continue;
             }
             let dims = image::ImageReader::with_format(
@@ -227,11 +227,6 @@ impl Atlas {
             .collect();
         json!({"atlas": {"size": self.size, "cells": cells}})
     }
-}
-
-/// Whether a library file is a cut-out material's colour texture.
-fn is_cut_out(file: &str) -> bool {
-    MATERIALS.iter().any(|m| m.alpha && m.texture == Some(file))
 }
 
 /// Atlas sizes from the smallest: powers of two, width first.

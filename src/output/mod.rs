@@ -108,10 +108,7 @@ pub fn texture_library(set: &str) -> Result<Vec<Texture>, String> {
             .map_err(|e| format!("{}: not a readable PNG: {e}", path.display()))?;
         // A cut-out's transparent texels get the colour of their drawn neighbours, as the
         // shipped ones have (`cutout::bleed`).
-        let cut_out = crate::materials::MATERIALS
-            .iter()
-            .any(|m| m.alpha && m.texture == Some(slot.0));
-        let bytes = match cut_out {
+        let bytes = match crate::materials::is_cut_out_texture(slot.0) {
             true => cutout::bleed_png(&bytes)
                 .map_err(|e| format!("{}: not a readable PNG: {e}", path.display()))?,
             false => bytes,
