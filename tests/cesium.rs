@@ -71,3 +71,41 @@ fn cesium_loads_the_tileset_where_proj_puts_it_and_reads_its_metadata() {
         "{picked}"
     );
 }
+
+/// Walkers (a skinned crowd and its clip) and instanced grown trees in CesiumJS: the example
+/// town's leaves all load (a screen-space error of 1 pixel) with no error, and the middle of
+/// the overview is the town, not a walker: with normalized short rotations in the clip,
+/// CesiumJS drew every walker hundreds of metres tall over the town.
+#[test]
+fn cesium_draws_the_walkers_and_instanced_trees_of_the_leaves() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = dir.path().join("p.toml");
+    std::fs::write(
+        &params,
+        "[trees]\nstyle = \"lsystem\"\n[people]\nmotion = \"boids\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("edo");
+    build_ok(
+        &common::fixture("kyoto-small"),
+        &out,
+        &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
+    );
+    let leaves = read_json(&out.join("manifest.json"))["tiles"]
+        .as_array()
+        .unwrap()
+        .len() as u64;
+    let mut serve = Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
+    serve.args(["serve", "--port", "0"]).arg(&out);
+    let (server, url) = common::start_server(serve);
+    let (got, text) = common::run_browser_script(
+        "cesium.mjs",
+        &[url.as_ref(), "-".as_ref(), "1".as_ref()],
+        &[],
+    );
+    drop(server);
+    assert_eq!(got["errors"], serde_json::json!([]), "{text}");
+    assert!(got["tilesLoaded"].as_u64().unwrap() >= leaves, "{text}");
+    assert_ne!(got["picked"]["kind"], "people", "{text}");
+    assert!(got["picked"]["lot"].is_string(), "{text}");
+}

@@ -173,6 +173,12 @@ fn node_clip(glb: &[u8], json: &serde_json::Value, person: &str) -> Vec<(f32, [f
         .unwrap();
     let s = &clip["samplers"][ch["sampler"].as_u64().unwrap() as usize];
     assert_eq!(s["interpolation"], "LINEAR");
+    // Every output is floats: CesiumJS read normalized short rotations as raw integers.
+    for c in clip["channels"].as_array().unwrap() {
+        let s = &clip["samplers"][c["sampler"].as_u64().unwrap() as usize];
+        let output = &json["accessors"][s["output"].as_u64().unwrap() as usize];
+        assert_eq!(output["componentType"], 5126, "{c}");
+    }
     let times = accessor_floats(glb, json, &s["input"]);
     let at = accessor_floats(glb, json, &s["output"]);
     times
@@ -230,6 +236,37 @@ fn the_glb_clip_moves_each_walker_through_its_csv_places_in_the_file_and_in_thre
         .filter(|n| n["extras"]["person"].is_string())
         .collect();
     assert_eq!(nodes.len(), in_tile.len());
+    // ... a joint of one skin (at most 32 a skin), drawn by a skinned mesh of the skin's
+    // figures: a draw call per skin and material, not per walker.
+    let skins = json["skins"].as_array().unwrap();
+    assert_eq!(skins.len(), in_tile.len().div_ceil(32), "{skins:?}");
+    let mut joints: Vec<u64> = skins
+        .iter()
+        .flat_map(|s| s["joints"].as_array().unwrap())
+        .map(|j| j.as_u64().unwrap())
+        .collect();
+    assert!(skins
+        .iter()
+        .all(|s| s["joints"].as_array().unwrap().len() <= 32));
+    joints.sort_unstable();
+    let persons: Vec<u64> = (json["nodes"].as_array().unwrap().iter().enumerate())
+        .filter(|(_, n)| n["extras"]["person"].is_string())
+        .map(|(i, n)| {
+            assert!(n.get("mesh").is_none(), "{n}");
+            i as u64
+        })
+        .collect();
+    assert_eq!(joints, persons);
+    let skinned: Vec<&serde_json::Value> = (json["nodes"].as_array().unwrap().iter())
+        .filter(|n| n.get("skin").is_some())
+        .collect();
+    assert_eq!(skinned.len(), skins.len());
+    for n in skinned {
+        let mesh = &json["meshes"][n["mesh"].as_u64().unwrap() as usize];
+        for p in mesh["primitives"].as_array().unwrap() {
+            assert!(p["attributes"]["JOINTS_0"].is_u64() && p["attributes"]["WEIGHTS_0"].is_u64());
+        }
+    }
     assert!(json["nodes"]
         .as_array()
         .unwrap()
@@ -301,6 +338,7 @@ fn the_glb_clip_moves_each_walker_through_its_csv_places_in_the_file_and_in_thre
         pair.0,
         pair.1
     );
+    assert_eq!(got["picked"], person.as_str(), "{text}");
     assert_eq!(got["paused_held"], true, "{text}");
     assert_eq!(got["played_on"], true, "{text}");
     // The street clicked there charts its stretch's crowd: lambda1-3 each second, 0-59 s.
@@ -395,7 +433,7 @@ fn blenders_gltf_importer_plays_the_same_clip_as_the_csv() {
         assert_eq!(
             at.keys().map(String::as_str).collect::<Vec<_>>(),
             in_tile.iter().copied().collect::<Vec<_>>(),
-            "one Blender object per walker of {csv}"
+            "one Blender object or bone per walker of {csv}"
         );
         for (id, places) in at {
             let k = &keys[id];

@@ -40,8 +40,12 @@ viewer.scene.globe.baseColor = Cesium.Color.fromCssColorString('#8a7f6a');
 viewer.scene.backgroundColor = Cesium.Color.fromCssColorString('#bcd6ea');
 
 async function main() {
-  const h = Number(new URLSearchParams(location.search).get('h') ?? 0);
+  const query = new URLSearchParams(location.search);
+  const h = Number(query.get('h') ?? 0);
   const tileset = await Cesium.Cesium3DTileset.fromUrl(`/h/${h}/tileset.json`);
+  // `?sse=N`: Cesium's screen-space error target (16 pixels by default); a small one loads
+  // the leaves of a small town from its overview (the tests read walkers and instanced trees).
+  if (query.has('sse')) tileset.maximumScreenSpaceError = Number(query.get('sse'));
   tileset.tileFailed.addEventListener((e) => api.errors.push(`${e.url}: ${e.message}`));
   tileset.tileLoad.addEventListener(() => {
     api.tilesLoaded += 1;

@@ -154,6 +154,12 @@ function city(k) {
     // Each node of a tile is one object kind (machiya, kura, fence, people, ...): its
     // glTF extras, which three.js puts in userData.kind.
     applyToggles(model);
+    // A tile's walkers are skinned meshes (a draw call per 32 walkers): three.js would cull
+    // one by its bounding sphere at the pose it first saw, while the walkers walk on. The
+    // tile's own box holds the whole clip, and the renderer culls tiles by it.
+    model.traverse((o) => {
+      if (o.isSkinnedMesh) o.frustumCulled = false;
+    });
     c.models.add(tile);
     // The tile's ground and streets, which walking stands on.
     const under = [];
@@ -430,9 +436,14 @@ function pick(event) {
   // An instanced tree (EXT_mesh_gpu_instancing): its row is its instance's feature id
   // (EXT_instance_features; three.js keeps the instance attribute on the geometry).
   const instanceIds = hit.object.isInstancedMesh && hit.object.geometry.getAttribute('_FEATURE_ID_0');
-  // A walker (an animated node): its person and group from its node's extras.
+  // A walker: a joint (bone) of its tile's skinned crowd, found from the hit vertex's joint;
+  // its person and group from the joint node's extras.
   let walker = null;
-  for (let o = hit.object; o && !walker; o = o.parent) if (o.userData.person !== undefined) walker = o.userData;
+  if (hit.object.isSkinnedMesh && hit.face) {
+    const joints = hit.object.geometry.getAttribute('skinIndex');
+    const bone = joints && hit.object.skeleton.bones[joints.getX(hit.face.a)];
+    if (bone && bone.userData.person !== undefined) walker = bone.userData;
+  }
   api.picked = {
     instance: hit.object.isInstancedMesh ? hit.instanceId : null,
     person: walker ? walker.person : null,

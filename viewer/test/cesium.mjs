@@ -5,10 +5,10 @@
 // centre (longitude, latitude, height), the tiles loaded, the metadata row of the object at
 // the middle of the picture, the time to ready.
 //
-// Usage: node test/cesium.mjs <url> [screenshot.png]
+// Usage: node test/cesium.mjs <url> [screenshot.png] [screen-space error target]
 import { launchChromium } from './launch.mjs';
 
-const [url, shot] = process.argv.slice(2);
+const [url, shot, sse] = process.argv.slice(2);
 if (!url) {
   console.error('usage: node test/cesium.mjs <url> [screenshot.png]');
   process.exit(2);
@@ -34,7 +34,7 @@ try {
   });
   page.setDefaultTimeout(120000);
   const t0 = Date.now();
-  await page.goto(`${url}viewer/cesium.html?h=0`, { waitUntil: 'domcontentloaded' });
+  await page.goto(`${url}viewer/cesium.html?h=0${sse ? `&sse=${sse}` : ''}`, { waitUntil: 'domcontentloaded' });
   await page.waitForFunction(() => window.edoCesium && (window.edoCesium.ready || window.edoCesium.errors.length), null, {
     timeout: 120000,
     polling: 250,
@@ -47,7 +47,7 @@ try {
   for (const e of api.errors) fail(`tile error: ${e}`);
   if (api.tilesLoaded < 1) fail('no tile loaded');
   out.picked = await page.evaluate(() => window.edoCesium.pick(512, 320));
-  if (shot) await page.screenshot({ path: shot });
+  if (shot && shot !== '-') await page.screenshot({ path: shot });
 } catch (e) {
   fail(`${e.message}`);
 } finally {

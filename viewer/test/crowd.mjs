@@ -1,7 +1,8 @@
 // The street crowds in the viewer: a walker's node moved by the tile's clip. Opens a served
 // build, comes down near a walker (map metres east, north from the origin), pauses the
 // crowd, sets the clip to two times and reports where the walker's node is at each (scene
-// metres: x east, y up, z south), then whether pause holds the time and play moves it on.
+// metres: x east, y up, z south), that a click there names the walker, then whether pause
+// holds the time and play moves it on.
 // tests/crowd_clip.rs compares the two places with crowds/<tile>.csv; then a click on the
 // street there charts its stretch's lambda1-3 over the clip.
 //
@@ -47,6 +48,14 @@ try {
     );
   out.first = await at(t1);
   out.second = await at(t2);
+  // A click on the walker (paused at t2, at its middle): the viewer names the person, found
+  // from the skinned crowd's joint under the pointer.
+  const [x, y, z] = out.second.at;
+  await page.evaluate(([e, n]) => window.edoCity.lookAt(e, n, 0, 25), [x, -z]);
+  await page.waitForFunction(() => window.edoCity.ready, null, { polling: 250 });
+  const p0 = await page.evaluate(([e, n, u]) => window.edoCity.screenOf(e, n, u), [x, -z, y + 0.7]);
+  await page.mouse.click(p0.x, p0.y);
+  out.picked = await page.evaluate(() => window.edoCity.picked && window.edoCity.picked.person);
   // Paused: the time holds over frames drawn (three of them, however slow); played: it moves.
   const frames = () =>
     page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(() => requestAnimationFrame(r)))));

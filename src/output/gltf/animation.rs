@@ -1,17 +1,20 @@
-//! A tile's walkers as glTF 2.0 animation: each figure (a picture's person at 1 m) once as a
-//! mesh, one node per walker drawing its figure at its scale, and one clip, `crowd`, of every
+//! A tile's walkers as glTF 2.0 animation: one joint node per walker (its place, heading and
+//! height), the figures (a picture's person at 1 m) of up to [`SKIN_JOINTS`] walkers as one
+//! skinned mesh, so a tile's crowd is a draw call or two, and one clip, `crowd`, of every
 //! walker's translation and rotation keys (LINEAR, the last key the first, so a player that
 //! loops it shows no jump). three.js' GLTFLoader, Blender's importer and CesiumJS play it.
 //!
 //! Keys on a straight, even walk say nothing the keys either side do not: a key is kept only
 //! where leaving it out would move the walker more than [`TOLERANCE`] metres or turn it more
 //! than [`TURN_TOLERANCE`] from where interpolation puts it (each walker its own times).
-//! Rotations are normalized shorts (core glTF allows them for rotation outputs), times and
-//! translations floats; all through meshopt's vertex codec when the GLB is compressed.
+//! Times, translations and rotations are floats, through meshopt's vertex codec when the GLB
+//! is compressed. Core glTF allows normalized shorts for rotations, but CesiumJS 1.145 reads
+//! them as raw integers: its walkers were drawn hundreds of metres tall.
 //!
 //! Each walker's node carries its person id and group in `extras` (three.js copies them into
-//! `userData`), and its figure's vertices the feature id of the tile's people row, so a click
-//! on a walker names it as a click on a standing person does.
+//! the bone's `userData`), and its figure's vertices the feature id of the tile's people row
+//! and its joint, so a click on a walker names it (the viewer finds the bone from the hit
+//! vertex's joint) as a click on a standing person does.
 
 use std::collections::BTreeMap;
 
@@ -33,9 +36,24 @@ const MAX_RUN: usize = 64;
 /// The clip's name.
 pub const CLIP: &str = "crowd";
 
-/// Adds the figures as meshes and a node per walker (appended to `meshes` and `nodes`) and
-/// returns the clip. `feature` is the people row the figures' vertices carry; `origin` and
-/// `shift` as for the tile's other nodes.
+/// The most walkers one skin moves. A skinned mesh is one draw call whatever its joints;
+/// CesiumJS gives each joint a 4-vector matrix uniform, and 32 of them (128 vectors) stay
+/// within the 256 vertex uniform vectors of common mobile GPUs beside the rest of its shader
+/// (three.js keeps bones in a texture and has no such bound).
+pub const SKIN_JOINTS: usize = 32;
+
+/// What a tile's crowd adds besides its meshes and nodes: the clip and the skins.
+pub(super) struct Animated {
+    pub clip: Value,
+    pub skins: Vec<Value>,
+}
+
+/// Adds the walkers (appended to `meshes` and `nodes`) and returns the clip and skins.
+/// Each walker is a joint node, `person_<id>`, under one `crowd` node; the figures of up to
+/// [`SKIN_JOINTS`] walkers are one skinned mesh, each figure's vertices following its
+/// walker's joint wholly (a node per walker drew each walker in a call of its own: +263
+/// draw calls at the 30,052-lot town's central crossing). `feature` is the people row the
+/// figures' vertices carry; `origin` and `shift` as for the tile's other nodes.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn add(
     crowd: &Crowd,
@@ -47,16 +65,34 @@ pub(super) fn add(
     used: &mut Vec<u16>,
     meshes: &mut Vec<Value>,
     nodes: &mut Vec<Value>,
-) -> Option<Value> {
-    let mut figure_mesh: Vec<Option<usize>> = Vec::new();
-    for f in &crowd.figures {
+) -> Option<Animated> {
+    let walkers: Vec<&crate::generate::crowd::Walker> = crowd
+        .walkers
+        .iter()
+        .filter(|w| {
+            crowd.figures[w.figure]
+                .faces
+                .iter()
+                .any(|f| f.corners.len() > 2)
+        })
+        .collect();
+    if walkers.is_empty() {
+        return None;
+    }
+    let root = nodes.len();
+    nodes.push(json!({"name": "crowd", "children": [], "extras": {"kind": "people"}}));
+    let first_joint = nodes.len();
+    let (mut skins, mut skinned) = (Vec::new(), Vec::new());
+    for (k, group) in walkers.chunks(SKIN_JOINTS).enumerate() {
         let mut prims: BTreeMap<u16, Primitive> = BTreeMap::new();
-        for face in &f.faces {
-            let slot = Slot::of(atlas, face.material);
-            prims
-                .entry(slot.key)
-                .or_default()
-                .face(feature, f, &face.corners, [0, 0, 0], slot);
+        for (j, w) in group.iter().enumerate() {
+            let f = &crowd.figures[w.figure];
+            for face in &f.faces {
+                let slot = Slot::of(atlas, face.material);
+                let p = prims.entry(slot.key).or_default();
+                p.joint = Some(j as u8);
+                p.face(feature, f, &face.corners, [0, 0, 0], slot);
+            }
         }
         let mut primitives = Vec::new();
         for (&material, p) in prims.iter_mut() {
@@ -65,20 +101,24 @@ pub(super) fn add(
                 primitives.push(super::primitive_json(p, material, true, buf, used));
             }
         }
-        figure_mesh.push((!primitives.is_empty()).then(|| {
-            meshes.push(json!({"name": f.name, "primitives": primitives}));
-            meshes.len() - 1
+        if primitives.is_empty() {
+            continue; // faces of no area: nothing to draw, the joints still walk
+        }
+        let first = first_joint + k * SKIN_JOINTS;
+        skins.push(json!({
+            "name": format!("crowd_{k}"),
+            "skeleton": root,
+            "joints": (first..first + group.len()).collect::<Vec<_>>(),
         }));
+        meshes.push(json!({"name": format!("crowd_{k}"), "primitives": primitives}));
+        skinned.push((k, meshes.len() - 1));
     }
     // Every walker's keys in three views for the tile (times, translations, rotations),
     // each walker's accessors at its offset: a view and its JSON per walker and channel took
     // twice the bytes of the keys themselves.
     let (mut times, mut moves, mut turns) = (Vec::new(), Vec::new(), Vec::new());
     let mut animated: Vec<(usize, usize, usize)> = Vec::new(); // node, first key, keys
-    for w in &crowd.walkers {
-        let Some(mesh) = figure_mesh[w.figure] else {
-            continue;
-        };
+    for w in &walkers {
         let keys = &w.walk.keys;
         let place = |k: &WalkKey| {
             let p = [k.at[0] - origin[0], k.at[2], -(k.at[1] - origin[1])];
@@ -92,7 +132,6 @@ pub(super) fn add(
         let h = round(h, 1000.0);
         nodes.push(json!({
             "name": format!("person_{}", w.walk.id),
-            "mesh": mesh,
             "translation": place(&keys[0]).map(|v| round(v, 1000.0)),
             "rotation": rotation(keys[0].heading).map(|v| round(v, 1e5)),
             "scale": [h, h, h],
@@ -103,21 +142,29 @@ pub(super) fn add(
         times.extend(idx.iter().map(|&k| k as f32 * dt));
         moves.extend(idx.iter().map(|&k| place(&keys[k])));
         let q = continuous(idx.iter().map(|&k| rotation(keys[k].heading)));
-        turns.extend(q.iter().map(|r| r.map(short)));
+        turns.extend(q);
         if let Some(last) = animated.last_mut() {
             last.2 = idx.len();
         }
     }
-    if animated.is_empty() {
-        return None;
+    nodes[root]["children"] = json!((first_joint..nodes.len()).collect::<Vec<_>>());
+    // The skinned meshes' nodes, at the scene's root with no transform of their own (glTF
+    // ignores it: the joints place every vertex).
+    for (skin, &(k, mesh)) in skinned.iter().enumerate() {
+        nodes.push(json!({
+            "name": format!("crowd_{k}"),
+            "mesh": mesh,
+            "skin": skin,
+            "extras": {"kind": "people"},
+        }));
     }
     let views = [
         buf.animation(&times, f32::to_le_bytes),
         buf.animation(&moves, flat12),
-        buf.animation(&turns, |v: [i16; 4]| {
-            let mut b = [0u8; 8];
+        buf.animation(&turns, |v: [f32; 4]| {
+            let mut b = [0u8; 16];
             for (k, x) in v.iter().enumerate() {
-                b[2 * k..2 * k + 2].copy_from_slice(&x.to_le_bytes());
+                b[4 * k..4 * k + 4].copy_from_slice(&x.to_le_bytes());
             }
             b
         }),
@@ -142,8 +189,8 @@ pub(super) fn add(
         let turned = push(
             buf,
             json!({
-                "bufferView": views[2], "byteOffset": 8 * first, "componentType": 5122,
-                "normalized": true, "count": n, "type": "VEC4",
+                "bufferView": views[2], "byteOffset": 16 * first, "componentType": 5126,
+                "count": n, "type": "VEC4",
             }),
         );
         for (path, output) in [("translation", moved), ("rotation", turned)] {
@@ -152,7 +199,10 @@ pub(super) fn add(
             samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
         }
     }
-    Some(json!({"name": CLIP, "channels": channels, "samplers": samplers}))
+    Some(Animated {
+        clip: json!({"name": CLIP, "channels": channels, "samplers": samplers}),
+        skins,
+    })
 }
 
 /// Adds an accessor; returns its index.
@@ -225,11 +275,6 @@ fn continuous(q: impl Iterator<Item = [f32; 4]>) -> Vec<[f32; 4]> {
         out.push(if flip { r.map(|v| -v) } else { r });
     }
     out
-}
-
-/// A unit component as a normalized short.
-fn short(v: f32) -> i16 {
-    (v.clamp(-1.0, 1.0) * 32767.0).round() as i16
 }
 
 fn flat12(v: [f32; 3]) -> [u8; 12] {

@@ -294,6 +294,35 @@ impl Buffer {
         self.accessors.len() - 1
     }
 
+    /// A skinned primitive's `JOINTS_0` and `WEIGHTS_0` accessors (in that order): each vertex
+    /// follows one joint wholly (a walker's figure moves as one body), so its joints are
+    /// that joint and three unused zeros, unsigned bytes, and its weights 1, 0, 0, 0. The
+    /// weights are floats: CesiumJS 1.145 read normalized byte weights as 255, drawing each
+    /// walker 255 times its size; a tile's walkers are a few hundred vertices, and alike
+    /// weights compress to next to nothing.
+    pub fn joints(&mut self, joints: &[f32]) -> (usize, usize) {
+        let j: Vec<[u8; 4]> = joints.iter().map(|&j| [j as u8, 0, 0, 0]).collect();
+        let view = self.attributes(&j, |b| b);
+        self.views[view]["byteStride"] = json!(4);
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": 5121,
+            "count": j.len(),
+            "type": "VEC4",
+        }));
+        let joints_accessor = self.accessors.len() - 1;
+        let w = vec![[1.0f32, 0.0, 0.0, 0.0]; joints.len()];
+        let view = self.attributes(&w, |v| flat::<4, 16>(v.map(f32::to_le_bytes)));
+        self.views[view]["byteStride"] = json!(16);
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": 5126,
+            "count": w.len(),
+            "type": "VEC4",
+        }));
+        (joints_accessor, self.accessors.len() - 1)
+    }
+
     /// The index accessor: u16 while the vertices fit, else u32.
     pub fn indices(&mut self, idx: &[u32], vertices: usize) -> usize {
         let short = vertices <= u16::MAX as usize;
@@ -327,7 +356,7 @@ impl Buffer {
     }
 }
 
-/// meshopt's vertex codec over `raw`, elements of `stride` bytes (4, 8 or 12 here); `None`
+/// meshopt's vertex codec over `raw`, elements of `stride` bytes (4, 8, 12 or 16 here); `None`
 /// for another stride or if the codec refuses.
 fn encode_attributes(raw: &[u8], stride: usize) -> Option<Vec<u8>> {
     fn encode<const N: usize>(raw: &[u8]) -> Option<Vec<u8>> {
@@ -341,6 +370,7 @@ fn encode_attributes(raw: &[u8], stride: usize) -> Option<Vec<u8>> {
         4 => encode::<4>(raw),
         8 => encode::<8>(raw),
         12 => encode::<12>(raw),
+        16 => encode::<16>(raw),
         _ => None,
     }
 }
@@ -422,6 +452,32 @@ mod tests {
         let jlen = u32::from_le_bytes(out[12..16].try_into().unwrap()) as usize;
         assert_eq!(jlen % 4, 0);
         assert_eq!(&out[20 + jlen + 4..20 + jlen + 8], b"BIN\0");
+    }
+
+    #[test]
+    fn each_vertex_follows_its_one_joint_wholly() {
+        let mut b = Buffer::default();
+        let (j, w) = b.joints(&[0.0, 3.0, 31.0]);
+        let view =
+            |a: usize| b.views[b.accessors[a]["bufferView"].as_u64().unwrap() as usize].clone();
+        let bytes = |a: usize| {
+            let v = view(a);
+            let (o, n) = (
+                v["byteOffset"].as_u64().unwrap() as usize,
+                v["byteLength"].as_u64().unwrap() as usize,
+            );
+            b.bin[o..o + n].to_vec()
+        };
+        assert_eq!(b.accessors[j]["componentType"], 5121);
+        assert_eq!(bytes(j), [0, 0, 0, 0, 3, 0, 0, 0, 31, 0, 0, 0]);
+        // Float weights (CesiumJS misread normalized bytes), 1 on the first joint only.
+        assert_eq!(b.accessors[w]["componentType"], 5126);
+        assert!(b.accessors[w].get("normalized").is_none());
+        let weights: Vec<f32> = bytes(w)
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!(weights, [1.0, 0.0, 0.0, 0.0].repeat(3));
     }
 
     #[test]

@@ -32,7 +32,12 @@ struct Primitive {
     normals: Vec<f32>,
     uvs: Vec<f32>,
     ids: Vec<f32>,
+    /// Per vertex, the joint of a skinned primitive (a walker of the tile's crowd); empty
+    /// unless faces were added with [`Primitive::joint`] set.
+    joints: Vec<f32>,
     indices: Vec<u32>,
+    /// The joint the faces added now follow, in a skinned primitive.
+    joint: Option<u8>,
     /// The vertices made so far, found by their object's position index.
     seen: Vertices,
     /// How many objects have faces here, and the last one: objects are added in order, so
@@ -158,7 +163,11 @@ impl Primitive {
         let mut idx = std::mem::take(&mut self.corners);
         idx.clear();
         for &(p, t) in corners {
-            let tk = u64::from(t) | u64::from(slot.material) << 32;
+            // The uv, then the material (cut-outs share the atlas's primitive), then the joint
+            // (walkers of one figure share its positions but not their vertices).
+            let tk = u64::from(t)
+                | u64::from(slot.material) << 32
+                | u64::from(self.joint.unwrap_or(0)) << 48;
             let v = match self.seen.find(object, p, tk, nb, mesh.positions.len()) {
                 Some(v) => v,
                 None => {
@@ -178,6 +187,9 @@ impl Primitive {
                     self.uvs.push(snap(uv[0], UV_STEPS));
                     self.uvs.push(snap(uv[1], UV_STEPS));
                     self.ids.push(object as f32);
+                    if let Some(j) = self.joint {
+                        self.joints.push(f32::from(j));
+                    }
                     v
                 }
             };
@@ -224,6 +236,9 @@ impl Primitive {
         self.normals = permute(&self.normals, 3);
         self.uvs = permute(&self.uvs, 2);
         self.ids = permute(&self.ids, 1);
+        if !self.joints.is_empty() {
+            self.joints = permute(&self.joints, 1);
+        }
     }
 }
 
@@ -334,7 +349,7 @@ pub fn tile_glb(
         &mut meshes_json,
         &mut nodes,
     );
-    let clip = match (tile.crowd, walking) {
+    let animated = match (tile.crowd, walking) {
         (Some(crowd), Some(row)) => animation::add(
             crowd,
             atlas,
@@ -378,15 +393,24 @@ pub fn tile_glb(
             }
         }
         doc["extensions"] = json!({"EXT_structural_metadata": metadata});
-        doc["scenes"][0]["nodes"] = json!((0..nodes.len()).collect::<Vec<_>>());
+        // The roots: every node that is no other's child (a crowd's walkers are its joints).
+        let children: std::collections::BTreeSet<u64> = (nodes.iter())
+            .filter_map(|n| n["children"].as_array())
+            .flatten()
+            .filter_map(Value::as_u64)
+            .collect();
+        doc["scenes"][0]["nodes"] = json!((0..nodes.len() as u64)
+            .filter(|n| !children.contains(n))
+            .collect::<Vec<_>>());
         doc["nodes"] = json!(nodes);
         doc["meshes"] = json!(meshes_json);
         doc["materials"] = json!(materials);
         doc["buffers"] = buf.buffers_json();
         doc["bufferViews"] = json!(buf.views);
         doc["accessors"] = json!(buf.accessors);
-        if let Some(clip) = clip {
-            doc["animations"] = json!([clip]);
+        if let Some(a) = animated {
+            doc["animations"] = json!([a.clip]);
+            doc["skins"] = json!(a.skins);
         }
     }
     add_images(&mut doc, images, textures);
@@ -423,6 +447,11 @@ fn primitive_json(
         "material": m,
         "mode": 4,
     });
+    if !p.joints.is_empty() {
+        let (joints, weights) = buf.joints(&p.joints);
+        prim["attributes"]["JOINTS_0"] = json!(joints);
+        prim["attributes"]["WEIGHTS_0"] = json!(weights);
+    }
     if let Some(fid) = fid {
         prim["attributes"]["_FEATURE_ID_0"] = json!(fid);
         prim["extensions"] = json!({"EXT_mesh_features": {"featureIds": [{
