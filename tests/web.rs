@@ -385,7 +385,7 @@ fn triangles(json: &Value) -> u64 {
 /// The levels of detail: every inner node has content of its own (`tiles/lod/`), with fewer
 /// triangles than its leaves, a measured error above zero, its quantized vertices inside its
 /// box, and a metadata row for every house below it, so a click on a distant house names
-/// its lot; no people on it.
+/// its lot; no people on it, standing or walking.
 #[test]
 fn parents_hold_the_city_coarser_and_still_name_every_lot() {
     let out = tempfile::tempdir().unwrap();
@@ -393,7 +393,7 @@ fn parents_hold_the_city_coarser_and_still_name_every_lot() {
     let params = out.path().join("p.toml");
     std::fs::write(
         &params,
-        "tile_size = 60.0\n[output]\nglb_compression = \"none\"\n",
+        "tile_size = 60.0\n[output]\nglb_compression = \"none\"\n[people]\nmotion = \"boids\"\n",
     )
     .unwrap();
     let dir = out.path().join("o");
@@ -461,6 +461,13 @@ fn parents_hold_the_city_coarser_and_still_name_every_lot() {
         assert!(kinds.windows(2).all(|w| w[0] < w[1]), "{uri}: {kinds:?}");
         assert!(
             kinds.contains(&"machiya") && kinds.len() > 3,
+            "{uri}: {kinds:?}"
+        );
+        // No people: neither standing nor walking (the leaves' skinned crowds).
+        assert!(
+            kinds
+                .iter()
+                .all(|k| *k != "people" && !k.starts_with("crowd")),
             "{uri}: {kinds:?}"
         );
         for n in nodes {

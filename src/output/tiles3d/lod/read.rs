@@ -52,11 +52,13 @@ pub fn leaf(
     let place = |p: [f32; 3]| transform.apply([p[0] as f64, -p[2] as f64, p[1] as f64]);
     for node in g.document.nodes() {
         let Some(mesh) = node.mesh() else { continue };
-        // A walker (an animated node: its figure at the origin, moved by its clip) is people.
-        let walker = node.extras().as_ref().is_some_and(|e| {
-            serde_json::from_str::<serde_json::Value>(e.get())
-                .is_ok_and(|v| v.get("person").is_some())
-        });
+        // Walkers are people: a tile's skinned crowd (its figures at the origin, placed by
+        // the joints its clip moves), or a walker's own node as tiles had it before.
+        let walker = node.skin().is_some()
+            || node.extras().as_ref().is_some_and(|e| {
+                serde_json::from_str::<serde_json::Value>(e.get())
+                    .is_ok_and(|v| v.get("person").is_some())
+            });
         let kind = if walker {
             "people"
         } else {
