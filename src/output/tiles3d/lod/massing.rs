@@ -203,15 +203,39 @@ pub fn hausdorff(points: &[[f64; 3]], original: &[[[f64; 3]; 3]], tris: &[[[f64;
 }
 
 /// The largest distance from a point to the nearest of the triangles.
+///
+/// Exact, with the early break of Taha and Hanbury (2015): a point's search stops as soon as
+/// some triangle is no farther than the largest distance found so far, since that point can
+/// no longer raise it; and each search starts at the triangle nearest the point before
+/// (neighbouring points are near the same faces). Measuring every point against every
+/// triangle was three quarters of a build's time (a massing's corners against a house's
+/// thousands of triangles, twice a level).
 pub fn error(points: &[[f64; 3]], tris: &[[[f64; 3]; 3]]) -> f64 {
-    points
-        .iter()
-        .map(|&p| {
-            tris.iter()
-                .map(|t| distance(p, t))
-                .fold(f64::INFINITY, f64::min)
-        })
-        .fold(0.0, f64::max)
+    let n = tris.len();
+    if n == 0 {
+        return if points.is_empty() {
+            0.0
+        } else {
+            f64::INFINITY
+        };
+    }
+    let (mut worst, mut start) = (0.0f64, 0);
+    for &p in points {
+        let (mut nearest, mut at) = (f64::INFINITY, start);
+        for k in 0..n {
+            let i = (start + k) % n;
+            let d = distance(p, &tris[i]);
+            if d < nearest {
+                (nearest, at) = (d, i);
+                if nearest <= worst {
+                    break;
+                }
+            }
+        }
+        worst = worst.max(nearest);
+        start = at;
+    }
+    worst
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -334,5 +358,38 @@ mod tests {
         );
         assert_eq!(m.gable_triangles().len(), 14);
         assert_eq!(m.flat_triangles().len(), 10);
+    }
+
+    #[test]
+    fn the_early_break_finds_what_every_point_against_every_triangle_finds() {
+        // A fixed scatter (an LCG): 300 points against 200 triangles, in a 20 m box.
+        let mut x: u64 = 12345;
+        let mut next = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 20.0
+        };
+        let points: Vec<[f64; 3]> = (0..300).map(|_| [next(), next(), next()]).collect();
+        let tris: Vec<[[f64; 3]; 3]> = (0..200)
+            .map(|_| {
+                [
+                    [next(), next(), next()],
+                    [next(), next(), next()],
+                    [next(), next(), next()],
+                ]
+            })
+            .collect();
+        let brute = points
+            .iter()
+            .map(|&p| {
+                tris.iter()
+                    .map(|t| distance(p, t))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max);
+        assert_eq!(error(&points, &tris).to_bits(), brute.to_bits());
+        assert_eq!(error(&[], &tris), 0.0);
+        assert_eq!(error(&points, &[]), f64::INFINITY);
     }
 }
