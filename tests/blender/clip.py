@@ -4,9 +4,9 @@
         <tile.glb> <t0> <t1> ...
 
 Prints one line, `EDO_CITY_JSON {...}`: the scene's frame rate, the frame range the importer
-set, and for every walker (an object or an armature's bone named `person_<id>`) its world location (Blender's Z up: x east,
-y north of the tile's origin) and yaw (radians about Z) at each time. tests/crowd_clip.rs
-compares them with crowds/<tile>.csv.
+set, and for every walker (an object or an armature's bone named `person_<id>`) its world
+location (Blender's Z up: x east, y north of the tile's origin) and yaw (radians about Z) at
+each time. tests/crowd_clip.rs compares them with crowds/<tile>.csv.
 """
 import json
 import math

@@ -5,12 +5,13 @@
 // centre (longitude, latitude, height), the tiles loaded, the metadata row of the object at
 // the middle of the picture, the time to ready.
 //
-// Usage: node test/cesium.mjs <url> [screenshot.png] [screen-space error target]
+// Usage: node test/cesium.mjs <url> [screenshot.png | -] [screen-space error target]
+// (`-`: no screenshot; a small error target loads the leaves, e.g. 1 for the example town)
 import { launchChromium } from './launch.mjs';
 
 const [url, shot, sse] = process.argv.slice(2);
 if (!url) {
-  console.error('usage: node test/cesium.mjs <url> [screenshot.png]');
+  console.error('usage: node test/cesium.mjs <url> [screenshot.png | -] [screen-space error target]');
   process.exit(2);
 }
 const problems = [];

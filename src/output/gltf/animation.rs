@@ -172,27 +172,18 @@ pub(super) fn add(
     let (mut channels, mut samplers) = (Vec::new(), Vec::new());
     for (node, first, n) in animated {
         let t = &times[first..first + n];
-        let input = push(
-            buf,
-            json!({
-                "bufferView": views[0], "byteOffset": 4 * first, "componentType": 5126,
-                "count": n, "type": "SCALAR", "min": [t[0]], "max": [t[n - 1]],
-            }),
-        );
-        let moved = push(
-            buf,
-            json!({
-                "bufferView": views[1], "byteOffset": 12 * first, "componentType": 5126,
-                "count": n, "type": "VEC3",
-            }),
-        );
-        let turned = push(
-            buf,
-            json!({
-                "bufferView": views[2], "byteOffset": 16 * first, "componentType": 5126,
-                "count": n, "type": "VEC4",
-            }),
-        );
+        let input = buf.accessor(json!({
+            "bufferView": views[0], "byteOffset": 4 * first, "componentType": 5126,
+            "count": n, "type": "SCALAR", "min": [t[0]], "max": [t[n - 1]],
+        }));
+        let moved = buf.accessor(json!({
+            "bufferView": views[1], "byteOffset": 12 * first, "componentType": 5126,
+            "count": n, "type": "VEC3",
+        }));
+        let turned = buf.accessor(json!({
+            "bufferView": views[2], "byteOffset": 16 * first, "componentType": 5126,
+            "count": n, "type": "VEC4",
+        }));
         for (path, output) in [("translation", moved), ("rotation", turned)] {
             channels
                 .push(json!({"sampler": samplers.len(), "target": {"node": node, "path": path}}));
@@ -203,12 +194,6 @@ pub(super) fn add(
         clip: json!({"name": CLIP, "channels": channels, "samplers": samplers}),
         skins,
     })
-}
-
-/// Adds an accessor; returns its index.
-fn push(buf: &mut Buffer, accessor: Value) -> usize {
-    buf.accessors.push(accessor);
-    buf.accessors.len() - 1
 }
 
 /// The keys to keep (indices, the first and last always): from each kept key, the farthest

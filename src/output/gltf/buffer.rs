@@ -195,6 +195,12 @@ impl Buffer {
         self.close_view(start, target)
     }
 
+    /// Adds an accessor; returns its index.
+    pub fn accessor(&mut self, accessor: Value) -> usize {
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
     /// A float accessor of `n`-component elements (`SCALAR`, `VEC2`, `VEC3`), with `min`
     /// and `max` when asked (positions must have them).
     pub fn floats(&mut self, data: &[f32], n: usize, bounds: bool) -> usize {
@@ -228,8 +234,7 @@ impl Buffer {
             a["min"] = json!(lo);
             a["max"] = json!(hi);
         }
-        self.accessors.push(a);
-        self.accessors.len() - 1
+        self.accessor(a)
     }
 
     /// A unit-vector accessor (normals) quantized to normalized bytes (`KHR_mesh_quantization`):
@@ -244,14 +249,13 @@ impl Buffer {
             .collect();
         let view = self.attributes(&packed, |b| b);
         self.views[view]["byteStride"] = json!(4);
-        self.accessors.push(json!({
+        self.accessor(json!({
             "bufferView": view,
             "componentType": 5120,
             "normalized": true,
             "count": packed.len(),
             "type": "VEC3",
-        }));
-        self.accessors.len() - 1
+        }))
     }
 
     /// A position accessor of shorts (`KHR_mesh_quantization`; the node's scale makes them
@@ -268,15 +272,14 @@ impl Buffer {
         self.views[view]["byteStride"] = json!(8);
         let lo = [0, 1, 2].map(|k| data.iter().map(|p| p[k]).min().unwrap_or(0));
         let hi = [0, 1, 2].map(|k| data.iter().map(|p| p[k]).max().unwrap_or(0));
-        self.accessors.push(json!({
+        self.accessor(json!({
             "bufferView": view,
             "componentType": 5122,
             "count": data.len(),
             "type": "VEC3",
             "min": lo,
             "max": hi,
-        }));
-        self.accessors.len() - 1
+        }))
     }
 
     /// A vertex colour accessor (`COLOR_0`): linear RGBA as normalized unsigned bytes, which
@@ -284,14 +287,13 @@ impl Buffer {
     pub fn colours(&mut self, data: &[[u8; 4]]) -> usize {
         let view = self.attributes(data, |b| b);
         self.views[view]["byteStride"] = json!(4);
-        self.accessors.push(json!({
+        self.accessor(json!({
             "bufferView": view,
             "componentType": 5121,
             "normalized": true,
             "count": data.len(),
             "type": "VEC4",
-        }));
-        self.accessors.len() - 1
+        }))
     }
 
     /// A skinned primitive's `JOINTS_0` and `WEIGHTS_0` accessors (in that order): each vertex
@@ -304,23 +306,22 @@ impl Buffer {
         let j: Vec<[u8; 4]> = joints.iter().map(|&j| [j as u8, 0, 0, 0]).collect();
         let view = self.attributes(&j, |b| b);
         self.views[view]["byteStride"] = json!(4);
-        self.accessors.push(json!({
+        let joints_accessor = self.accessor(json!({
             "bufferView": view,
             "componentType": 5121,
             "count": j.len(),
             "type": "VEC4",
         }));
-        let joints_accessor = self.accessors.len() - 1;
         let w = vec![[1.0f32, 0.0, 0.0, 0.0]; joints.len()];
         let view = self.attributes(&w, |v| flat::<4, 16>(v.map(f32::to_le_bytes)));
         self.views[view]["byteStride"] = json!(16);
-        self.accessors.push(json!({
+        let weights = self.accessor(json!({
             "bufferView": view,
             "componentType": 5126,
             "count": w.len(),
             "type": "VEC4",
         }));
-        (joints_accessor, self.accessors.len() - 1)
+        (joints_accessor, weights)
     }
 
     /// The index accessor: u16 while the vertices fit, else u32.
@@ -346,13 +347,12 @@ impl Buffer {
             ),
             (None, false) => (self.numbers(idx, u32::to_le_bytes, Some(INDICES)), 5125),
         };
-        self.accessors.push(json!({
+        self.accessor(json!({
             "bufferView": view,
             "componentType": ctype,
             "count": idx.len(),
             "type": "SCALAR",
-        }));
-        self.accessors.len() - 1
+        }))
     }
 }
 
