@@ -6,7 +6,9 @@
 //! root's), grouped 4 x 4 per level up to one root, whose `transform` is the frame at the
 //! output origin in WGS84 ECEF (see [`globe`]). Bounding volumes are boxes that hold their
 //! content (leaves: the tile's extent, padded 5 cm) and every child (inner nodes, in the
-//! root's frame); geometric error doubles the node's width up the tree; `refine` is `ADD`.
+//! root's frame); every inner node has content of its own ([`lod`]), with its measured
+//! geometric error, which its children replace (`refine: REPLACE`). The parents are made
+//! depth first, each as soon as its children are.
 //! Without a CRS and without `origin_lonlat` the root's transform is the identity and a
 //! warning says the city is not placed on the globe.
 
@@ -111,10 +113,9 @@ const MIN_ERROR: f64 = 0.5;
 /// The simplification asked of a level: its width over this (1 km groups: 4 m).
 const TARGET_PER_WIDTH: f64 = 256.0;
 
-/// A node of the tree being built: its cell at its level, box in the root's frame, JSON,
-/// and what its parent is made from.
+/// A node of the tree being built: its box in the root's frame, JSON, and what its parent
+/// is made from.
 struct Node {
-    cell: (i64, i64),
     bounds: Aabb,
     json: Value,
     source: Source,
@@ -186,55 +187,25 @@ pub fn tileset(
     for l in &mut leaves {
         l.cell = (l.cell.0 - first.0, l.cell.1 - first.1);
     }
-    // Level 0: the leaves as nodes (box in the root frame for grouping, JSON).
-    let mut nodes: Vec<Node> = leaves
-        .iter()
-        .map(|l| {
-            let path = l
-                .tile
-                .glb
-                .as_ref()
-                .map(|f| f.path.clone())
-                .unwrap_or_default();
-            let json = json!({
-                "boundingVolume": {"box": l.local.as_box()},
-                "geometricError": 0.0,
-                "transform": l.transform.column_major(),
-                "content": {"uri": path},
-            });
-            Node {
-                cell: l.cell,
-                bounds: Aabb::of(l.local.corners().map(|p| l.transform.apply(p))),
-                json,
-                source: Source::Leaf(path, l.transform),
-            }
-        })
-        .collect();
-    let meshopt = manifest.params.output.glb_compression == "meshopt";
-    let textures = lod::read::texture_colours(out);
-    let mut width = size;
-    let mut level = 0;
-    while nodes.len() > 1 {
-        width *= FANOUT as f64;
-        level += 1;
-        let mut groups: BTreeMap<(i64, i64), Vec<Node>> = BTreeMap::new();
-        for n in nodes {
-            let key = (n.cell.0.div_euclid(FANOUT), n.cell.1.div_euclid(FANOUT));
-            groups.entry(key).or_default().push(n);
-        }
-        let groups: Vec<_> = groups.into_iter().collect();
-        let target = width / TARGET_PER_WIDTH;
-        let made: Vec<Result<(Node, ManifestFile), String>> = groups
-            .into_par_iter()
-            .map(|(cell, children)| parent(out, cell, children, level, target, meshopt, &textures))
-            .collect();
-        nodes = Vec::new();
-        for m in made {
-            let (node, file) = m?;
-            files.push(file);
-            nodes.push(node);
-        }
-    }
+    let tree = Tree {
+        out,
+        leaves: &leaves,
+        groups: hierarchy(&leaves.iter().map(|l| l.cell).collect::<Vec<_>>()),
+        size,
+        meshopt: manifest.params.output.glb_compression == "meshopt",
+        textures: lod::read::texture_colours(out),
+    };
+    let level = tree.groups.len();
+    let mut nodes: Vec<Node> = if level == 0 {
+        leaves.iter().map(leaf_node).collect()
+    } else {
+        let (node, mut made) = tree.node(level, 0)?;
+        // In the order the levels were once made one after the other: the first level's
+        // groups by cell, then the second's, ...
+        made.sort_by_key(|(level, index, _)| (*level, *index));
+        files.extend(made.into_iter().map(|(_, _, file)| file));
+        vec![node]
+    };
     let mut root = match nodes.pop() {
         Some(n) if n.json.get("children").is_some() => n.json,
         // One tile (or none): the root is a group over it.
@@ -288,6 +259,102 @@ fn box_diagonal(b: &serde_json::Value) -> f64 {
     2.0 * v[3..].iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
+/// The groups of each level above the leaves at `cells`, until one is left: a group's cell
+/// and its children's places on the level below (the leaves' in the manifest's order),
+/// groups in cell order.
+fn hierarchy(cells: &[(i64, i64)]) -> Vec<Vec<Group>> {
+    let mut levels = Vec::new();
+    let mut cells = cells.to_vec();
+    while cells.len() > 1 {
+        let mut groups: BTreeMap<(i64, i64), Vec<usize>> = BTreeMap::new();
+        for (i, c) in cells.iter().enumerate() {
+            let key = (c.0.div_euclid(FANOUT), c.1.div_euclid(FANOUT));
+            groups.entry(key).or_default().push(i);
+        }
+        let level: Vec<Group> = groups.into_iter().collect();
+        cells = level.iter().map(|(cell, _)| *cell).collect();
+        levels.push(level);
+    }
+    levels
+}
+
+/// A parent's cell and its children's places on the level below.
+type Group = ((i64, i64), Vec<usize>);
+
+/// What making the parents needs.
+struct Tree<'a> {
+    out: &'a Path,
+    leaves: &'a [Leaf<'a>],
+    /// [`hierarchy`]: `groups[l - 1]` are the parents of level `l`.
+    groups: Vec<Vec<Group>>,
+    size: f64,
+    meshopt: bool,
+    textures: lod::TextureColours,
+}
+
+impl Tree<'_> {
+    /// The node at `index` of `level` (0 the leaves) with the parents' files made under it,
+    /// each with its level and index.
+    ///
+    /// Depth first, so that a level's contents are held only until their parent is made,
+    /// not all of them until the whole next level is (1,000,000 lots: the first level's
+    /// contents alone held 1.1 GB).
+    fn node(&self, level: usize, index: usize) -> Result<(Node, Vec<Made>), String> {
+        if level == 0 {
+            return Ok((leaf_node(&self.leaves[index]), Vec::new()));
+        }
+        let (cell, children) = &self.groups[level - 1][index];
+        let below: Vec<Result<(Node, Vec<Made>), String>> = children
+            .par_iter()
+            .map(|&c| self.node(level - 1, c))
+            .collect();
+        let mut nodes = Vec::with_capacity(below.len());
+        let mut made = Vec::new();
+        for b in below {
+            let (node, files) = b?;
+            nodes.push(node);
+            made.extend(files);
+        }
+        let width = (0..level).fold(self.size, |w, _| w * FANOUT as f64);
+        let target = width / TARGET_PER_WIDTH;
+        let (node, file) = parent(
+            self.out,
+            *cell,
+            nodes,
+            level as u32,
+            target,
+            self.meshopt,
+            &self.textures,
+        )?;
+        made.push((level, index, file));
+        Ok((node, made))
+    }
+}
+
+/// A parent's file with its level and index there.
+type Made = (usize, usize, ManifestFile);
+
+/// A leaf as a node: its box in the root frame (for its parent's), its JSON.
+fn leaf_node(l: &Leaf) -> Node {
+    let path = l
+        .tile
+        .glb
+        .as_ref()
+        .map(|f| f.path.clone())
+        .unwrap_or_default();
+    let json = json!({
+        "boundingVolume": {"box": l.local.as_box()},
+        "geometricError": 0.0,
+        "transform": l.transform.column_major(),
+        "content": {"uri": path},
+    });
+    Node {
+        bounds: Aabb::of(l.local.corners().map(|p| l.transform.apply(p))),
+        json,
+        source: Source::Leaf(path, l.transform),
+    }
+}
+
 /// The parent at `cell` of `level` over `children`: its content made and written, its node.
 fn parent(
     out: &Path,
@@ -331,7 +398,6 @@ fn parent(
     });
     Ok((
         Node {
-            cell,
             bounds,
             json,
             source: Source::Made(content),
