@@ -8,13 +8,16 @@
 //! streets, walls, bark, stones) simplified by meshoptimizer with small parts pruned, the
 //! cut-outs (leaves, billboards) thinned to a quarter of their cards per level (or fewer,
 //! for cards so small they stay within the level's target) with each kept card scaled to
-//! cover as much, and no people. Surfaces are coloured per vertex (a texture by
-//! its mean colour) and drawn by one primitive; each cut-out material keeps its texture.
-//! Every object keeps its metadata row, so a click on a distant house names its lot.
+//! cover as much, no people, and no building within half the level's target. Surfaces are
+//! coloured per vertex (a texture by its mean colour) and drawn by one primitive; each
+//! cut-out material keeps its texture.
+//! Every object drawn keeps its metadata row (and only those keep theirs), so a click on a
+//! distant house names its lot.
 //!
 //! The `geometricError` of a parent is measured, not guessed: the largest of its children's
 //! errors, plus the largest distance this level moves a surface (a building's vertex from
-//! its massing, meshoptimizer's own error, half a kept card's size, the people left out).
+//! its massing, meshoptimizer's own error, half a kept card's size, the people and the
+//! buildings left out).
 
 pub mod massing;
 pub mod read;
@@ -154,6 +157,7 @@ pub fn coarsen(children: Vec<Content>, level: u32, target: f64) -> Content {
         level_error = level_error.max(m.gable_error);
     }
     out.masses.extend(masses);
+    level_error = level_error.max(leave_out_small(&mut out.masses, target));
     if level > 1 {
         for m in &out.masses {
             level_error = level_error.max(m.flat_error);
@@ -168,7 +172,61 @@ pub fn coarsen(children: Vec<Content>, level: u32, target: f64) -> Content {
         level_error = level_error.max(e);
     }
     out.error = child_error + level_error;
+    compact(&mut out);
     out
+}
+
+/// Leaves out the buildings whose largest size (long side or height) is at most half of
+/// `target`; the error of that is the tallest one's height, since each of its vertices
+/// stands at most so far above the ground beneath it, which is drawn.
+///
+/// Without it every level held every building of the city: the root of 1,000,000 lots was
+/// 106 MB (1.15 million boxes and their rows), the levels above the first twice the time
+/// and memory of the first. A building left out is within half the level's target, as the
+/// simplified ground, the thinned cards and the kept boxes are.
+fn leave_out_small(masses: &mut Vec<Mass>, target: f64) -> f64 {
+    let mut error = 0.0f64;
+    masses.retain(|m| {
+        let keep = m.size() > target / 2.0;
+        if !keep {
+            error = error.max(m.ridge - m.base);
+        }
+        keep
+    });
+    error
+}
+
+/// Keeps only the metadata rows that something drawn in `content` still names (not the
+/// people's, nor those of buildings left out), renumbered in their order.
+fn compact(content: &mut Content) {
+    let mut used = vec![false; content.features.len()];
+    let ids = (content.masses.iter().map(|m| m.id))
+        .chain(content.solid.ids.iter().copied())
+        .chain(
+            content
+                .cutouts
+                .values()
+                .flat_map(|c| c.part.ids.iter().copied()),
+        );
+    for id in ids {
+        if let Some(u) = used.get_mut(id as usize) {
+            *u = true;
+        }
+    }
+    let mut row = vec![0u32; used.len()];
+    let mut kept = 0u32;
+    for (r, &u) in row.iter_mut().zip(&used) {
+        *r = kept;
+        kept += u32::from(u);
+    }
+    let renumber = |id: &mut u32| *id = row.get(*id as usize).copied().unwrap_or(*id);
+    content.masses.iter_mut().for_each(|m| renumber(&mut m.id));
+    content.solid.ids.iter_mut().for_each(renumber);
+    for c in content.cutouts.values_mut() {
+        c.part.ids.iter_mut().for_each(renumber);
+    }
+    let mut used = used.into_iter();
+    content.features.retain(|_| used.next().unwrap_or(false));
 }
 
 /// The buildings of `solid` (triangles of a [`MASSED`] kind) as massing, and the rest.
@@ -395,5 +453,60 @@ mod tests {
         // Cards larger than the target stay as they are.
         let (big, e) = thin(cards(8, 5.0), 3.9);
         assert_eq!((big.indices.len(), e), (8 * 6, 0.0));
+    }
+
+    /// A level leaves out the buildings within half its target (the error is the tallest's
+    /// height) and keeps only the rows its surfaces name, renumbered in order.
+    #[test]
+    fn small_buildings_and_their_rows_leave_the_coarse_levels() {
+        let row = |name: &str, kind: &str| Feature {
+            name: name.into(),
+            kind: kind.into(),
+            ..Feature::default()
+        };
+        let house = |id: u32, long: f64, height: f64| Mass {
+            id,
+            rect: [[0.0, 0.0], [long, 0.0], [long, 4.0], [0.0, 4.0]],
+            base: 1.0,
+            eave: 1.0 + height / 2.0,
+            ridge: 1.0 + height,
+            flat: 1.0 + height,
+            wall: [0; 4],
+            roof: [0; 4],
+            gable_error: 0.0,
+            flat_error: 0.0,
+        };
+        let mut content = Content {
+            features: vec![
+                row("people", "people"),
+                row("kura_1", "kura"),
+                row("machiya_2", "machiya"),
+                row("terrain", "terrain"),
+                row("hall_3", "hall"),
+            ],
+            masses: vec![house(1, 6.0, 7.0), house(2, 18.0, 7.5), house(4, 5.0, 9.0)],
+            solid: Part {
+                positions: vec![[0.0; 3]; 3],
+                colours: vec![[0; 4]; 3],
+                ids: vec![3; 3],
+                indices: vec![0, 1, 2],
+                ..Part::default()
+            },
+            ..Content::default()
+        };
+        // Target 16 m: the kura (7 m) goes, the machiya (18 m long) and the hall (9 m tall)
+        // stay.
+        let e = leave_out_small(&mut content.masses, 16.0);
+        assert_eq!(e, 7.0);
+        assert_eq!(content.masses.len(), 2);
+        compact(&mut content);
+        let names: Vec<&str> = content.features.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(names, ["machiya_2", "terrain", "hall_3"]);
+        let ids: Vec<u32> = content.masses.iter().map(|m| m.id).collect();
+        assert_eq!(ids, [0, 2]);
+        assert_eq!(content.solid.ids, [1, 1, 1]);
+        // Nothing small enough: nothing leaves, and nothing is renumbered.
+        assert_eq!(leave_out_small(&mut content.masses, 10.0), 0.0);
+        assert_eq!(content.masses.len(), 2);
     }
 }
