@@ -385,22 +385,27 @@ mod tests {
         assert!((distance([3.0, 3.0, 0.0], &t) - 2.0f64.sqrt()).abs() < 1e-12);
     }
 
-    /// A box of 10 x 6 x 8 m with a gable roof: its own massing is exact (error 0 up to the
-    /// height steps), and the flat box's error is the roof's height above its top.
-    #[test]
-    fn a_gabled_house_is_its_own_massing_and_a_flat_box_errs_by_its_roof() {
-        let house = Mass {
+    /// A house of `long` x `wide` m on the ground, eaves and ridge at those heights.
+    fn gabled(long: f64, wide: f64, eave: f64, ridge: f64) -> Mass {
+        Mass {
             id: 0,
-            rect: [[0.0, 0.0], [10.0, 0.0], [10.0, 6.0], [0.0, 6.0]],
+            rect: [[0.0, 0.0], [long, 0.0], [long, wide], [0.0, wide]],
             base: 0.0,
-            eave: 4.0,
-            ridge: 8.0,
-            flat: 8.0,
+            eave,
+            ridge,
+            flat: ridge,
             wall: [0; 4],
             roof: [0; 4],
             gable_error: 0.0,
             flat_error: 0.0,
-        };
+        }
+    }
+
+    /// A box of 10 x 6 x 8 m with a gable roof: its own massing is exact (error 0 up to the
+    /// height steps), and the flat box's error is the roof's height above its top.
+    #[test]
+    fn a_gabled_house_is_its_own_massing_and_a_flat_box_errs_by_its_roof() {
+        let house = gabled(10.0, 6.0, 4.0, 8.0);
         let tris: Vec<_> = (house.gable_triangles().into_iter())
             .map(|t| (t, [200, 200, 200, 255]))
             .collect();
@@ -496,18 +501,7 @@ mod tests {
     /// candidate in full.
     #[test]
     fn the_cutoffs_choose_what_measuring_every_candidate_chooses() {
-        let house = Mass {
-            id: 0,
-            rect: [[0.0, 0.0], [12.0, 0.0], [12.0, 7.0], [0.0, 7.0]],
-            base: 0.0,
-            eave: 3.5,
-            ridge: 7.5,
-            flat: 7.5,
-            wall: [0; 4],
-            roof: [0; 4],
-            gable_error: 0.0,
-            flat_error: 0.0,
-        };
+        let house = gabled(12.0, 7.0, 3.5, 7.5);
         let lean_to = Mass {
             rect: [[12.0, 1.0], [15.0, 1.0], [15.0, 5.0], [12.0, 5.0]],
             eave: 2.0,
