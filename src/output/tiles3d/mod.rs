@@ -196,17 +196,18 @@ pub fn tileset(
         textures: lod::read::texture_colours(out),
     };
     let level = tree.groups.len();
-    let mut nodes: Vec<Node> = if level == 0 {
-        leaves.iter().map(leaf_node).collect()
+    // No level above the leaves: one leaf or none.
+    let top = if level == 0 {
+        leaves.first().map(leaf_node)
     } else {
         let (node, mut made) = tree.node(level, 0)?;
         // In the order the levels were once made one after the other: the first level's
         // groups by cell, then the second's, ...
         made.sort_by_key(|(level, index, _)| (*level, *index));
         files.extend(made.into_iter().map(|(_, _, file)| file));
-        vec![node]
+        Some(node)
     };
-    let mut root = match nodes.pop() {
+    let mut root = match top {
         Some(n) if n.json.get("children").is_some() => n.json,
         // One tile (or none): the root is a group over it.
         Some(n) => json!({
@@ -373,7 +374,6 @@ fn parent(
     meshopt: bool,
     textures: &lod::TextureColours,
 ) -> Result<(Node, ManifestFile), String> {
-    let mut contents = Vec::with_capacity(children.len());
     let mut bounds = Vec::new();
     let mut json_children = Vec::with_capacity(children.len());
     let mut sources = Vec::with_capacity(children.len());
@@ -382,7 +382,7 @@ fn parent(
         json_children.push(c.json);
         sources.push(c.source);
     }
-    let read: Vec<Result<lod::Content, String>> = sources
+    let contents: Vec<lod::Content> = sources
         .into_par_iter()
         .map(|source| match source {
             Source::Made(content) => Ok(content),
@@ -393,10 +393,10 @@ fn parent(
                 lod::read::leaf(&bytes, &path, &transform, textures)
             }
         })
-        .collect();
-    for c in read {
-        contents.push(c?);
-    }
+        .collect::<Vec<Result<_, String>>>()
+        // The first error in the children's order, whichever thread met it first.
+        .into_iter()
+        .collect::<Result<_, _>>()?;
     let mut content = lod::coarsen(contents, level, target);
     let name = format!("{level}_{}_{}", cell.0, cell.1);
     let glb = lod::write::content_glb(&name, &content, level, meshopt);

@@ -63,8 +63,7 @@ pub fn mass(id: u32, tris: &[([[f64; 3]; 3], [u8; 4])]) -> Option<Mass> {
     let original: Vec<[[f64; 3]; 3]> = tris.iter().map(|(t, _)| *t).collect();
     // Where each point's search starts, per kind of massing: where it ended for the height
     // before (the candidates differ in a few heights, so the nearest face rarely moves).
-    let mut gable_starts = Starts::new(points.len(), 14 * 4);
-    let mut flat_starts = Starts::new(points.len(), 10 * 4);
+    let (mut gable_starts, mut flat_starts) = (Starts::default(), Starts::default());
     for k in STEPS / 2..=STEPS {
         let h = base + (ridge - base) * k as f64 / STEPS as f64;
         let gable = Mass {
@@ -204,21 +203,11 @@ fn colours(tris: &[([[f64; 3]; 3], [u8; 4])]) -> ([u8; 4], [u8; 4]) {
 }
 
 /// Where each point's search for its nearest triangle starts, both ways of [`hausdorff`]
-/// (`usize::MAX`: where the point before it ended).
-#[derive(Debug, Clone)]
+/// (`usize::MAX`: where the point before it ended); sized by the first call.
+#[derive(Debug, Clone, Default)]
 pub struct Starts {
     there: Vec<usize>,
     back: Vec<usize>,
-}
-
-impl Starts {
-    /// For `points` building vertices and `samples` samples of the massing.
-    pub fn new(points: usize, samples: usize) -> Starts {
-        Starts {
-            there: vec![usize::MAX; points],
-            back: vec![usize::MAX; samples],
-        }
-    }
 }
 
 /// The distance between a building (its vertices `points`, its triangles `original`) and its
@@ -234,19 +223,26 @@ pub fn hausdorff(
     cutoff: f64,
     starts: &mut Starts,
 ) -> f64 {
+    starts.there.resize(points.len(), usize::MAX);
     let there = error(points, tris, 0.0, cutoff, &mut starts.there);
     if there >= cutoff {
         return there;
     }
-    let samples: Vec<[f64; 3]> = tris
-        .iter()
+    let samples = samples(tris);
+    starts.back.resize(samples.len(), usize::MAX);
+    // The way back only matters where it is larger than the way there.
+    error(&samples, original, there, cutoff, &mut starts.back)
+}
+
+/// The corners and centre of each of the massing's faces: where it is measured against the
+/// building.
+fn samples(tris: &[[[f64; 3]; 3]]) -> Vec<[f64; 3]> {
+    tris.iter()
         .flat_map(|t| {
             let c = [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0);
             [t[0], t[1], t[2], c]
         })
-        .collect();
-    // The way back only matters where it is larger than the way there.
-    error(&samples, original, there, cutoff, &mut starts.back)
+        .collect()
 }
 
 /// The largest of `floor` and the distances from each point to the nearest of the triangles;
@@ -524,21 +520,9 @@ mod tests {
         let points: Vec<[f64; 3]> = tris.iter().flat_map(|(t, _)| *t).collect();
         let original: Vec<_> = tris.iter().map(|(t, _)| *t).collect();
         let full = |massing: &[[[f64; 3]; 3]]| {
-            let samples: Vec<[f64; 3]> = massing
-                .iter()
-                .flat_map(|t| {
-                    let c = [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0);
-                    [t[0], t[1], t[2], c]
-                })
-                .collect();
             let inf = f64::INFINITY;
-            error(&points, massing, 0.0, inf, &mut []).max(error(
-                &samples,
-                &original,
-                0.0,
-                inf,
-                &mut [],
-            ))
+            let there = error(&points, massing, 0.0, inf, &mut []);
+            there.max(error(&samples(massing), &original, 0.0, inf, &mut []))
         };
         let (mut gable, mut flat) = ((f64::INFINITY, 0.0), (f64::INFINITY, 0.0));
         for k in STEPS / 2..=STEPS {
