@@ -475,6 +475,7 @@ fn write_city(
             &opts.out,
             &tiles_dir,
             &opts.out.join(output::TEXTURE_DIR),
+            &opts.out.join(output::gltf::models::DIR),
             &crowds_dir,
         ] {
             output::atomic::remove_leftover_temporaries(dir);
@@ -558,6 +559,7 @@ fn write_city(
                     mtl: None,
                     glb: None,
                     crowds: None,
+                    models: Vec::new(),
                     bounds: extent.map(|(lo, hi)| {
                         // Output frame (x east, y up, z south) to east, north, up.
                         let m = |v: i64| v as f64 / 1000.0;
@@ -650,7 +652,12 @@ fn write_city(
         written.push(r?);
     }
     let tiles_written = written.len();
-    let bytes_written: u64 = written.iter().map(|t| t.bytes()).sum();
+    // Each shared model once, however many tiles draw it.
+    let models: std::collections::BTreeMap<&str, u64> = (written.iter())
+        .flat_map(|t| t.models.iter().map(|f| (f.path.as_str(), f.bytes)))
+        .collect();
+    let bytes_written: u64 =
+        written.iter().map(|t| t.bytes()).sum::<u64>() + models.values().sum::<u64>();
 
     // The manifest's tiles: what this run wrote, plus (for --tiles) the earlier build's
     // entries for the tiles it did not touch.

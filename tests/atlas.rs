@@ -45,7 +45,7 @@ fn every_cut_out_is_drawn_from_its_cell_of_the_atlas_one_primitive_a_kind() {
         let path = out.join(glb);
         let bytes = std::fs::read(&path).unwrap();
         let glb = gltf::Gltf::from_slice_without_validation(&bytes).unwrap();
-        let blob = glb.blob.as_deref().unwrap();
+        let data = common::glb::buffers(&path, &glb);
         for node in glb.nodes() {
             let Some(mesh) = node.mesh() else { continue };
             let mut masked = 0;
@@ -78,7 +78,7 @@ fn every_cut_out_is_drawn_from_its_cell_of_the_atlas_one_primitive_a_kind() {
                         (c["texture"].as_str().unwrap().to_string(), r)
                     })
                     .collect();
-                let reader = prim.reader(|_| Some(blob));
+                let reader = prim.reader(|b| data.get(b.index()).map(|d| &d[..]));
                 let uvs: Vec<[f32; 2]> = reader.read_tex_coords(0).unwrap().into_f32().collect();
                 let idx: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
                 for tri in idx.chunks(3) {

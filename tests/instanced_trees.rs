@@ -2,13 +2,14 @@
 //! grown tree of a tile is an instance of its variant's model, with its own metadata row
 //! (`tree_<id>`, its lot), standing where `placements.csv` and the OBJ's copies have it: the
 //! model moved by each instance lands on the OBJ's `trees_grown` vertices. The GLB holds no
-//! copies.
+//! copies, nor the model: each variant is one file, `tiles/models/<species>_<k>.bin`, that
+//! every tile planting it references and lists in the manifest.
 
 mod common;
 
 use std::collections::{HashMap, HashSet};
 
-use common::glb::{accessor_floats, glb_json, strings};
+use common::glb::{accessor_floats, glb_json, shared_floats, strings};
 use common::{build_ok, synth};
 
 /// `v` rotated by the unit quaternion `q` (x, y, z, w).
@@ -81,7 +82,10 @@ fn each_grown_tree_is_an_instance_with_its_row_where_the_obj_has_its_copy() {
         .collect();
 
     let mut instances = 0u64;
-    for t in r["tiles"].as_array().unwrap() {
+    let mut models: HashSet<String> = HashSet::new();
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    for t in manifest["tiles"].as_array().unwrap() {
         let id = t["id"].as_str().unwrap();
         let bytes = std::fs::read(out.join(format!("tiles/{id}.glb"))).unwrap();
         let g = glb_json(&bytes);
@@ -120,12 +124,20 @@ fn each_grown_tree_is_an_instance_with_its_row_where_the_obj_has_its_copy() {
             let f = &n["extensions"]["EXT_instance_features"]["featureIds"][0];
             assert_eq!(f["featureCount"].as_u64().unwrap() as usize, tr.len());
             let mesh = &g["meshes"][n["mesh"].as_u64().unwrap() as usize];
+            let tiles = out.join("tiles");
             let model: Vec<Vec<f32>> = mesh["primitives"]
                 .as_array()
                 .unwrap()
                 .iter()
-                .flat_map(|p| accessor_floats(&bytes, &g, &p["attributes"]["POSITION"]))
+                .flat_map(|p| shared_floats(&tiles, &g, &p["attributes"]["POSITION"]))
                 .collect();
+            // The variant's file, listed with the tile.
+            let file = format!("tiles/models/{}.bin", mesh["name"].as_str().unwrap());
+            assert!(
+                t["models"].as_array().is_some(),
+                "{id}: the manifest lists no models with it"
+            );
+            models.insert(file);
             for i in 0..tr.len() {
                 instances += 1;
                 let row = ids[i][0] as usize;
@@ -151,4 +163,69 @@ fn each_grown_tree_is_an_instance_with_its_row_where_the_obj_has_its_copy() {
         }
     }
     assert_eq!(instances, grown, "every grown tree is an instance");
+    // Each variant's model is one file for the whole city, listed by the tiles that draw it.
+    let listed: HashSet<String> = (manifest["tiles"].as_array().unwrap().iter())
+        .flat_map(|t| t["models"].as_array().cloned().unwrap_or_default())
+        .map(|f| f["path"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(listed, models);
+    let on_disk = std::fs::read_dir(out.join("tiles/models")).unwrap().count();
+    assert_eq!(on_disk, models.len(), "no other file in tiles/models");
+}
+
+/// The shared models are part of the city as its tiles are: shards in separate directories
+/// merged, and a tile rebuilt with `--tiles` (its model deleted first), give the full build's
+/// files byte for byte; a build without variants leaves no model behind.
+#[test]
+fn shared_models_follow_shards_merge_and_single_tiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let town = dir.path().join("town");
+    synth(&town, 300, 5);
+    let params = dir.path().join("trees.toml");
+    std::fs::write(&params, "[trees]\nstyle = \"lsystem\"\nper_ha = 200.0\n").unwrap();
+    let p = params.to_str().unwrap();
+    let full = dir.path().join("full");
+    build_ok(&town, &full, &["--quiet", "--params", p]);
+    let models = common::all_files(&full.join("tiles/models"));
+    assert!(models.len() > 3, "{} models", models.len());
+    let same = |other: &std::path::Path| {
+        let (a, b) = (common::all_files(&full), common::all_files(other));
+        assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+        for (name, bytes) in &a {
+            assert!(bytes == &b[name], "{name} differs");
+        }
+    };
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    for (out, shard) in [(&a, "1/2"), (&b, "2/2")] {
+        common::run_ok(&town, out, &["--quiet", "--params", p, "--shard", shard]);
+    }
+    common::edo_city()
+        .arg("merge")
+        .arg(&a)
+        .arg(&b)
+        .assert()
+        .success();
+    same(&a);
+    // One tile again, its first model gone: written back, the same bytes.
+    let manifest = common::read_json(&full.join("manifest.json"));
+    let tile = (manifest["tiles"].as_array().unwrap().iter())
+        .find(|t| t["models"].as_array().is_some_and(|m| !m.is_empty()))
+        .unwrap();
+    let model = tile["models"][0]["path"].as_str().unwrap();
+    std::fs::remove_file(full.join(model)).unwrap();
+    let id = tile["id"].as_str().unwrap();
+    build_ok(&town, &full, &["--quiet", "--params", p, "--tiles", id]);
+    assert_eq!(
+        common::all_files(&full.join("tiles/models")),
+        models,
+        "{model} written back"
+    );
+    // Without variants no tile names a model: the directory goes.
+    std::fs::write(
+        &params,
+        "[trees]\nstyle = \"lsystem\"\nper_ha = 200.0\nvariants = 0\n",
+    )
+    .unwrap();
+    build_ok(&town, &full, &["--quiet", "--params", p, "--force"]);
+    assert!(!full.join("tiles/models").exists());
 }

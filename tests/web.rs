@@ -115,17 +115,34 @@ fn the_tileset_holds_every_tile_and_places_a_house_where_proj_does() {
     assert_eq!(report["tiles"][0]["glb_bytes"], tiles[0]["glb"]["bytes"]);
 
     // Every vertex of every GLB lies in its leaf's box (glTF y-up turned z-up as 3D Tiles
-    // does: (x, y, z) -> (x, -z, y)).
+    // does: (x, y, z) -> (x, -z, y)), its shorts placed by its node's translation and scale
+    // (within half a step of the millimetres the box was made from).
     for (leaf, _) in &leaves {
         let uri = leaf["content"]["uri"].as_str().unwrap();
         let g = glb_json(&std::fs::read(out.path().join(uri)).unwrap());
-        for mesh in g["meshes"].as_array().unwrap() {
+        for node in g["nodes"].as_array().unwrap() {
+            let Some(mesh) = node["mesh"].as_u64() else {
+                continue;
+            };
+            assert!(
+                node.get("skin").is_none(),
+                "no walkers in the example's build"
+            );
+            assert!(
+                node["extensions"].is_null(),
+                "no grown trees in the example's build"
+            );
+            let t = floats(&node["translation"]);
+            let sc = floats(&node["scale"])[0];
+            let mesh = &g["meshes"][mesh as usize];
             for p in mesh["primitives"].as_array().unwrap() {
                 let a = &g["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
+                assert_eq!(a["componentType"], 5122, "{uri}: shorts");
                 for m in [&a["min"], &a["max"]] {
                     let v = floats(m);
+                    let v = [0, 1, 2].map(|k| t[k] + sc * v[k]);
                     assert!(
-                        inside(&leaf["boundingVolume"]["box"], [v[0], -v[2], v[1]], 1e-4),
+                        inside(&leaf["boundingVolume"]["box"], [v[0], -v[2], v[1]], sc),
                         "{uri}: a vertex outside its box"
                     );
                 }

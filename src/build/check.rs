@@ -41,6 +41,7 @@ pub fn check(
                 mtl: None,
                 glb: None,
                 crowds: None,
+                models: Vec::new(),
                 bounds: None,
                 centre: [0.0; 2],
                 stats: meshes.stats,

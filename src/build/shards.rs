@@ -289,6 +289,7 @@ pub fn remove_stale_tiles(out: &Path, manifest: &Manifest) {
         }
     }
     let _ = std::fs::remove_dir(out.join(crate::output::tiles3d::LOD_DIR));
+    let _ = std::fs::remove_dir(out.join(crate::output::gltf::models::DIR));
     let _ = std::fs::remove_dir(out.join(crate::output::crowds::DIR));
 }
 

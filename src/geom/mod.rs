@@ -5,6 +5,7 @@
 //! `input` (a landmark model) and `output` (its own tiles, read back for their parents)
 //! both need.
 
+pub mod accessor;
 pub mod bbox;
 pub mod clip;
 pub mod crs;

@@ -510,6 +510,10 @@ pub struct ManifestTile {
     /// Its walkers' clips, `crowds/<id>.csv` (`people.motion = "boids"`, any format).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crowds: Option<ManifestFile>,
+    /// The shared models its GLB draws (`tiles/models/<species>_<k>.bin`, grown trees'
+    /// variants): other tiles list the same files.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub models: Vec<ManifestFile>,
     /// The extent of its content, metres relative to the origin: `[east_min, north_min,
     /// up_min, east_max, north_max, up_max]` (for the tileset's bounding boxes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -523,8 +527,14 @@ pub struct ManifestTile {
 }
 
 impl ManifestTile {
-    /// Every file of the tile, whatever the format, in a fixed order.
+    /// Every file of the tile, whatever the format, in a fixed order: its own, then the
+    /// shared models it draws.
     pub fn files(&self) -> impl Iterator<Item = &ManifestFile> {
+        self.own_files().chain(&self.models)
+    }
+
+    /// The files of the tile alone (not the shared models).
+    fn own_files(&self) -> impl Iterator<Item = &ManifestFile> {
         [&self.obj, &self.mtl, &self.glb, &self.crowds]
             .into_iter()
             .flatten()
@@ -537,15 +547,20 @@ impl ManifestTile {
                 Some("obj") => &mut self.obj,
                 Some("mtl") => &mut self.mtl,
                 Some("csv") => &mut self.crowds,
+                Some("bin") => {
+                    self.models.push(f);
+                    continue;
+                }
                 _ => &mut self.glb,
             };
             *slot = Some(f);
         }
     }
 
-    /// The bytes of all its files.
+    /// The bytes of its own files (a shared model is counted once by the caller, not with
+    /// each tile that draws it).
     pub fn bytes(&self) -> u64 {
-        self.files().map(|f| f.bytes).sum()
+        self.own_files().map(|f| f.bytes).sum()
     }
 }
 

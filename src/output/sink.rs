@@ -76,6 +76,7 @@ pub fn sinks(
             "glb" => Box::new(super::gltf::GlbSink {
                 meshopt: output.glb_compression == "meshopt",
                 atlas: atlas.cloned(),
+                shared: Default::default(),
             }),
             _ => continue,
         };

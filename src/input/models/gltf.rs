@@ -39,7 +39,7 @@ pub(super) fn load_gltf(
     let g = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| bad(&e))?;
     validate(&g.document).map_err(|e| bad(&e))?;
     drop(bytes);
-    float_positions(&g.document, shown)?;
+    readable_positions(&g.document, shown)?;
     let mut buffers = buffers(&g, dir, shown, confined)?;
     crate::geom::meshopt::decode(&g.document, &mut buffers, shown)?;
     check_accessors(&g.document, shown)?;
@@ -126,14 +126,17 @@ fn add_primitive(
     if triangles > MAX_TRIANGLES || model.positions.len() + pos_accessor.count() > MAX_ELEMENTS {
         return Err(too_many(shown, triangles));
     }
-    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-    let Some(pos) = reader.read_positions() else {
+    let get = |b: gltf::Buffer| buffers.get(b.index()).map(|d| &d.0[..]);
+    let reader = prim.reader(get);
+    // Quantized ones too (`KHR_mesh_quantization`: our own tiles' shorts, gltfpack's):
+    // the node's transform, in `world`, turns them into metres.
+    let Some(pos) = crate::geom::accessor::positions(prim, get) else {
         return Ok(());
     };
     let base = model.positions.len() as u32;
     model
         .positions
-        .extend(pos.map(|p| apply(world, p.map(f64::from))));
+        .extend(pos.into_iter().map(|p| apply(world, p.map(f64::from))));
     let n = model.positions.len() as u32 - base;
     let uv_base = model.uvs.len() as u32;
     if let Some(t) = reader.read_tex_coords(0) {
@@ -252,7 +255,8 @@ fn local_uri(uri: &str, dir: &Path, shown: &str) -> Result<std::path::PathBuf, S
 /// The crate's validation, with two extensions more than it knows: `KHR_mesh_quantization`,
 /// which our own GLB tiles require (byte normals), and `EXT_meshopt_compression`, which
 /// they require by default and [`super::meshopt`] decodes. What this reader takes from a model reads
-/// the same under it: positions (checked to be floats by [`float_positions`]), texture
+/// the same under it: positions (floats or `KHR_mesh_quantization`'s integers, checked by
+/// [`readable_positions`] and read each as itself by [`crate::geom::accessor`]), texture
 /// coordinates (normalized integers turned to floats by the crate) and indices; normals are
 /// not read.
 fn validate(doc: &gltf::Document) -> Result<(), gltf::Error> {
@@ -274,19 +278,19 @@ fn validate(doc: &gltf::Document) -> Result<(), gltf::Error> {
     }
 }
 
-/// Refuses positions that are not floats (`KHR_mesh_quantization` allows integers with a
-/// node scale, which the crate's reader would take as floats).
-fn float_positions(doc: &gltf::Document, shown: &str) -> Result<(), String> {
+/// Refuses positions that are not three floats, shorts or bytes (what `KHR_mesh_quantization`
+/// allows): no reader would know what else means.
+fn readable_positions(doc: &gltf::Document, shown: &str) -> Result<(), String> {
     for mesh in doc.meshes() {
         for prim in mesh.primitives() {
             let Some(a) = prim.get(&gltf::Semantic::Positions) else {
                 continue;
             };
-            if a.data_type() != gltf::accessor::DataType::F32
+            if a.data_type() == gltf::accessor::DataType::U32
                 || a.dimensions() != gltf::accessor::Dimensions::Vec3
             {
                 return Err(format!(
-                    "{shown}: mesh {} has quantized positions ({:?}), which are not read: \
+                    "{shown}: mesh {} has positions of {:?}, which glTF does not allow: \
                      export the model with float positions",
                     mesh.index(),
                     a.data_type()

@@ -98,7 +98,7 @@ pub(super) fn add(
         for (&material, p) in prims.iter_mut() {
             p.reorder();
             if !p.indices.is_empty() {
-                primitives.push(super::primitive_json(p, material, true, buf, used));
+                primitives.push(super::primitive_json(p, material, true, None, buf, used));
             }
         }
         if primitives.is_empty() {

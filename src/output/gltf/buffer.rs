@@ -28,6 +28,9 @@ pub struct Buffer {
     pub meshopt: bool,
     /// The decoded size of the compressed views: the fallback buffer's `byteLength`.
     pub fallback: usize,
+    /// External buffers (shared models, see [`super::models`]): URI and length, numbered
+    /// after the BIN chunk and the fallback buffer.
+    pub externals: Vec<(String, usize)>,
 }
 
 /// meshopt's two codecs, as `EXT_meshopt_compression` names them.
@@ -48,21 +51,47 @@ impl Buffer {
         }
     }
 
-    /// The glTF `buffers`: the BIN chunk and, when a view was compressed, the fallback buffer.
+    /// The glTF `buffers`: the BIN chunk, the fallback buffer when a view was compressed
+    /// (or an external buffer needs index 1 to be it), then the external buffers.
     pub fn buffers_json(&self) -> Value {
         let mut out = vec![json!({"byteLength": self.bin.len().next_multiple_of(4)})];
-        if self.fallback > 0 {
+        if self.fallback > 0 || (self.meshopt && !self.externals.is_empty()) {
             out.push(json!({
-                "byteLength": self.fallback,
+                "byteLength": self.fallback.max(4),
                 "extensions": {"EXT_meshopt_compression": {"fallback": true}},
             }));
+        }
+        for (uri, length) in &self.externals {
+            out.push(json!({"uri": uri, "byteLength": length}));
         }
         json!(out)
     }
 
+    /// The index of the external buffer `uri` (`length` bytes), added at first use. With
+    /// meshopt on, index 1 is the fallback buffer, written even if no view of the tile's own
+    /// was compressed.
+    pub fn external(&mut self, uri: &str, length: usize) -> usize {
+        let first = if self.meshopt { 2 } else { 1 };
+        let k = match self.externals.iter().position(|(u, _)| u == uri) {
+            Some(k) => k,
+            None => {
+                self.externals.push((uri.to_string(), length));
+                self.externals.len() - 1
+            }
+        };
+        first + k
+    }
+
+    /// Room for `length` decoded bytes in the fallback buffer; returns their offset.
+    pub fn reserve_fallback(&mut self, length: usize) -> usize {
+        let offset = self.fallback.next_multiple_of(8);
+        self.fallback = offset + length;
+        offset
+    }
+
     /// Whether a view was compressed (and the file needs `EXT_meshopt_compression`).
     pub fn compressed(&self) -> bool {
-        self.fallback > 0
+        self.fallback > 0 || (self.meshopt && !self.externals.is_empty())
     }
 
     /// Stores `raw` (`count` elements of `stride` bytes) compressed as a view of the fallback
@@ -86,8 +115,7 @@ impl Buffer {
         };
         let start = self.align();
         self.bin.extend_from_slice(&encoded);
-        let offset = self.fallback.next_multiple_of(8);
-        self.fallback = offset + raw.len();
+        let offset = self.reserve_fallback(raw.len());
         let mut v = json!({
             "buffer": 1,
             "byteOffset": offset,

@@ -1,30 +1,29 @@
-//! A tile's grown trees by instancing: each variant's model once (a mesh of one primitive per
-//! material, without feature ids) and one node that draws it at every tree of the variant
-//! (`EXT_mesh_gpu_instancing`: translation, rotation about the vertical, scale), each
-//! instance with its own row of the metadata table (`EXT_instance_features`, the instance
-//! attribute `_FEATURE_ID_0`), so a click on one tree names its lot. The tile's bytes then
-//! grow with the variants, not the trees; three.js draws a node as one `InstancedMesh` per
-//! primitive, CesiumJS as instanced draws.
+//! A tile's grown trees by instancing: each variant's model (a shared file,
+//! [`super::models`], one primitive per material, without feature ids) and one node that
+//! draws it at every tree of the variant (`EXT_mesh_gpu_instancing`: translation, rotation
+//! about the vertical, scale), each instance with its own row of the metadata table
+//! (`EXT_instance_features`, the instance attribute `_FEATURE_ID_0`), so a click on one tree
+//! names its lot. The tile's bytes then grow with the trees, not their branches; three.js
+//! draws a node as one `InstancedMesh` per primitive, CesiumJS as instanced draws.
 //!
 //! The OBJ draws the same trees as copies (`trees_grown`, made by `variant::place_copy` with the
 //! same numbers), so both formats show the same branches; the GLB leaves that mesh out.
 
-use std::collections::BTreeMap;
-
 use serde_json::{json, Value};
 
 use super::buffer::Buffer;
-use super::{Primitive, Slot};
+use super::models::Model;
 use crate::generate::planted::Instanced;
 
 /// The mesh and the node of each variant, appended to `meshes` and `nodes` (the node's mesh
-/// is its index there). `origin` is the dataset origin (map metres) and `shift` the tile
-/// centre (output millimetres) the translations are taken around; `first_feature` is the
-/// metadata row of the first tree; `used` the tile's materials in first-use order.
+/// is its index there). `models` are the variants' shared models, in the order of `groups`
+/// (one per group with trees); `origin` is the dataset origin (map metres) and `shift` the
+/// tile centre (output millimetres) the translations are taken around; `first_feature` is
+/// the metadata row of the first tree; `used` the tile's materials in first-use order.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn add(
     groups: &[Instanced],
-    atlas: Option<&crate::output::atlas::Atlas>,
+    models: &[&Model],
     origin: [f64; 2],
     shift: [i64; 3],
     first_feature: usize,
@@ -34,33 +33,23 @@ pub(super) fn add(
     nodes: &mut Vec<Value>,
 ) {
     let mut feature = first_feature;
-    for g in groups.iter().filter(|g| !g.trees.is_empty()) {
-        let mut prims: BTreeMap<u16, Primitive> = BTreeMap::new();
-        for f in &g.model.faces {
-            let slot = Slot::of(atlas, f.material);
-            prims
-                .entry(slot.key)
-                .or_default()
-                .face(0, &g.model, &f.corners, [0, 0, 0], slot);
-        }
-        let mut primitives = Vec::new();
-        for (&material, p) in prims.iter_mut() {
-            p.reorder();
-            if p.indices.is_empty() {
-                continue;
-            }
-            primitives.push(super::primitive_json(p, material, false, buf, used));
-        }
-        if primitives.is_empty() {
+    let planted = groups.iter().filter(|g| !g.trees.is_empty());
+    for (g, model) in planted.zip(models) {
+        if model.is_empty() {
+            // Its trees' rows are in the table all the same: the next variant's follow them.
+            feature += g.trees.len();
             continue;
         }
+        let primitives = super::models::graft(model, buf, used);
         let (mut t, mut r, mut s, mut ids) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for tree in &g.trees {
             let [x, y, z] = translation(tree.stance, origin, shift);
             t.extend_from_slice(&[x, y, z]);
             r.extend_from_slice(&rotation(tree.stance.place.rotation));
+            // The model's positions are shorts of `step` metres around the foot.
             let (w, h) = (tree.stance.scale * tree.stance.squeeze, tree.stance.scale);
-            s.extend_from_slice(&[w as f32, h as f32, w as f32]);
+            let (w, h) = (w as f32 * model.step, h as f32 * model.step);
+            s.extend_from_slice(&[w, h, w]);
             ids.push(feature as f32);
             feature += 1;
         }

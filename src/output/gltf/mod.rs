@@ -3,8 +3,9 @@
 //! `EXT_structural_metadata`) are plain JSON that `gltf-json` would hold as untyped values
 //! anyway.
 //!
-//! Frame: y-up, x = east, z = -north, metres around the tile's centre (so f32 keeps
-//! sub-millimetre precision); `tileset.json` places each tile. One node per object kind
+//! Frame: y-up, x = east, z = -north, metres around the tile's centre (positions as shorts
+//! on one grid per tile, [`quantize`], the nodes' translation and scale making them metres);
+//! `tileset.json` places each tile. One node per object kind
 //! (`machiya`, `kura`, `fence`, `people`, ...), so a viewer can hide a kind; one primitive
 //! per material within it, merged across objects; each vertex carries its object's row in
 //! the metadata table (`_FEATURE_ID_0`). Normals are normalized bytes (`KHR_mesh_quantization`,
@@ -16,6 +17,8 @@ mod animation;
 pub mod buffer;
 mod instances;
 pub mod metadata;
+pub mod models;
+pub mod quantize;
 
 use serde_json::{json, Value};
 
@@ -266,11 +269,13 @@ pub fn linear(c: f32) -> f32 {
 /// The GLB bytes of one tile. `shift` (millimetres, output frame) is the tile centre the
 /// positions are taken around; `features` has one entry per mesh. Grown trees come
 /// instanced when the tile has `instanced` variants (their copies in `trees_grown` are left
-/// out), each tree with its row of `instance_features` after the meshes' rows.
+/// out), each tree with its row of `instance_features` after the meshes' rows, drawn from
+/// `models` (the shared model of each variant with trees, in their order).
 pub fn tile_glb(
     tile: &crate::output::sink::TileContent,
     meshopt: bool,
     atlas: Option<&Atlas>,
+    models: &[&models::Model],
 ) -> buffer::Glb {
     let (meshes, features, shift, palette) =
         (tile.meshes, tile.features, tile.centre, tile.palette);
@@ -323,24 +328,38 @@ pub fn tile_glb(
     let mut used: Vec<u16> = Vec::new();
     let mut meshes_json = Vec::new();
     let mut nodes = Vec::new();
+    let grid = quantize::Grid::over(
+        (kinds.iter().flat_map(|(_, p)| p.values())).flat_map(|p| p.positions.iter().copied()),
+    );
     for (kind, prims) in &kinds {
         let mut primitives = Vec::new();
         for (&material, p) in prims {
             if p.indices.is_empty() {
                 continue;
             }
-            primitives.push(primitive_json(p, material, true, &mut buf, &mut used));
+            primitives.push(primitive_json(
+                p,
+                material,
+                true,
+                Some(&grid),
+                &mut buf,
+                &mut used,
+            ));
         }
         if primitives.is_empty() {
             continue;
         }
         // The kind in `extras` too: three.js copies it into the object's userData.
-        nodes.push(json!({"name": kind, "mesh": meshes_json.len(), "extras": {"kind": kind}}));
+        let mut node = json!({"name": kind, "mesh": meshes_json.len(), "extras": {"kind": kind}});
+        if let (Some(n), Some(t)) = (node.as_object_mut(), grid.node_transform().as_object()) {
+            n.extend(t.clone());
+        }
+        nodes.push(node);
         meshes_json.push(json!({"name": kind, "primitives": primitives}));
     }
     instances::add(
         tile.instanced,
-        atlas,
+        models,
         tile.origin,
         shift,
         features.len(),
@@ -420,16 +439,21 @@ pub fn tile_glb(
 /// A primitive's accessors written to `buf` (positions, normals, uvs, its objects' feature
 /// ids when `featured`, indices: in that order) and its JSON; its material is given its index
 /// in `used` (added at first use). An instanced model is not `featured`: its rows are its
-/// instances'.
+/// instances'. Positions are shorts on `grid` when given (its node carries the grid's
+/// transform), else floats (a skinned crowd: glTF ignores a skinned node's transform).
 fn primitive_json(
     p: &Primitive,
     material: u16,
     featured: bool,
+    grid: Option<&quantize::Grid>,
     buf: &mut Buffer,
     used: &mut Vec<u16>,
 ) -> Value {
     let vertices = p.positions.len() / 3;
-    let pos = buf.floats(&p.positions, 3, true);
+    let pos = match grid {
+        Some(g) => buf.short_positions(&g.shorts(&p.positions)),
+        None => buf.floats(&p.positions, 3, true),
+    };
     let nor = buf.unit_vectors(&p.normals);
     let uv = buf.floats(&p.uvs, 2, false);
     let fid = featured.then(|| buf.floats(&p.ids, 1, false));
@@ -545,6 +569,8 @@ pub struct GlbSink {
     pub meshopt: bool,
     /// The cut-out atlas the build wrote (`tiles/textures/cutouts.png`), if any.
     pub atlas: Option<Atlas>,
+    /// The grown trees' variants, written once for every tile that plants them.
+    pub shared: models::Shared,
 }
 
 impl crate::output::sink::Sink for GlbSink {
@@ -557,10 +583,20 @@ impl crate::output::sink::Sink for GlbSink {
         out: &std::path::Path,
         tile: &crate::output::sink::TileContent,
     ) -> std::io::Result<crate::output::sink::TileFiles> {
-        let glb = tile_glb(tile, self.meshopt, self.atlas.as_ref());
+        let atlas = self.atlas.as_ref();
+        let written = (tile.instanced.iter())
+            .filter(|g| !g.trees.is_empty())
+            .map(|g| self.shared.get(out, &g.model, atlas, self.meshopt))
+            .collect::<std::io::Result<Vec<_>>>()?;
+        let models: Vec<&models::Model> = written.iter().map(|w| &w.model).collect();
+        let glb = tile_glb(tile, self.meshopt, atlas, &models);
         let path = format!("tiles/{}.glb", tile.id);
+        let mut files = vec![crate::output::write_listed(out, path, &glb.parts())?];
+        // The shared models it draws: listed with every tile that needs them, so that a
+        // tile's files are whole wherever it is copied (merge) or checked.
+        files.extend(written.iter().map(|w| w.file.clone()));
         Ok(crate::output::sink::TileFiles {
-            files: vec![crate::output::write_listed(out, path, &glb.parts())?],
+            files,
             mesh_bytes: None,
         })
     }

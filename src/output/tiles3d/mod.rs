@@ -193,7 +193,7 @@ pub fn tileset(
         groups: hierarchy(&leaves.iter().map(|l| l.cell).collect::<Vec<_>>()),
         size,
         meshopt: manifest.params.output.glb_compression == "meshopt",
-        textures: lod::read::texture_colours(out),
+        sources: lod::read::Sources::of(out),
     };
     let level = tree.groups.len();
     // No level above the leaves: one leaf or none.
@@ -290,7 +290,7 @@ struct Tree<'a> {
     groups: Vec<Vec<Group>>,
     size: f64,
     meshopt: bool,
-    textures: lod::TextureColours,
+    sources: lod::read::Sources,
 }
 
 impl Tree<'_> {
@@ -333,7 +333,7 @@ impl Tree<'_> {
             level as u32,
             target,
             self.meshopt,
-            &self.textures,
+            &self.sources,
         )?;
         made.push((level, index, file));
         Ok((node, made))
@@ -372,7 +372,7 @@ fn parent(
     level: u32,
     target: f64,
     meshopt: bool,
-    textures: &lod::TextureColours,
+    reading: &lod::read::Sources,
 ) -> Result<(Node, ManifestFile), String> {
     let mut bounds = Vec::new();
     let mut json_children = Vec::with_capacity(children.len());
@@ -390,7 +390,7 @@ fn parent(
                 let bytes = std::fs::read(out.join(&path)).map_err(|e| {
                     format!("{path}: cannot read it back for the levels of detail: {e}")
                 })?;
-                lod::read::leaf(&bytes, &path, &transform, textures)
+                lod::read::leaf(&bytes, &path, &transform, reading)
             }
         })
         .collect::<Vec<Result<_, String>>>()

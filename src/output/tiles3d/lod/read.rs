@@ -8,6 +8,7 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::{Arc, Mutex};
 
 use gltf::Semantic;
 use serde_json::Value;
@@ -20,26 +21,78 @@ use crate::output::tiles3d::globe::Affine;
 /// The kinds a parent leaves out: people are the size of the error of the first level.
 pub const LEFT_OUT: &[&str] = &["people"];
 
+/// What reading the leaves needs besides their own bytes: the textures' colours and the
+/// shared models they draw, each read once.
+pub struct Sources {
+    /// The mean colour of each texture.
+    pub textures: TextureColours,
+    /// `tiles/`, where the leaves' external buffers (`models/<name>.bin`) are.
+    tiles: std::path::PathBuf,
+    /// The external buffers read so far, by URI.
+    models: Mutex<BTreeMap<String, Arc<Vec<u8>>>>,
+}
+
+impl Sources {
+    /// The sources of the build in `out`.
+    pub fn of(out: &Path) -> Sources {
+        Sources {
+            textures: texture_colours(out),
+            tiles: out.join("tiles"),
+            models: Mutex::default(),
+        }
+    }
+
+    /// The external buffer `uri` of a leaf (`shown`): a shared model the build wrote, read
+    /// once. A URI that is not one (another directory, a scheme, `..`) is refused: a leaf
+    /// read back names only what the build wrote.
+    fn model(&self, uri: &str, shown: &str) -> Result<Arc<Vec<u8>>, String> {
+        let name = uri.strip_prefix("models/").unwrap_or("");
+        let ours = name.ends_with(".bin")
+            && (name.chars()).all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.')
+            && !name.contains("..");
+        if !ours {
+            return Err(format!(
+                "{shown}: its buffer `{uri}` is not a shared model of this build \
+                 (models/<name>.bin): build the tiles again"
+            ));
+        }
+        let mut models = self.models.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(b) = models.get(uri) {
+            return Ok(b.clone());
+        }
+        let path = self.tiles.join(uri);
+        let bytes = std::fs::read(&path).map_err(|e| {
+            format!(
+                "{shown}: its shared model {} cannot be read ({e}): build the tiles again",
+                path.display()
+            )
+        })?;
+        let b = Arc::new(bytes);
+        models.insert(uri.to_string(), b.clone());
+        Ok(b)
+    }
+}
+
 /// Reads `tiles/<id>.glb` (its bytes `bytes`) placed by `transform` (leaf frame, z up, to
 /// the root's frame).
 pub fn leaf(
     bytes: &[u8],
     shown: &str,
     transform: &Affine,
-    textures: &TextureColours,
+    sources: &Sources,
 ) -> Result<Content, String> {
+    let textures = &sources.textures;
     let g = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| format!("{shown}: not a readable GLB: {e}"))?;
     let mut buffers: Vec<gltf::buffer::Data> = Vec::new();
     let mut blob = g.blob.clone();
     for b in g.document.buffers() {
-        let data = if crate::geom::meshopt::is_fallback(&b) {
-            vec![0; b.length().next_multiple_of(4)]
-        } else {
-            let mut d = blob.take().unwrap_or_default();
-            d.resize(d.len().next_multiple_of(4).max(b.length()), 0);
-            d
+        let mut data = match b.source() {
+            _ if crate::geom::meshopt::is_fallback(&b) => Vec::new(),
+            gltf::buffer::Source::Uri(uri) => sources.model(uri, shown)?.to_vec(),
+            gltf::buffer::Source::Bin => blob.take().unwrap_or_default(),
         };
+        data.resize(data.len().next_multiple_of(4).max(b.length()), 0);
         buffers.push(gltf::buffer::Data(data));
     }
     crate::geom::meshopt::decode(&g.document, &mut buffers, shown)?;
@@ -68,13 +121,17 @@ pub fn leaf(
         let copies = instances(&node, &g.document, &get, shown)?;
         for prim in mesh.primitives() {
             let reader = prim.reader(get);
-            let model: Vec<[f32; 3]> = match reader.read_positions() {
-                Some(p) => p.collect(),
-                None => continue,
+            let Some(model) = crate::geom::accessor::positions(&prim, get) else {
+                continue;
             };
             let (positions, ids, indices) = match &copies {
+                // Drawn once, where its node puts it (quantized positions: the grid's
+                // translation and scale).
                 None => (
-                    model.iter().map(|&p| place(p)).collect::<Vec<_>>(),
+                    model
+                        .iter()
+                        .map(|&p| place(moved(&node, p)))
+                        .collect::<Vec<_>>(),
                     None,
                     None,
                 ),
@@ -247,6 +304,12 @@ fn instances<'a>(
             })
             .collect(),
     ))
+}
+
+/// `p` moved by `node`'s own transform (a leaf's nodes are at the tile's root).
+fn moved(node: &gltf::Node, p: [f32; 3]) -> [f32; 3] {
+    let m = node.transform().matrix();
+    [0, 1, 2].map(|r| m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r])
 }
 
 /// The largest side of the box around `points`.
