@@ -19,6 +19,7 @@
 //! its massing, meshoptimizer's own error, half a kept card's size, the people and the
 //! buildings left out).
 
+mod hidden;
 pub mod massing;
 pub mod read;
 pub mod write;

@@ -18,7 +18,8 @@ use crate::output::gltf::metadata;
 pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> buffer::Glb {
     let mut solid = content.solid.clone();
     let flat = level > 1;
-    for m in &content.masses {
+    let hidden = super::hidden::hidden_walls(&content.masses, flat);
+    for (m, hidden) in content.masses.iter().zip(hidden) {
         let tris = if flat {
             m.flat_triangles()
         } else {
@@ -26,6 +27,10 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
         };
         let mut shared: HashMap<([u64; 3], bool), u32> = HashMap::new();
         for (i, t) in tris.iter().enumerate() {
+            // Wall k is triangles 2k and 2k + 1; one against a neighbour's is not drawn.
+            if i < 8 && hidden[i / 2] {
+                continue;
+            }
             // The 8 walls and the gables in the wall colour; the roof planes (or the flat
             // top) in the roof's. Corners are shared within a colour.
             let roof = i >= 8 && (flat || i < 12);
