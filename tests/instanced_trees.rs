@@ -188,13 +188,6 @@ fn shared_models_follow_shards_merge_and_single_tiles() {
     build_ok(&town, &full, &["--quiet", "--params", p]);
     let models = common::all_files(&full.join("tiles/models"));
     assert!(models.len() > 3, "{} models", models.len());
-    let same = |other: &std::path::Path| {
-        let (a, b) = (common::all_files(&full), common::all_files(other));
-        assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
-        for (name, bytes) in &a {
-            assert!(bytes == &b[name], "{name} differs");
-        }
-    };
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
     for (out, shard) in [(&a, "1/2"), (&b, "2/2")] {
         common::run_ok(&town, out, &["--quiet", "--params", p, "--shard", shard]);
@@ -205,7 +198,7 @@ fn shared_models_follow_shards_merge_and_single_tiles() {
         .arg(&b)
         .assert()
         .success();
-    same(&a);
+    common::assert_same_tree(&full, &a);
     // One tile again, its first model gone: written back, the same bytes.
     let manifest = common::read_json(&full.join("manifest.json"));
     let tile = (manifest["tiles"].as_array().unwrap().iter())

@@ -7,18 +7,6 @@ use std::path::Path;
 use common::*;
 use predicates::prelude::*;
 
-fn assert_same_tree(a: &Path, b: &Path) {
-    let (fa, fb) = (all_files(a), all_files(b));
-    assert_eq!(
-        fa.keys().collect::<Vec<_>>(),
-        fb.keys().collect::<Vec<_>>(),
-        "same files"
-    );
-    for (name, bytes) in &fa {
-        assert!(bytes == &fb[name], "{name} differs");
-    }
-}
-
 #[test]
 fn regenerated_tiles_are_byte_identical_to_a_full_build() {
     let work = tempfile::tempdir().unwrap();

@@ -84,6 +84,19 @@ pub fn all_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     out
 }
 
+/// Fails unless directories `a` and `b` hold the same files with the same bytes.
+pub fn assert_same_tree(a: &Path, b: &Path) {
+    let (fa, fb) = (all_files(a), all_files(b));
+    assert_eq!(
+        fa.keys().collect::<Vec<_>>(),
+        fb.keys().collect::<Vec<_>>(),
+        "same files"
+    );
+    for (name, bytes) in &fa {
+        assert!(bytes == &fb[name], "{name} differs");
+    }
+}
+
 /// Lots of a shapefile: id -> (use, mtype, polygon).
 pub fn read_lots(shp: &Path) -> HashMap<String, (String, String, Polygon<f64>)> {
     let mut reader = shapefile::Reader::from_path(shp).expect("lots readable");
