@@ -182,9 +182,16 @@ impl Shared {
             return Ok(w.clone());
         }
         let encoded = encode(model, atlas, meshopt);
-        let dir = out.join(DIR);
-        std::fs::create_dir_all(&dir)?;
-        let file = crate::output::write_listed(out, encoded.path(), &[&encoded.bin])?;
+        // The tile's writer names the tile if this fails: say which file it was.
+        let named = |e: std::io::Error| {
+            std::io::Error::new(
+                e.kind(),
+                format!("{}: {e}", out.join(encoded.path()).display()),
+            )
+        };
+        std::fs::create_dir_all(out.join(DIR)).map_err(named)?;
+        let file =
+            crate::output::write_listed(out, encoded.path(), &[&encoded.bin]).map_err(named)?;
         let w = Arc::new(Written {
             model: encoded,
             file,
