@@ -458,13 +458,7 @@ fn primitive_json(
     let uv = buf.floats(&p.uvs, 2, false);
     let fid = featured.then(|| buf.floats(&p.ids, 1, false));
     let ind = buf.indices(&p.indices, vertices);
-    let m = match used.iter().position(|&u| u == material) {
-        Some(m) => m,
-        None => {
-            used.push(material);
-            used.len() - 1
-        }
-    };
+    let m = material_index(used, material);
     let mut prim = json!({
         "attributes": {"POSITION": pos, "NORMAL": nor, "TEXCOORD_0": uv},
         "indices": ind,
@@ -485,6 +479,18 @@ fn primitive_json(
         }]}});
     }
     prim
+}
+
+/// The index of `material` among the tile's materials `used` (in first-use order), added
+/// at its first use.
+fn material_index(used: &mut Vec<u16>, material: u16) -> usize {
+    match used.iter().position(|&u| u == material) {
+        Some(m) => m,
+        None => {
+            used.push(material);
+            used.len() - 1
+        }
+    }
 }
 
 /// The images and textures of a tile (leaf or parent), with the one sampler they share

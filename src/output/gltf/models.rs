@@ -27,6 +27,21 @@ use crate::output::report::ManifestFile;
 /// `tiles/textures/`, so a tile reaches them without `..`).
 pub const DIR: &str = "tiles/models";
 
+/// The URI of the model named `name`, relative to `tiles/` (a variant's name is
+/// `<species>_<k>`, the species' name checked to be letters, digits and `_`).
+fn uri_of(name: &str) -> String {
+    format!("models/{name}.bin")
+}
+
+/// Whether `uri` is one [`uri_of`] makes: `models/<name>.bin`, the name of letters, digits,
+/// `_` and `.` but no `..`. Readers of our own tiles take no other external buffer.
+pub fn is_shared_uri(uri: &str) -> bool {
+    let name = uri.strip_prefix("models/").unwrap_or("");
+    name.ends_with(".bin")
+        && (name.chars()).all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.')
+        && !name.contains("..")
+}
+
 /// One model encoded as a buffer of its own.
 pub struct Model {
     /// The file's URI relative to `tiles/` (`models/<name>.bin`).
@@ -76,7 +91,7 @@ pub fn encode(model: &Mesh, atlas: Option<&crate::output::atlas::Atlas>, meshopt
         primitives.push((material, prim));
     }
     Model {
-        uri: format!("models/{}.bin", model.name),
+        uri: uri_of(&model.name),
         step: grid.step,
         bin: buf.bin,
         views: buf.views,
@@ -138,13 +153,7 @@ pub fn graft(model: &Model, buf: &mut Buffer, used: &mut Vec<u16>) -> Vec<Value>
             }
         }
         prim["indices"] = renumber(&prim["indices"]);
-        prim["material"] = json!(match used.iter().position(|u| u == material) {
-            Some(m) => m,
-            None => {
-                used.push(*material);
-                used.len() - 1
-            }
-        });
+        prim["material"] = json!(super::material_index(used, *material));
         out.push(prim);
     }
     out
@@ -219,6 +228,22 @@ mod tests {
         m.face(1, [(a, t), (b, t), (c, t)].into_iter().collect());
         m.face(2, [(a, t), (c, t), (d, t)].into_iter().collect());
         m.finish()
+    }
+
+    #[test]
+    fn only_the_uris_of_shared_models_are_taken() {
+        assert!(is_shared_uri(&uri_of("matsu_3")));
+        for bad in [
+            "../matsu_3.bin",
+            "models/../matsu_3.bin",
+            "models/a/b.bin",
+            "models/matsu_3.png",
+            "https://example.org/models/matsu_3.bin",
+            "/models/matsu_3.bin",
+            "models/.bin.",
+        ] {
+            assert!(!is_shared_uri(bad), "{bad}");
+        }
     }
 
     #[test]

@@ -46,11 +46,7 @@ impl Sources {
     /// once. A URI that is not one (another directory, a scheme, `..`) is refused: a leaf
     /// read back names only what the build wrote.
     fn model(&self, uri: &str, shown: &str) -> Result<Arc<Vec<u8>>, String> {
-        let name = uri.strip_prefix("models/").unwrap_or("");
-        let ours = name.ends_with(".bin")
-            && (name.chars()).all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.')
-            && !name.contains("..");
-        if !ours {
+        if !crate::output::gltf::models::is_shared_uri(uri) {
             return Err(format!(
                 "{shown}: its buffer `{uri}` is not a shared model of this build \
                  (models/<name>.bin): build the tiles again"
@@ -119,6 +115,8 @@ pub fn leaf(
         };
         // A node drawn at many places (instanced trees): each copy placed, with its own row.
         let copies = instances(&node, &g.document, &get, shown)?;
+        // Its own transform (the grid of its quantized positions), once for all its vertices.
+        let matrix = node.transform().matrix();
         for prim in mesh.primitives() {
             let reader = prim.reader(get);
             let Some(model) = crate::geom::accessor::positions(&prim, get) else {
@@ -130,7 +128,7 @@ pub fn leaf(
                 None => (
                     model
                         .iter()
-                        .map(|&p| place(moved(&node, p)))
+                        .map(|&p| place(moved(&matrix, p)))
                         .collect::<Vec<_>>(),
                     None,
                     None,
@@ -306,9 +304,9 @@ fn instances<'a>(
     ))
 }
 
-/// `p` moved by `node`'s own transform (a leaf's nodes are at the tile's root).
-fn moved(node: &gltf::Node, p: [f32; 3]) -> [f32; 3] {
-    let m = node.transform().matrix();
+/// `p` moved by a node's own transform `m` (column-major; a leaf's nodes are at the tile's
+/// root).
+fn moved(m: &[[f32; 4]; 4], p: [f32; 3]) -> [f32; 3] {
     [0, 1, 2].map(|r| m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r])
 }
 
