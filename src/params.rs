@@ -555,10 +555,23 @@ impl Default for Params {
     }
 }
 
+/// The largest parameter file read (the defaults, with every comment, are 20 KB).
+const MAX_PARAMS_BYTES: u64 = 16 << 20;
+
+/// The text of a parameter file, through `bounded` (a FIFO or device named instead is
+/// refused, never waited on).
+fn read_file(path: &Path) -> std::io::Result<String> {
+    use crate::bounded::Refusal;
+    crate::bounded::read_text(path, MAX_PARAMS_BYTES).map_err(|e| match e {
+        Refusal::Io(e) => e,
+        e => std::io::Error::new(std::io::ErrorKind::InvalidInput, e.to_string()),
+    })
+}
+
 impl Params {
     /// Reads a parameter file. Keys it leaves out keep their default values.
     pub fn from_path(path: &Path) -> Result<Params, ParamsError> {
-        let text = std::fs::read_to_string(path).map_err(|cause| ParamsError::Io {
+        let text = read_file(path).map_err(|cause| ParamsError::Io {
             path: path.display().to_string(),
             cause,
         })?;

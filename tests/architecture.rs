@@ -28,7 +28,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("bounded", &[]),
     // The procedural growers know nothing of GIS: plane geometry and the RNG only.
     ("growers", &["geom", "rng"]),
-    ("params", &["model", "growers"]),
+    ("params", &["model", "growers", "bounded"]),
     (
         "templates",
         &["materials", "geom", "model", "growers", "bounded"],

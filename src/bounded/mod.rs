@@ -6,10 +6,16 @@
 //! a file far larger than any real one. [`read`] opens only a regular file, checks its size
 //! against a cap before it opens it, and reads at most one byte past the cap, so a file that
 //! grows while it is read is refused too. Callers say what the file is and what to do.
+//! [`open`] is the one door every reader of a user's or another build's file goes through:
+//! it looks at the kind before opening, opens without blocking (a FIFO swapped in after the
+//! look would otherwise hold the open until a writer comes), and looks again at what it
+//! opened, so only a regular file is ever read.
 //! [`Confined`] adds where: a file a user's file names is read only inside the directories
 //! given for it, after its links are resolved.
 
+use std::fs::{File, Metadata};
 use std::io::Read;
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::Path;
 
 use thiserror::Error;
@@ -42,19 +48,46 @@ pub enum Refusal {
     Io(#[from] std::io::Error),
 }
 
-/// The bytes of the regular file `path`, of at most `cap` bytes.
-pub fn read(path: &Path, cap: u64) -> Result<Vec<u8>, Refusal> {
-    let meta = std::fs::metadata(path)?;
+/// The regular file `path`, open for reading, with its metadata as opened. A directory,
+/// device, FIFO or socket is refused before it is opened, and again after (it may have been
+/// swapped in between): the open never blocks, and nothing but a regular file is read.
+pub fn open(path: &Path) -> Result<(File, Metadata), Refusal> {
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(Refusal::NotRegular);
+    }
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(rustix::fs::OFlags::NONBLOCK.bits() as i32)
+        .open(path)?;
+    let meta = file.metadata()?;
     if !meta.is_file() {
         return Err(Refusal::NotRegular);
     }
+    Ok((file, meta))
+}
+
+/// [`open`] as `File::open` is used: the file alone, a refusal as an I/O error that says
+/// what the file is not ("is not a regular file ...").
+pub fn file(path: &Path) -> std::io::Result<File> {
+    match open(path) {
+        Ok((file, _)) => Ok(file),
+        Err(Refusal::Io(e)) => Err(e),
+        Err(e) => Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            e.to_string(),
+        )),
+    }
+}
+
+/// The bytes of the regular file `path`, of at most `cap` bytes.
+pub fn read(path: &Path, cap: u64) -> Result<Vec<u8>, Refusal> {
+    let (file, meta) = open(path)?;
     if meta.len() > cap {
         return Err(Refusal::TooLarge {
             bytes: meta.len(),
             cap,
         });
     }
-    let file = std::fs::File::open(path)?;
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     file.take(cap.saturating_add(1)).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > cap {

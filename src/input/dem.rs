@@ -7,6 +7,12 @@
 use std::path::Path;
 
 use super::InputError;
+
+/// The largest world file (`.tfw`, six numbers) read.
+const SIDECAR_BYTES: u64 = 1 << 20;
+/// The largest ESRI ASCII grid read (4e8 cells, the GeoTIFF bound, at about ten characters
+/// a cell).
+const ASCII_GRID_BYTES: u64 = 4 << 30;
 pub use crate::model::dem::{Dem, Sample};
 
 /// [`Dem::from_grid`], its complaint put to the file.
@@ -45,7 +51,7 @@ pub fn read_geotiff(path: &Path) -> Result<Dem, InputError> {
         file: file.clone(),
         message,
     };
-    let reader = std::fs::File::open(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+    let reader = crate::bounded::file(path).map_err(|e| bad(format!("cannot read: {e}")))?;
     let mut dec = Decoder::new(std::io::BufReader::new(reader))
         .map_err(|e| bad(format!("not a readable TIFF: {e}")))?;
     let (w, h) = dec
@@ -84,7 +90,7 @@ pub fn read_geotiff(path: &Path) -> Result<Dem, InputError> {
         }
         _ => {
             let tfw = path.with_extension("tfw");
-            let text = std::fs::read_to_string(&tfw).map_err(|_| {
+            let text = crate::bounded::read_text(&tfw, SIDECAR_BYTES).map_err(|_| {
                 bad(format!(
                     "no GeoTIFF placement tags and no world file {}: the DEM cannot be placed",
                     tfw.display()
@@ -153,7 +159,8 @@ pub fn read_ascii(path: &Path) -> Result<Dem, InputError> {
         file: file.clone(),
         message,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(format!("cannot read: {e}")))?;
+    let text = crate::bounded::read_text(path, ASCII_GRID_BYTES)
+        .map_err(|e| bad(format!("cannot be read: it {e}")))?;
     let mut words = text.split_ascii_whitespace().peekable();
     let (mut ncols, mut nrows, mut cell, mut nodata) = (None, None, None, None);
     let (mut x, mut y, mut centre) = (None, None, false);

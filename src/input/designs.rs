@@ -4,7 +4,6 @@
 //! size, a second design for the same garden) is skipped with its record and reason, and the
 //! rest are kept for `analyse::gardens`, which places each exactly or skips it with why.
 
-use std::io::Read as _;
 use std::path::Path;
 
 use super::InputError;
@@ -29,22 +28,19 @@ pub fn read_designs(params: &Params, data: &mut Dataset) -> Result<(), InputErro
     let label = path
         .file_name()
         .map_or_else(|| name.clone(), |n| n.to_string_lossy().into_owned());
-    let file = std::fs::File::open(path).map_err(|e| {
-        bad(format!(
-            "cannot read the designs file ({e}); `garden.designs` names it, relative to the \
-             parameter file (`edo-city serve --designs FILE` writes one)"
-        ))
+    let text = crate::bounded::read_text(path, MAX_DESIGNS_BYTES).map_err(|e| {
+        let what = match e {
+            crate::bounded::Refusal::NotRegular => "name a regular file",
+            crate::bounded::Refusal::TooLarge { .. } | crate::bounded::Refusal::Grew { .. } => {
+                "keep fewer designs in it"
+            }
+            crate::bounded::Refusal::Io(_) => {
+                "`garden.designs` names it, relative to the parameter file (`edo-city serve \
+                 --designs FILE` writes one)"
+            }
+        };
+        bad(format!("the designs file {e}: {what}"))
     })?;
-    let meta = file.metadata().map_err(|e| bad(e.to_string()))?;
-    if !meta.is_file() || meta.len() > MAX_DESIGNS_BYTES {
-        return Err(bad(format!(
-            "not a regular file of at most {MAX_DESIGNS_BYTES} bytes"
-        )));
-    }
-    let mut text = String::new();
-    file.take(MAX_DESIGNS_BYTES + 1)
-        .read_to_string(&mut text)
-        .map_err(|e| bad(format!("cannot read it as UTF-8 text ({e})")))?;
     let designs = Designs::parse(&text).map_err(bad)?;
     data.layers.push(LayerInfo {
         role: "designs".into(),

@@ -568,7 +568,7 @@ fn read_dem(
         }
     }
     let prj = path.with_extension("prj");
-    if let (Ok(wkt), Some(t)) = (std::fs::read_to_string(&prj), target) {
+    if let (Ok(wkt), Some(t)) = (crate::bounded::read_text(&prj, 1 << 20), target) {
         let own = Crs::from_wkt(&wkt).map_err(|m| InputError::Layer {
             file: prj.display().to_string(),
             message: m,

@@ -45,10 +45,14 @@ pub struct Layer {
     pub deleted: Vec<usize>,
 }
 
+/// The largest sidecar read (a `.prj` is a few hundred bytes).
+const SIDECAR_BYTES: u64 = 1 << 20;
+
 /// The text of a sidecar file (`.cpg`, `.prj`): `None` when there is none, `Err` saying what
 /// is wrong when it is there but cannot be read (a directory, no permission, not text).
 fn sidecar(path: &Path) -> Result<Option<String>, String> {
-    match std::fs::read(path) {
+    use crate::bounded::Refusal;
+    match crate::bounded::read(path, SIDECAR_BYTES) {
         Ok(bytes) => match String::from_utf8(bytes) {
             Ok(text) => Ok(Some(text)),
             Err(e) => match e
@@ -66,9 +70,13 @@ fn sidecar(path: &Path) -> Result<Option<String>, String> {
                 )),
             },
         },
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(Refusal::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
         Err(_) if path.is_dir() => Err(format!("{} is a directory, not a file", path.display())),
-        Err(e) => Err(format!("cannot read {}: {e}", path.display())),
+        Err(Refusal::Io(e)) => Err(format!("cannot read {}: {e}", path.display())),
+        Err(e) => Err(format!(
+            "{} {e}: name a file of a few lines",
+            path.display()
+        )),
     }
 }
 
@@ -77,7 +85,7 @@ fn sidecar(path: &Path) -> Result<Option<String>, String> {
 /// DBF is not held in memory a second time.
 fn deletion_flags(path: &Path) -> std::io::Result<Vec<bool>> {
     use std::io::{Read, Seek, SeekFrom};
-    let mut f = BufReader::new(File::open(path)?);
+    let mut f = BufReader::new(crate::bounded::file(path)?);
     let mut head = [0u8; 12];
     if f.read_exact(&mut head).is_err() {
         return Ok(Vec::new());
@@ -149,7 +157,7 @@ fn read_table(path: &Path, forced: &str) -> Result<Table, InputError> {
     };
     let mut warnings = Vec::new();
     let dbf_path = path.with_extension("dbf");
-    let dbf = File::open(&dbf_path).map_err(|e| match e.kind() {
+    let dbf = crate::bounded::file(&dbf_path).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => InputError::Layer {
             file: file.clone(),
             message: format!(
@@ -248,6 +256,20 @@ fn read_table(path: &Path, forced: &str) -> Result<Table, InputError> {
     })
 }
 
+/// The `.shp` and, when there is one, its `.shx`, each opened by [`crate::bounded::file`] (a
+/// FIFO or device in their place is refused, never waited on or read for ever).
+fn open_shapes(path: &Path) -> Result<shapefile::ShapeReader<BufReader<File>>, shapefile::Error> {
+    let source = BufReader::new(crate::bounded::file(path)?);
+    let shx = path.with_extension("shx");
+    match std::fs::symlink_metadata(&shx).is_ok() {
+        true => {
+            let index = BufReader::new(crate::bounded::file(&shx)?);
+            shapefile::ShapeReader::with_shx(source, index)
+        }
+        false => shapefile::ShapeReader::new(source),
+    }
+}
+
 /// Reads a whole layer. `forced` is the encoding from the parameter file, empty for none.
 ///
 /// The shapes and the attribute table are read at the same time (two files, two threads: at
@@ -256,7 +278,7 @@ pub fn read_layer(path: &Path, forced: &str) -> Result<Layer, InputError> {
     let file = path.display().to_string();
     let (shapes, table) = rayon::join(
         || {
-            shapefile::ShapeReader::from_path(path)
+            open_shapes(path)
                 .and_then(|r| r.read())
                 .map_err(|e| InputError::Layer {
                     file: file.clone(),

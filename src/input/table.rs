@@ -162,6 +162,9 @@ pub fn find_and_read(
     }
 }
 
+/// The largest CSV table read (a million lots' attributes are about 100 MB).
+const MAX_TABLE_BYTES: u64 = 4 << 30;
+
 fn table_error(path: &Path, message: String) -> InputError {
     InputError::Table {
         file: path.display().to_string(),
@@ -171,7 +174,8 @@ fn table_error(path: &Path, message: String) -> InputError {
 
 /// Reads a CSV table with a header row. A UTF-8 byte-order mark (Excel's export) is ignored.
 pub fn read_csv(path: &Path, id_field: &str) -> Result<Table, InputError> {
-    let bytes = std::fs::read(path).map_err(|e| table_error(path, e.to_string()))?;
+    let bytes = crate::bounded::read(path, MAX_TABLE_BYTES)
+        .map_err(|e| table_error(path, format!("the table {e}")))?;
     let text = match std::str::from_utf8(&bytes) {
         Ok(t) => t.trim_start_matches('\u{feff}').to_string(),
         // Excel on Japanese Windows saves CSV as Shift_JIS.
@@ -197,8 +201,11 @@ pub fn read_csv(path: &Path, id_field: &str) -> Result<Table, InputError> {
 
 /// Reads the named sheet (or the first) of an XLSX workbook, first row as header.
 pub fn read_xlsx(path: &Path, sheet: &str, id_field: &str) -> Result<Table, InputError> {
-    let mut book = calamine::open_workbook_auto(path)
+    let file = crate::bounded::file(path)
         .map_err(|e| table_error(path, format!("cannot open the workbook: {e}")))?;
+    let mut book: calamine::Xlsx<_> =
+        calamine::open_workbook_from_rs(std::io::BufReader::new(file))
+            .map_err(|e| table_error(path, format!("cannot open the workbook: {e}")))?;
     let names = book.sheet_names().to_vec();
     let name = if sheet.trim().is_empty() {
         names

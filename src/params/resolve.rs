@@ -40,11 +40,10 @@ pub(super) fn resolved_table(
                     });
                 }
                 chain.push(key.clone());
-                let parent_text =
-                    std::fs::read_to_string(&file).map_err(|cause| ParamsError::Io {
-                        path: format!("{key} (extended by {path})"),
-                        cause,
-                    })?;
+                let parent_text = super::read_file(&file).map_err(|cause| ParamsError::Io {
+                    path: format!("{key} (extended by {path})"),
+                    cause,
+                })?;
                 let dir = file.parent().unwrap_or(Path::new("."));
                 resolved_table(&parent_text, &key, dir, chain)?
             }

@@ -203,7 +203,8 @@ impl Keyer {
             return None;
         }
         self.h.update(len.to_le_bytes());
-        let Ok(file) = fs::File::open(path) else {
+        // A FIFO swapped in since it was listed is refused, not waited on.
+        let Ok(file) = crate::bounded::file(path) else {
             self.h.update(b"\0unreadable\0");
             return Some(());
         };

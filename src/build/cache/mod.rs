@@ -63,7 +63,7 @@ pub fn file_for(out: &Path) -> Option<PathBuf> {
 /// The input and plan cached for `out` under `key`, or `None` (no file, another key,
 /// damaged).
 pub fn load(file: &Path, key: &[u8; 32]) -> Option<(Dataset, Plan)> {
-    let mut r = BufReader::new(fs::File::open(file).ok()?);
+    let mut r = BufReader::new(crate::bounded::file(file).ok()?);
     let mut head = [0u8; 24 + 32];
     r.read_exact(&mut head).ok()?;
     if &head[..24] != MAGIC || &head[24..] != key {
