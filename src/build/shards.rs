@@ -31,9 +31,17 @@ fn manifests_in(out: &Path) -> Vec<PathBuf> {
     found
 }
 
+/// The largest manifest read (a million lots' is tens of MB; its skips can make it more).
+pub const MAX_MANIFEST_BYTES: u64 = 2 << 30;
+
+/// The bytes of a manifest, through `bounded` (a FIFO or device named so is refused).
+pub(crate) fn manifest_bytes(path: &Path) -> Result<Vec<u8>, BuildError> {
+    crate::bounded::read(path, MAX_MANIFEST_BYTES)
+        .map_err(|e| BuildError::Config(format!("{} {e}", path.display())))
+}
+
 fn read_manifest(path: &Path) -> Result<Manifest, BuildError> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| BuildError::Config(format!("cannot read {}: {e}", path.display())))?;
+    let bytes = manifest_bytes(path)?;
     serde_json::from_slice(&bytes).map_err(|e| {
         BuildError::Config(format!(
             "{} is not a manifest of this edo-city version ({e}); use another --out or --force",
@@ -87,7 +95,7 @@ pub fn check_out_dir(opts: &BuildOptions) -> Result<(), BuildError> {
     report::publish_paths(&mut current);
     let input = super::absolute(&opts.input);
     for path in manifests_in(&opts.out) {
-        let Ok(bytes) = std::fs::read(&path) else {
+        let Ok(bytes) = manifest_bytes(&path) else {
             continue;
         };
         let mut old: serde_json::Value = serde_json::from_slice(&bytes).unwrap_or_default();
@@ -283,7 +291,7 @@ pub fn remove_stale_tiles(out: &Path, manifest: &Manifest) {
         .chain(old.files.iter().map(|f| f.path.clone()));
     for path in old_files {
         let ours = path.starts_with("tiles/") || path.starts_with(crate::output::crowds::DIR);
-        let safe = ours && !path.contains("..");
+        let safe = ours && crate::output::listed::relative(&path).is_ok();
         if safe && !current.contains(path.as_str()) {
             let _ = std::fs::remove_file(out.join(&path));
         }
@@ -361,55 +369,26 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     }
     let _lock = crate::output::lock::OutLock::acquire(target)
         .map_err(|e| BuildError::Config(e.to_string()))?;
-    // Every file is checked against its shard's manifest before anything is written: a
-    // truncated or missing tile stops the merge with the target as it was.
-    let mut tiles: BTreeMap<String, report::ManifestTile> = BTreeMap::new();
-    let mut copies: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-    for (dir, path, m) in &shards {
-        let shard = m.shard.map(|[i, n]| format!("{i}/{n}")).unwrap_or_default();
-        for t in &m.tiles {
-            for f in t.files() {
-                let from = dir.join(&f.path);
-                let bytes = std::fs::read(&from).map_err(|e| {
-                    BuildError::Config(format!(
-                        "shard {shard}'s tile file {} cannot be read ({e}); {} lists it: run \
-                         that shard again, then merge",
-                        from.display(),
-                        path.display()
-                    ))
-                })?;
-                if bytes.len() as u64 != f.bytes || crate::output::sha256_hex(&bytes) != f.sha256 {
-                    return Err(BuildError::Config(format!(
-                        "shard {shard}'s tile file {} is not what {} lists ({} bytes, {} \
-                         expected, or another sha256): it was cut short or changed; run that \
-                         shard again, then merge",
-                        from.display(),
-                        path.display(),
-                        bytes.len(),
-                        f.bytes
-                    )));
-                }
-                if dir != target {
-                    copies.push((target.join(&f.path), bytes));
-                }
-            }
-            tiles.insert(t.id.clone(), t.clone());
+    let (tiles, files) = gather(&shards)?;
+    // Every file is copied under a temporary name and checked against its shard's manifest
+    // as it streams by (a file of the target itself is checked in place); only when all are
+    // in are they renamed, so a truncated, missing or stray file stops the merge with the
+    // target as it was, and no file is held in memory.
+    let mut staged = Vec::new();
+    for (f, (dir, shard, manifest)) in files.values() {
+        let listed = |e: crate::output::listed::Unlisted| {
+            BuildError::Config(format!(
+                "shard {shard}'s manifest {} {e}: run that shard again, then merge",
+                manifest.display()
+            ))
+        };
+        match *dir == target {
+            true => crate::output::listed::check(dir, f).map_err(listed)?,
+            false => staged.push(crate::output::listed::copy(dir, target, f).map_err(listed)?),
         }
     }
-    // The links are the same in every shard: the first one's, when it is elsewhere.
-    if let Some((dir, _, m)) = shards.first() {
-        for f in m.files.iter().filter(|f| f.path == "links.json") {
-            if dir != target {
-                let bytes = std::fs::read(dir.join(&f.path)).map_err(|e| write_err(dir, e))?;
-                copies.push((target.join(&f.path), bytes));
-            }
-        }
-    }
-    for (to, bytes) in &copies {
-        if let Some(parent) = to.parent() {
-            std::fs::create_dir_all(parent).map_err(|e| write_err(parent, e))?;
-        }
-        write_atomic(to, bytes).map_err(|e| write_err(to, e))?;
+    for s in staged {
+        s.commit().map_err(|e| write_err(target, e))?;
     }
     let mut merged = first.clone();
     merged.shard = None;
@@ -431,6 +410,61 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     Ok(rep)
 }
 
+/// Where each shard's file comes from: its directory, the shard (`I/N`) and its manifest.
+type Origin<'a> = (&'a PathBuf, String, &'a PathBuf);
+
+/// The merged city's tiles, and every file to bring into the target once (tiles, their
+/// shared models, `links.json`), each with the shard it is taken from. Two shards listing
+/// one path with other contents (a shared model grown otherwise) are refused, naming both.
+#[allow(clippy::type_complexity)]
+fn gather<'a>(
+    shards: &'a [(PathBuf, PathBuf, Manifest)],
+) -> Result<
+    (
+        BTreeMap<String, report::ManifestTile>,
+        BTreeMap<&'a str, (&'a report::ManifestFile, Origin<'a>)>,
+    ),
+    BuildError,
+> {
+    let mut tiles = BTreeMap::new();
+    let mut files: BTreeMap<&str, (&report::ManifestFile, Origin)> = BTreeMap::new();
+    for (k, (dir, path, m)) in shards.iter().enumerate() {
+        let shard = m.shard.map(|[i, n]| format!("{i}/{n}")).unwrap_or_default();
+        let links = m.files.iter().filter(|f| f.path == "links.json");
+        // The links are the same in every shard: the first one's.
+        let links = links.filter(|_| k == 0);
+        for f in m.tiles.iter().flat_map(|t| t.files()).chain(links) {
+            if let Some((g, (_, other, other_path))) = files.get(f.path.as_str()) {
+                if g.sha256 != f.sha256 || g.bytes != f.bytes {
+                    return Err(BuildError::Config(format!(
+                        "shards {other} and {shard} disagree on `{}` ({} and {} list other \
+                         bytes): they were built by other programs or parameters; run the \
+                         shards of one build again, then merge",
+                        f.path,
+                        other_path.display(),
+                        path.display()
+                    )));
+                }
+                continue;
+            }
+            files.insert(f.path.as_str(), (f, (dir, shard.clone(), path)));
+        }
+        for t in &m.tiles {
+            if let Some(before) = tiles.insert(t.id.clone(), t.clone()) {
+                if before != *t {
+                    return Err(BuildError::Config(format!(
+                        "tile {} is listed by two shards with other files (the second is \
+                         shard {shard}, {}): run the shards of one build again, then merge",
+                        t.id,
+                        path.display()
+                    )));
+                }
+            }
+        }
+    }
+    Ok((tiles, files))
+}
+
 /// Deletes the texture files an earlier build listed that this one did not write (an
 /// earlier layout kept them in `textures/`), and that directory once it is empty.
 pub fn remove_stale_textures(out: &Path, textures: &[report::ManifestFile]) {
@@ -440,7 +474,7 @@ pub fn remove_stale_textures(out: &Path, textures: &[report::ManifestFile]) {
     let current: HashSet<&str> = textures.iter().map(|f| f.path.as_str()).collect();
     for f in &old.textures {
         let safe = (f.path.starts_with("textures/") || f.path.starts_with("tiles/textures/"))
-            && !f.path.contains("..");
+            && crate::output::listed::relative(&f.path).is_ok();
         if safe && !current.contains(f.path.as_str()) {
             let _ = std::fs::remove_file(out.join(&f.path));
         }
@@ -474,11 +508,17 @@ pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildEr
 }
 
 /// What makes shard manifest `m` part of another build than `first`: the shard count, the
-/// first differing parameter, the input, or the origin. The input's path may differ (shards
+/// program and its version, the first differing parameter, the input, or the origin. The input's path may differ (shards
 /// run on other machines); what was read from it may not.
 fn difference(first: &Manifest, m: &Manifest) -> Option<String> {
     if m.shard.map(|s| s[1]) != first.shard.map(|s| s[1]) {
         return Some("the shard count differs".into());
+    }
+    if (&m.tool, &m.version) != (&first.tool, &first.version) {
+        return Some(format!(
+            "it was written by {} {}, the other by {} {}",
+            m.tool, m.version, first.tool, first.version
+        ));
     }
     let a = serde_json::to_value(&first.params).expect("parameters serialise");
     let b = serde_json::to_value(&m.params).expect("parameters serialise");

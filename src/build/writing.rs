@@ -12,10 +12,7 @@
 //! one differs; when all agree, the earlier run stopped before it changed anything that
 //! matters.
 
-use std::io::Read;
 use std::path::Path;
-
-use sha2::{Digest, Sha256};
 
 use super::{BuildError, BuildOptions, Selection};
 use crate::output::report::{Manifest, ManifestFile};
@@ -53,7 +50,8 @@ pub fn end(opts: &BuildOptions) {
 /// not.
 fn agrees_with_manifest(out: &Path) -> Result<(), String> {
     let path = out.join("manifest.json");
-    let bytes = std::fs::read(&path).map_err(|_| "it has no manifest.json".to_string())?;
+    let bytes =
+        super::shards::manifest_bytes(&path).map_err(|_| "it has no manifest.json".to_string())?;
     let manifest: Manifest = serde_json::from_slice(&bytes)
         .map_err(|e| format!("its manifest.json cannot be read ({e})"))?;
     let files = manifest
@@ -71,26 +69,8 @@ fn agrees_with_manifest(out: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Whether `out/<f.path>` has `f`'s size and sha256 (read in pieces: tiles can be large).
+/// Whether `out/<f.path>` has `f`'s size and sha256 (read in pieces: tiles can be large;
+/// a path that leaves `out` or names no regular file never agrees).
 fn on_disk_as_listed(out: &Path, f: &ManifestFile) -> bool {
-    let path = out.join(&f.path);
-    let Ok(meta) = std::fs::symlink_metadata(&path) else {
-        return false;
-    };
-    if !meta.is_file() || meta.len() != f.bytes {
-        return false;
-    }
-    let Ok(mut file) = std::fs::File::open(&path) else {
-        return false;
-    };
-    let mut h = Sha256::new();
-    let mut buf = vec![0u8; 1 << 20];
-    loop {
-        match file.read(&mut buf) {
-            Ok(0) => break,
-            Ok(n) => h.update(&buf[..n]),
-            Err(_) => return false,
-        }
-    }
-    crate::output::hex(&h.finalize()) == f.sha256
+    crate::output::listed::check(out, f).is_ok()
 }

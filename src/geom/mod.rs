@@ -3,10 +3,11 @@
 //! `output`) and the growers build on it. Where `geo` has the algorithm, it is used.
 //! One codec lives here too, [`meshopt`]: the decoding of compressed glTF meshes, which
 //! `input` (a landmark model) and `output` (its own tiles, read back for their parents)
-//! both need.
+//! both need, with [`buffers`], which gathers a glTF's buffers within a budget for both.
 
 pub mod accessor;
 pub mod bbox;
+pub mod buffers;
 pub mod clip;
 pub mod crs;
 pub mod frame;

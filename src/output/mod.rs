@@ -15,6 +15,7 @@ pub mod features;
 pub mod gltf;
 pub mod gpkg;
 pub mod links;
+pub mod listed;
 pub mod lock;
 pub mod obj;
 pub mod palette;
@@ -24,6 +25,7 @@ pub mod report;
 pub mod sink;
 pub mod sketch;
 pub mod species;
+pub mod target;
 pub mod text;
 pub mod tiles3d;
 

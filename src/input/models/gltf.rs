@@ -42,7 +42,6 @@ pub(super) fn load_gltf(
     readable_positions(&g.document, shown)?;
     let mut buffers = buffers(&g, dir, shown, confined)?;
     crate::geom::meshopt::decode(&g.document, &mut buffers, shown)?;
-    check_accessors(&g.document, shown)?;
     let mut model = Model::default();
     for m in g.document.materials() {
         let c = m.pbr_metallic_roughness().base_color_factor();
@@ -174,63 +173,27 @@ fn add_primitive(
 
 /// The document's buffers: the GLB's binary chunk, data URIs, and files beside the model
 /// read through `confined`, each at least as long as it declares, together under
-/// [`MAX_MODEL_BYTES`].
+/// [`MAX_MODEL_BYTES`] (`geom::buffers` checks every declared size and count).
 fn buffers(
     g: &gltf::Gltf,
     dir: &Path,
     shown: &str,
     confined: &Confined,
 ) -> Result<Vec<gltf::buffer::Data>, String> {
-    let mut blob = g.blob.clone();
-    let mut total = 0u64;
-    let mut out = Vec::new();
-    for b in g.document.buffers() {
-        let mut data = match b.source() {
-            // Filled by decoding its compressed views; counted against the bound first.
-            _ if crate::geom::meshopt::is_fallback(&b) => {
-                if total + b.length() as u64 > MAX_MODEL_BYTES {
-                    return Err(format!(
-                        "{shown}: its buffers hold more than {MAX_MODEL_BYTES} bytes: decimate it"
-                    ));
-                }
-                vec![0; b.length()]
-            }
-            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
-                format!(
-                    "{shown}: buffer {} is the GLB's binary chunk, which is missing: it is \
-                     damaged",
-                    b.index()
-                )
-            })?,
-            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                gltf::buffer::Data::from_source(b.source(), None)
-                    .map_err(|e| format!("{shown}: buffer {}'s data URI: {e}", b.index()))?
-                    .0
-            }
-            gltf::buffer::Source::Uri(uri) => {
-                let path = local_uri(uri, dir, shown)?;
-                let left = MAX_MODEL_BYTES.saturating_sub(total);
-                confined.read(&path, &format!("{shown}: buffer {}", excerpt(uri)), left)?
-            }
-        };
-        if data.len() < b.length() {
-            return Err(format!(
-                "{shown}: buffer {} declares {} bytes and holds {}: it is damaged",
-                b.index(),
-                b.length(),
-                data.len()
-            ));
+    let budget = crate::geom::buffers::Budget {
+        bytes: MAX_MODEL_BYTES,
+        elements: MAX_ELEMENTS,
+    };
+    crate::geom::buffers::gather(g, &budget, shown, |uri, left| {
+        if uri.starts_with("data:") {
+            let source = gltf::buffer::Source::Uri(uri);
+            return gltf::buffer::Data::from_source(source, None)
+                .map(|d| d.0)
+                .map_err(|e| format!("{shown}: a buffer's data URI: {e}"));
         }
-        total += data.len() as u64;
-        if total > MAX_MODEL_BYTES {
-            return Err(format!(
-                "{shown}: its buffers hold more than {MAX_MODEL_BYTES} bytes: decimate it"
-            ));
-        }
-        data.resize(data.len().next_multiple_of(4), 0);
-        out.push(gltf::buffer::Data(data));
-    }
-    Ok(out)
+        let path = local_uri(uri, dir, shown)?;
+        confined.read(&path, &format!("{shown}: buffer {}", excerpt(uri)), left)
+    })
 }
 
 /// The file a relative URI names, percent-decoded; a URI with a scheme (`file:`, `http:`)
@@ -296,24 +259,6 @@ fn readable_positions(doc: &gltf::Document, shown: &str) -> Result<(), String> {
                     a.data_type()
                 ));
             }
-        }
-    }
-    Ok(())
-}
-
-/// Refuses accessors that declare more elements than a model may hold, and sparse parts
-/// larger than their accessor: the crate would allocate or walk that many.
-fn check_accessors(doc: &gltf::Document, shown: &str) -> Result<(), String> {
-    for a in doc.accessors() {
-        let sparse = a.sparse().map_or(0, |s| s.count());
-        if a.count() > MAX_ELEMENTS || sparse > a.count() {
-            return Err(format!(
-                "{shown}: accessor {} declares {} elements ({} sparse), more than a model may \
-                 hold ({MAX_ELEMENTS}) or than it has: it is damaged, or too large to place",
-                a.index(),
-                a.count(),
-                sparse
-            ));
         }
     }
     Ok(())

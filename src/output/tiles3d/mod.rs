@@ -387,7 +387,7 @@ fn parent(
         .map(|source| match source {
             Source::Made(content) => Ok(content),
             Source::Leaf(path, transform) => {
-                let bytes = std::fs::read(out.join(&path)).map_err(|e| {
+                let bytes = lod::read::read_listed(out, &path).map_err(|e| {
                     format!("{path}: cannot read it back for the levels of detail: {e}")
                 })?;
                 lod::read::leaf(&bytes, &path, &transform, reading)

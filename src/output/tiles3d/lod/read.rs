@@ -21,13 +21,24 @@ use crate::output::tiles3d::globe::Affine;
 /// The kinds a parent leaves out: people are the size of the error of the first level.
 pub const LEFT_OUT: &[&str] = &["people"];
 
+/// What one leaf read back may take: its buffers (its shared models' and decoded views
+/// included) and the elements of any accessor. A leaf of ours is under a megabyte and a
+/// model a few; a leaf edited to declare more is refused, not allocated (issue 57).
+pub const BUDGET: crate::geom::buffers::Budget = crate::geom::buffers::Budget {
+    bytes: 1 << 30,
+    elements: 1 << 26,
+};
+/// The largest leaf GLB or shared model file read back.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
 /// What reading the leaves needs besides their own bytes: the textures' colours and the
 /// shared models they draw, each read once.
 pub struct Sources {
     /// The mean colour of each texture.
     pub textures: TextureColours,
-    /// `tiles/`, where the leaves' external buffers (`models/<name>.bin`) are.
-    tiles: std::path::PathBuf,
+    /// The build's directory, where the leaves' external buffers (`tiles/models/<name>.bin`)
+    /// are.
+    out: std::path::PathBuf,
     /// The external buffers read so far, by URI.
     models: Mutex<BTreeMap<String, Arc<Vec<u8>>>>,
 }
@@ -37,7 +48,7 @@ impl Sources {
     pub fn of(out: &Path) -> Sources {
         Sources {
             textures: texture_colours(out),
-            tiles: out.join("tiles"),
+            out: out.to_path_buf(),
             models: Mutex::default(),
         }
     }
@@ -56,13 +67,8 @@ impl Sources {
         if let Some(b) = models.get(uri) {
             return Ok(b.clone());
         }
-        let path = self.tiles.join(uri);
-        let bytes = std::fs::read(&path).map_err(|e| {
-            format!(
-                "{shown}: its shared model {} cannot be read ({e}): build the tiles again",
-                path.display()
-            )
-        })?;
+        let bytes = read_listed(&self.out, &format!("tiles/{uri}"))
+            .map_err(|e| format!("{shown}: its shared model {e}: build the tiles again"))?;
         let b = Arc::new(bytes);
         models.insert(uri.to_string(), b.clone());
         Ok(b)
@@ -80,21 +86,20 @@ pub fn leaf(
     let textures = &sources.textures;
     let g = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| format!("{shown}: not a readable GLB: {e}"))?;
-    let mut buffers: Vec<gltf::buffer::Data> = Vec::new();
-    let mut blob = g.blob.clone();
-    for b in g.document.buffers() {
-        let mut data = match b.source() {
-            _ if crate::geom::meshopt::is_fallback(&b) => Vec::new(),
-            gltf::buffer::Source::Uri(uri) => sources.model(uri, shown)?.to_vec(),
-            gltf::buffer::Source::Bin => blob.take().unwrap_or_default(),
-        };
-        data.resize(data.len().next_multiple_of(4).max(b.length()), 0);
-        buffers.push(gltf::buffer::Data(data));
-    }
+    let mut buffers = crate::geom::buffers::gather(&g, &BUDGET, shown, |uri, left| {
+        let model = sources.model(uri, shown)?;
+        match model.len() as u64 <= left {
+            true => Ok(model.to_vec()),
+            false => Err(format!(
+                "{shown}: its buffers hold more than {} bytes: build the tiles again",
+                BUDGET.bytes
+            )),
+        }
+    })?;
     crate::geom::meshopt::decode(&g.document, &mut buffers, shown)?;
     let get = |b: gltf::Buffer| buffers.get(b.index()).map(|d| &d.0[..]);
     let mut content = Content {
-        features: features(&g.document, &buffers),
+        features: features(&g.document, &buffers, shown)?,
         ..Content::default()
     };
     // glTF's y-up leaf frame to the 3D Tiles z-up one, then to the root's frame.
@@ -332,15 +337,21 @@ pub fn bounds<'a>(points: impl IntoIterator<Item = &'a [f64; 3]>) -> ([f64; 3], 
 
 /// The rows of the GLB's property table, as the writer laid them out
 /// ([`crate::output::gltf::metadata`]); a column the table leaves out is empty in every row.
-fn features(doc: &gltf::Document, buffers: &[gltf::buffer::Data]) -> Vec<Feature> {
+/// The table's `count` must be no more than its `name` column holds rows: a count of 1e10
+/// in a few bytes was allocated before it was believed (issue 57).
+fn features(
+    doc: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    shown: &str,
+) -> Result<Vec<Feature>, String> {
     let Some(table) = doc
         .extension_value("EXT_structural_metadata")
         .and_then(|m| m.get("propertyTables"))
         .and_then(|t| t.get(0))
     else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
-    let count = table["count"].as_u64().unwrap_or(0) as usize;
+    let count = table["count"].as_u64().unwrap_or(0);
     let view = |v: &Value| -> &[u8] {
         let Some(view) = v.as_u64().and_then(|i| doc.views().nth(i as usize)) else {
             return &[];
@@ -350,6 +361,15 @@ fn features(doc: &gltf::Document, buffers: &[gltf::buffer::Data]) -> Vec<Feature
             .and_then(|b| b.0.get(view.offset()..view.offset() + view.length()))
             .unwrap_or(&[])
     };
+    // Each row has a name: its end in the name column's string offsets (4 bytes a row).
+    let rows = (view(&table["properties"]["name"]["stringOffsets"]).len() / 4).saturating_sub(1);
+    if count > rows as u64 {
+        return Err(format!(
+            "{shown}: its property table claims {count} rows and holds {rows}: it is damaged; \
+             build the tiles again"
+        ));
+    }
+    let count = count as usize;
     let enums = doc
         .extension_value("EXT_structural_metadata")
         .map(|m| &m["schema"]["enums"]);
@@ -399,7 +419,7 @@ fn features(doc: &gltf::Document, buffers: &[gltf::buffer::Data]) -> Vec<Feature
     }
     let kura = view(&table["properties"]["kura"]["values"]);
     let mut take = |key: &str, i: usize| std::mem::take(&mut cols.get_mut(key).unwrap()[i]);
-    (0..count)
+    Ok((0..count)
         .map(|i| Feature {
             name: take("name", i),
             kind: take("kind", i),
@@ -410,7 +430,14 @@ fn features(doc: &gltf::Document, buffers: &[gltf::buffer::Data]) -> Vec<Feature
             source: take("source", i),
             kura: kura.get(i / 8).is_some_and(|b| b >> (i % 8) & 1 == 1),
         })
-        .collect()
+        .collect())
+}
+
+/// The bytes of a file a build listed (`dir/path`), checked as `output::listed` checks it
+/// and read within [`MAX_FILE_BYTES`]; the error names the path as listed.
+pub fn read_listed(dir: &Path, path: &str) -> Result<Vec<u8>, String> {
+    let real = crate::output::listed::locate(dir, path).map_err(|e| e.to_string())?;
+    crate::bounded::read(&real, MAX_FILE_BYTES).map_err(|e| format!("`{path}` {e}"))
 }
 
 /// The mean colour of each texture of the library (linear, alpha-weighted), read once.
