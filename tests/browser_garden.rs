@@ -3,8 +3,10 @@
 //! a click on the temple's garden offers "design", two candidates are picked (by clicking
 //! their pictures) for three generations, each pick changing the next generation, a second
 //! session with the same picks gets the same answers, and the candidate standing in place is
-//! kept. The town is rebuilt into the same directory with the designs file while the server
-//! runs; reloaded, the viewer's garden is the kept one, and its stones are in the tiles.
+//! kept. A page of another origin then tries to open a session and keep over the design
+//! (issue 57): nothing it sends changes the file. The town is rebuilt into the same
+//! directory with the designs file while the server runs; reloaded, the viewer's garden is
+//! the kept one, and its stones are in the tiles.
 
 mod common;
 
@@ -44,6 +46,21 @@ fn a_visitor_designs_the_temple_garden_keeps_it_and_finds_it_in_the_rebuilt_city
     let design = |v: &serde_json::Value| -> Design { serde_json::from_value(v.clone()).unwrap() };
     let file = read_json(&designs);
     assert_eq!(design(&file["designs"][0]), design(kept));
+
+    // Another origin's page: blind POSTs are sent but refused, the token cannot be read, a
+    // JSON POST never leaves the browser (its preflight is not granted).
+    let before = std::fs::read(&designs).unwrap();
+    let attacked = garden_mjs(&url, &["attack", "343"]);
+    assert_eq!(std::fs::read(&designs).unwrap(), before, "{attacked}");
+    assert!(
+        attacked["token"].as_str().unwrap().starts_with("failed"),
+        "{attacked}"
+    );
+    assert!(
+        attacked["json"].as_str().unwrap().starts_with("failed"),
+        "{attacked}"
+    );
+    assert_eq!(attacked["keeps"].as_array().unwrap().len(), 80);
 
     // Rebuilt where it was, with the design, while the server runs (--force: the
     // parameters differ from the build's there).

@@ -6,64 +6,11 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
+use common::designer::{ask, ask_with, built, error, page, post, serve, USES};
 use common::{build_objects, build_ok, fixture, read_json};
 use serde_json::{json, Value};
-
-/// Temple and estate lots both get gardens: the fixture then has two (lots 138 and 343).
-const USES: &str = "[garden]\nuses = [\"jisha\", \"buke\", \"kuge\"]\n";
-
-/// `edo-city serve` of `out`, with `--designs` when given; the server and its port.
-fn serve(dir: &Path, out: &Path, designs: Option<&Path>) -> (common::Server, u16) {
-    let viewer = dir.join("viewer");
-    std::fs::create_dir_all(viewer.join("node_modules/three")).unwrap();
-    std::fs::write(viewer.join("index.html"), "<!doctype html>").unwrap();
-    let mut cmd = Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
-    cmd.args(["serve", "--port", "0", "--viewer"])
-        .arg(&viewer)
-        .arg(out);
-    if let Some(d) = designs {
-        cmd.arg("--designs").arg(d);
-    }
-    let (server, url) = common::start_server(cmd);
-    let port = url
-        .trim_start_matches("http://127.0.0.1:")
-        .trim_end_matches('/')
-        .parse()
-        .unwrap();
-    (server, port)
-}
-
-/// One request on a connection of its own: the status and the body as JSON.
-fn ask(port: u16, method: &str, target: &str, body: &str) -> (u16, Value) {
-    let (status, text) = common::http(port, method, target, body);
-    let body = text.split_once("\r\n\r\n").map_or("", |(_, b)| b);
-    (status, serde_json::from_str(body).unwrap_or(Value::Null))
-}
-
-fn post(port: u16, route: &str, body: Value) -> (u16, Value) {
-    ask(
-        port,
-        "POST",
-        &format!("/api/gardens/{route}"),
-        &body.to_string(),
-    )
-}
-
-/// The fixture built with two gardens into `dir/out`, and the parameter file it used.
-fn built(dir: &Path) -> (PathBuf, PathBuf) {
-    let params = dir.join("params.toml");
-    std::fs::write(&params, USES).unwrap();
-    let out = dir.join("out");
-    build_ok(
-        &fixture("kyoto-small"),
-        &out,
-        &["--quiet", "--no-plan", "--params", params.to_str().unwrap()],
-    );
-    (out, params)
-}
 
 /// The report's garden of `key`.
 fn garden(report: &Value, key: &str) -> Value {
@@ -84,6 +31,7 @@ fn a_kept_design_survives_a_rebuild_stone_for_stone_and_other_gardens_stay_the_g
     let designs = dir.path().join("kept/designs.json");
     std::fs::create_dir(dir.path().join("kept")).unwrap();
     let (server, port) = serve(dir.path(), &out, Some(&designs));
+    let tok = page(port);
 
     let (status, list) = ask(port, "GET", "/api/gardens", "");
     assert_eq!(status, 200, "{list}");
@@ -96,16 +44,17 @@ fn a_kept_design_survives_a_rebuild_stone_for_stone_and_other_gardens_stay_the_g
     assert_eq!(keys, ["138", "343"]);
     assert_eq!(list["writable"], true);
 
-    let (status, s) = post(port, "open", json!({"lot": "343"}));
+    let (status, s) = post(port, &tok, "open", json!({"lot": "343"}));
     assert_eq!(status, 200, "{s}");
     let n = s["candidates"].as_array().unwrap().len();
     assert!((6..=9).contains(&n), "{n} candidates");
-    let session = s["session"].as_u64().unwrap();
+    let session = s["session"].as_str().unwrap().to_string();
     let mut g = 0;
     let mut last = s;
     for picks in [[0, 2], [1, 3], [0, 1]] {
         let (status, next) = post(
             port,
+            &tok,
             "next",
             json!({"session": session, "generation": g, "picks": picks}),
         );
@@ -120,6 +69,7 @@ fn a_kept_design_survives_a_rebuild_stone_for_stone_and_other_gardens_stay_the_g
     }
     let (status, kept) = post(
         port,
+        &tok,
         "keep",
         json!({"session": session, "generation": g, "candidate": 2}),
     );
@@ -228,15 +178,26 @@ fn bad_requests_get_a_clear_error_and_write_nothing() {
     let (out, _) = built(dir.path());
     let designs = dir.path().join("designs.json");
     let (server, port) = serve(dir.path(), &out, Some(&designs));
-    let error = |(status, v): (u16, Value)| (status, v["error"].as_str().unwrap_or("").to_string());
+    let tok = page(port);
 
-    let (status, e) = error(post(port, "open", json!({"lot": "nope"})));
+    let (status, e) = error(post(port, &tok, "open", json!({"lot": "nope"})));
     assert_eq!(status, 404);
     assert!(e.contains("no garden `nope`"), "{e}");
-    let (status, e) = error(post(port, "open", json!({"lot": "343", "population": 1})));
+    let (status, e) = error(post(
+        port,
+        &tok,
+        "open",
+        json!({"lot": "343", "population": 1}),
+    ));
     assert_eq!(status, 400);
     assert!(e.contains("population"), "{e}");
-    let (status, e) = error(ask(port, "POST", "/api/gardens/open", "{not json"));
+    let (status, e) = error(ask_with(
+        port,
+        &[("X-Edo-City-Token", &tok)],
+        "POST",
+        "/api/gardens/open",
+        "{not json",
+    ));
     assert_eq!(status, 400);
     assert!(e.contains("body"), "{e}");
     let (status, _) = ask(port, "GET", "/api/gardens/open", "");
@@ -244,10 +205,11 @@ fn bad_requests_get_a_clear_error_and_write_nothing() {
     let (status, _) = ask(port, "GET", "/api/gardens?h=5", "");
     assert_eq!(status, 404);
 
-    let (_, s) = post(port, "open", json!({"lot": "343"}));
-    let id = s["session"].as_u64().unwrap();
+    let (_, s) = post(port, &tok, "open", json!({"lot": "343"}));
+    let id = s["session"].as_str().unwrap().to_string();
     let (status, e) = error(post(
         port,
+        &tok,
         "next",
         json!({"session": id, "generation": 0, "picks": [0, 40]}),
     ));
@@ -255,18 +217,30 @@ fn bad_requests_get_a_clear_error_and_write_nothing() {
     assert!(e.contains("pick 40 is out of range"), "{e}");
     let (status, e) = error(post(
         port,
+        &tok,
         "next",
         json!({"session": id, "generation": 3, "picks": []}),
     ));
     assert_eq!(status, 409);
     assert!(e.contains("stale"), "{e}");
-    let (status, e) = error(post(port, "undo", json!({"session": id, "generation": 0})));
+    let (status, e) = error(post(
+        port,
+        &tok,
+        "undo",
+        json!({"session": id, "generation": 0}),
+    ));
     assert_eq!(status, 409);
     assert!(e.contains("nothing to undo"), "{e}");
-    let (status, _) = error(post(port, "next", json!({"session": 999, "generation": 0})));
+    let (status, _) = error(post(
+        port,
+        &tok,
+        "next",
+        json!({"session": "999", "generation": 0}),
+    ));
     assert_eq!(status, 404);
     let (status, e) = error(post(
         port,
+        &tok,
         "keep",
         json!({"session": id, "generation": 0, "candidate": 9}),
     ));
@@ -274,15 +248,17 @@ fn bad_requests_get_a_clear_error_and_write_nothing() {
     assert!(!designs.exists(), "nothing written");
 
     // The same picks from the same start: the same answers.
-    let (_, t) = post(port, "open", json!({"lot": "343"}));
+    let (_, t) = post(port, &tok, "open", json!({"lot": "343"}));
     assert_eq!(t["candidates"], s["candidates"]);
     let (_, a) = post(
         port,
+        &tok,
         "next",
         json!({"session": id, "generation": 0, "picks": [1, 4]}),
     );
     let (_, b) = post(
         port,
+        &tok,
         "next",
         json!({"session": t["session"], "generation": 0, "picks": [1, 4]}),
     );
@@ -292,6 +268,7 @@ fn bad_requests_get_a_clear_error_and_write_nothing() {
     std::fs::write(&designs, "garbage").unwrap();
     let (status, e) = error(post(
         port,
+        &tok,
         "keep",
         json!({"session": id, "generation": 1, "candidate": 0}),
     ));
@@ -306,6 +283,7 @@ fn bad_requests_get_a_clear_error_and_write_nothing() {
     // Two visitors on one garden: the second keep would lose the first, and is refused.
     let (status, _) = post(
         port,
+        &tok,
         "keep",
         json!({"session": id, "generation": 1, "candidate": 0}),
     );
@@ -313,6 +291,7 @@ fn bad_requests_get_a_clear_error_and_write_nothing() {
     let first = std::fs::read(&designs).unwrap();
     let (status, e) = error(post(
         port,
+        &tok,
         "keep",
         json!({"session": t["session"], "generation": 1, "candidate": 1}),
     ));
@@ -326,6 +305,7 @@ fn bad_requests_get_a_clear_error_and_write_nothing() {
     // The first visitor keeps again over their own design.
     let (status, _) = post(
         port,
+        &tok,
         "keep",
         json!({"session": id, "generation": 1, "candidate": 2}),
     );
@@ -334,9 +314,11 @@ fn bad_requests_get_a_clear_error_and_write_nothing() {
 
     // Without --designs the designer is read-only.
     let (server, port) = serve(dir.path(), &out, None);
-    let (_, s) = post(port, "open", json!({"lot": "138"}));
+    let tok = page(port);
+    let (_, s) = post(port, &tok, "open", json!({"lot": "138"}));
     let (status, e) = error(post(
         port,
+        &tok,
         "keep",
         json!({"session": s["session"], "generation": 0, "candidate": 0}),
     ));

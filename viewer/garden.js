@@ -65,10 +65,14 @@ export function createDesigner(ctx) {
   document.getElementById('dkeep').onclick = quiet(() => keep());
   document.getElementById('dclose').onclick = close;
 
+  // The page's token for writes (GET /api/token): the server refuses a POST without it,
+  // so another origin's page cannot drive the designer (docs/garden.md).
+  let token = null;
   async function call(route, body) {
+    if (!token) token = (await (await fetch('/api/token')).json()).token;
     const r = await fetch(`/api/gardens/${route}`, {
       method: 'POST',
-      headers: { 'content-type': 'application/json' },
+      headers: { 'content-type': 'application/json', 'x-edo-city-token': token },
       body: JSON.stringify(body),
     });
     const answer = await r.json();

@@ -7,7 +7,9 @@
 //! 3d-tiles-renderer, CesiumJS), from `viewer/node_modules`;
 //! `/hypotheses.json` the builds, in the order given; `/h/<k>/<path>` a file of build k;
 //! `/api/gardens...` the rock-garden designer (`serve/api.rs`), which writes only the file
-//! `--designs` names. Nothing outside those directories is ever served.
+//! `--designs` names. Nothing outside those directories is ever served, no request naming
+//! another host is answered, and a write must come from the served origin with a page
+//! token (`serve/guard.rs`).
 
 use std::path::{Path, PathBuf};
 
@@ -16,6 +18,7 @@ use clap::Args;
 
 mod api;
 mod designer;
+mod guard;
 mod http;
 
 /// The flags of `edo-city serve`.
@@ -120,7 +123,7 @@ fn hypotheses(outs: &[PathBuf]) -> Result<Vec<Hypothesis>> {
     let mut hs = Vec::new();
     for dir in outs {
         let manifest = dir.join("manifest.json");
-        let text = std::fs::read_to_string(&manifest).with_context(|| {
+        let bytes = edo_city::bounded::read(&manifest, 2 << 30).with_context(|| {
             format!(
                 "{} is not a build directory (no manifest.json): give the --out of `edo-city build`",
                 dir.display()
@@ -132,7 +135,7 @@ fn hypotheses(outs: &[PathBuf]) -> Result<Vec<Hypothesis>> {
                 dir.display()
             );
         }
-        let m: serde_json::Value = serde_json::from_str(&text)
+        let m: serde_json::Value = serde_json::from_slice(&bytes)
             .with_context(|| format!("{}: not a manifest", manifest.display()))?;
         let tiles = m["tiles"].as_array().map_or(0, |t| t.len());
         let name = dir
@@ -215,8 +218,15 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
     if args.open {
         let _ = std::process::Command::new("xdg-open").arg(&url).spawn();
     }
+    let guard = guard::Guard::new(port);
     let handler: http::Handler = std::sync::Arc::new(move |call: &http::Call| {
-        if let Some(a) = designer.answer(call.post, &call.target, &call.body) {
+        if let Err(r) = guard.host(&call.headers) {
+            return http::Answer::Refused {
+                status: r.status,
+                message: r.message,
+            };
+        }
+        if let Some(a) = designer.answer(call, &guard) {
             return a;
         }
         match call.post {

@@ -34,7 +34,12 @@ pub const MAX_GA: usize = 10_000;
 impl GardenParams {
     pub(super) fn validate(&self) -> Result<(), String> {
         for (key, v, lo, hi) in [
-            ("min_size", self.min_size, 1.0, 1000.0),
+            (
+                "min_size",
+                self.min_size,
+                crate::growers::garden::MIN_SIDE,
+                1000.0,
+            ),
             ("max_width", self.max_width, 1.0, 1000.0),
             ("clearance", self.clearance, 0.0, 100.0),
         ] {

@@ -3,6 +3,7 @@
 
 pub mod corpus;
 mod corpus_ledger;
+pub mod designer;
 pub mod glb;
 
 use std::collections::{BTreeMap, HashMap};
@@ -395,14 +396,37 @@ pub fn build_with_failing_template(dir: &Path) -> (PathBuf, serde_json::Value) {
 /// whole response (head and body) as text.
 #[allow(dead_code)]
 pub fn http(port: u16, method: &str, target: &str, body: &str) -> (u16, String) {
+    http_with(port, method, target, &[], body)
+}
+
+/// [`http`] with more headers (a page token, an `Origin`).
+#[allow(dead_code)]
+pub fn http_with(
+    port: u16,
+    method: &str,
+    target: &str,
+    headers: &[(&str, &str)],
+    body: &str,
+) -> (u16, String) {
     use std::io::{Read, Write};
     let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
     s.set_read_timeout(Some(std::time::Duration::from_secs(60)))
         .unwrap();
+    // The server's own Host and a JSON body, unless `headers` say otherwise.
+    let given = |name: &str| headers.iter().any(|(k, _)| k.eq_ignore_ascii_case(name));
+    let mut head = format!("{method} {target} HTTP/1.1\r\n");
+    if !given("host") {
+        head += &format!("Host: 127.0.0.1:{port}\r\n");
+    }
+    if !given("content-type") {
+        head += "Content-Type: application/json\r\n";
+    }
+    for (k, v) in headers {
+        head += &format!("{k}: {v}\r\n");
+    }
     write!(
         s,
-        "{method} {target} HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n\
-         Content-Length: {}\r\nConnection: close\r\n\r\n{body}",
+        "{head}Content-Length: {}\r\nConnection: close\r\n\r\n{body}",
         body.len()
     )
     .unwrap();

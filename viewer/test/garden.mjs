@@ -10,12 +10,22 @@
 //     reloads the viewer after a rebuild and prints the garden as the build lists it now.
 //   node test/garden.mjs <url> time <lot> <population> <generations>
 //     times "next generation" (server + transfer, then drawing the candidates).
+//   node test/garden.mjs <url> attack <lot>
+//     a page of another origin (a server of its own on another port) tries what a hostile
+//     site would: no-cors text/plain POSTs that open a session on <lot> and keep candidates
+//     of guessed sessions, reading a page token, a JSON POST with a made-up token. Prints
+//     what each attempt got; the caller checks that the designs file did not change.
+import http from 'node:http';
 import { launchChromium } from './launch.mjs';
 
 const [url, phase, lot, arg4, arg5] = process.argv.slice(2);
 if (!url || !phase || !lot) {
-  console.error('usage: node test/garden.mjs <url> design|check|time <lot> ...');
+  console.error('usage: node test/garden.mjs <url> design|check|time|attack <lot> ...');
   process.exit(2);
+}
+if (phase === 'attack') {
+  console.log(JSON.stringify(await attack(url, lot)));
+  process.exit(0);
 }
 const problems = [];
 const fail = (m) => problems.push(m);
@@ -97,7 +107,10 @@ try {
     if (JSON.stringify(again.candidates) !== JSON.stringify(third.candidates)) fail('undo and the same picks gave another generation');
     // A second session with the same picks: the same answers.
     out.replayed = await page.evaluate(async ([l, ps]) => {
-      const post = async (route, body) => (await fetch(`/api/gardens/${route}`, { method: 'POST', body: JSON.stringify(body) })).json();
+      // A page of its own: its own token.
+      const { token } = await (await fetch('/api/token')).json();
+      const headers = { 'content-type': 'application/json', 'x-edo-city-token': token };
+      const post = async (route, body) => (await fetch(`/api/gardens/${route}`, { method: 'POST', headers, body: JSON.stringify(body) })).json();
       let s = await post('open', { lot: l });
       for (const p of ps) s = await post('next', { session: s.session, generation: s.generation, picks: p });
       return s.candidates;
@@ -150,3 +163,42 @@ if (problems.length) {
   process.exit(1);
 }
 console.log(JSON.stringify(out));
+
+/** The hostile page: served from another origin, it attacks the server at `target`. */
+async function attack(target, lot) {
+  const page = `<!doctype html><title>elsewhere</title><script>
+    window.attacked = (async () => {
+      const target = ${JSON.stringify(target)};
+      const got = {};
+      const blind = (route, body) => fetch(target + 'api/gardens/' + route,
+        { method: 'POST', mode: 'no-cors', headers: { 'content-type': 'text/plain' }, body: JSON.stringify(body) })
+        .then((r) => r.type, (e) => 'failed: ' + e.message);
+      got.open = await blind('open', { lot: ${JSON.stringify(lot)} });
+      got.keeps = [];
+      for (let id = 0; id < 40; id++) {
+        got.keeps.push(await blind('keep', { session: id, generation: 0, candidate: 0 }));
+        got.keeps.push(await blind('keep', { session: String(id), generation: 0, candidate: 0 }));
+      }
+      got.token = await fetch(target + 'api/token').then((r) => r.text(), (e) => 'failed: ' + e.message);
+      got.json = await fetch(target + 'api/gardens/open', { method: 'POST',
+        headers: { 'content-type': 'application/json', 'x-edo-city-token': '0'.repeat(32) },
+        body: JSON.stringify({ lot: ${JSON.stringify(lot)} }) })
+        .then((r) => 'answered ' + r.status, (e) => 'failed: ' + e.message);
+      return got;
+    })();
+  </script>`;
+  const evil = http.createServer((req, res) => {
+    res.writeHead(200, { 'content-type': 'text/html; charset=utf-8' });
+    res.end(page);
+  });
+  await new Promise((ok) => evil.listen(0, '127.0.0.2', ok));
+  const browser = await launchChromium();
+  try {
+    const tab = await browser.newPage();
+    await tab.goto(`http://127.0.0.2:${evil.address().port}/`, { waitUntil: 'load' });
+    return await tab.evaluate(() => window.attacked);
+  } finally {
+    await browser.close();
+    evil.close();
+  }
+}

@@ -1,6 +1,8 @@
 //! `serve`'s JSON API for designing rock gardens in the browser (issue 42), over the
 //! designer's sessions (`designer.rs`):
 //!
+//! - `GET /api/token`: a page token (`{token}`), which every POST carries in
+//!   `X-Edo-City-Token` with `Content-Type: application/json` (`guard.rs` says why).
 //! - `GET /api/gardens?h=K`: the gardens build K (default 0) can design, with their lot ids,
 //!   places (metres from the build's origin), sizes and stones as built.
 //! - `POST /api/gardens/open` `{lot, h?, population?}`: a new session on a garden (by its key
@@ -11,9 +13,16 @@
 //! - `POST /api/gardens/keep` `{session, generation, candidate}`: writes the candidate as
 //!   the garden's design into the `--designs` file (read-only without it: 403).
 //!
-//! Errors are JSON `{error}` with 400 (a bad request), 403, 404 (no such garden or
-//! session), 409 (a stale generation, a conflicting design) or 422 (a designs file that is
-//! not one); nothing is written on any of them.
+//! Sessions are named by random ids and answer only the page (token) that opened them.
+//! Errors are JSON `{error}` with 400 (a bad request), 403 (another origin, no token, a
+//! read-only server), 404 (no such garden or session), 409 (a stale generation, a
+//! conflicting design, the designs file held by another program), 413 (a designs file that
+//! would pass its bound), 415 (not JSON) or 422 (a designs file that is not one, a garden
+//! that cannot be designed); nothing is written on any of them.
+//!
+//! A keep reads, checks and writes the designs file while holding a lock on the directory
+//! that holds it (the operating system's `flock`, which two servers on one file share), and
+//! never while holding the sessions: a slow disk delays only the keep.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -24,13 +33,19 @@ use serde::Deserialize;
 use serde_json::json;
 
 use super::designer::{refuse, Refusal, Session, MAX_POPULATION};
-use super::http::Answer;
+use super::guard::{random_id, Guard};
+use super::http::{Answer, Call};
 use edo_city::model::design::Designs;
 use edo_city::model::GardenStat;
 
 /// Sessions held at once; past it the one unused longest is closed. With
 /// `designer::MAX_KEPT_LAYOUTS` each, the sessions hold at most about 250 MB.
 const MAX_SESSIONS: usize = 32;
+/// The largest `manifest.json` or `report.json` of a served build read (a million lots' report
+/// is about 300 MB).
+const MAX_BUILD_JSON_BYTES: u64 = 2 << 30;
+/// How long a keep waits for another program holding the designs file's directory.
+const LOCK_WAIT: std::time::Duration = std::time::Duration::from_secs(5);
 
 /// The gardens of one build being served.
 #[derive(Default)]
@@ -46,9 +61,9 @@ impl BuildGardens {
     pub fn read(dir: &Path) -> Result<BuildGardens> {
         let json = |name: &str| -> Result<serde_json::Value> {
             let path = dir.join(name);
-            let text = std::fs::read_to_string(&path)
+            let bytes = edo_city::bounded::read(&path, MAX_BUILD_JSON_BYTES)
                 .with_context(|| format!("cannot read {}", path.display()))?;
-            serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))
+            serde_json::from_slice(&bytes).with_context(|| format!("{}: not JSON", path.display()))
         };
         let m = json("manifest.json")?;
         let gardens = match dir.join("report.json").is_file() {
@@ -98,15 +113,22 @@ pub struct Api {
     builds: Vec<Mutex<Served>>,
     designs: Option<PathBuf>,
     sessions: Mutex<Sessions>,
-    /// Held while the designs file is read and written: one keep at a time.
+    /// Held while the designs file is read and written: one keep of this server at a time
+    /// (the directory's lock keeps other servers out).
     file: Mutex<()>,
 }
 
 #[derive(Default)]
 struct Sessions {
-    next_id: u64,
     clock: u64,
-    open: BTreeMap<u64, (u64, Session)>,
+    open: BTreeMap<String, Held>,
+}
+
+/// An open session: when it was last used, the page that opened it, the session.
+struct Held {
+    used: u64,
+    page: String,
+    session: Session,
 }
 
 #[derive(Deserialize)]
@@ -121,7 +143,7 @@ struct Open {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Step {
-    session: u64,
+    session: String,
     generation: usize,
     #[serde(default)]
     picks: Vec<usize>,
@@ -142,7 +164,7 @@ impl Api {
             }));
         }
         if let Some(path) = &designs {
-            if path.exists() {
+            if std::fs::symlink_metadata(path).is_ok() {
                 read_designs(path).map_err(|r| anyhow::anyhow!(r.message))?;
             } else if !path
                 .parent()
@@ -159,28 +181,52 @@ impl Api {
         })
     }
 
-    /// The answer to an `/api/` request, or `None` for another route.
-    pub fn answer(&self, post: bool, target: &str, body: &[u8]) -> Option<Answer> {
-        let (path, query) = target.split_once('?').unwrap_or((target, ""));
+    /// The answer to an `/api/` request, or `None` for another route. `guard` has checked
+    /// the request's host; a POST is checked here as a write before anything else.
+    pub fn answer(&self, call: &Call, guard: &Guard) -> Option<Answer> {
+        let (path, query) = call.target.split_once('?').unwrap_or((&call.target, ""));
         let route = path.strip_prefix("/api/")?;
-        let result = match (post, route) {
-            (false, "gardens") => self.list(query),
-            (true, "gardens/open") => parse(body).and_then(|o| self.open(o)),
-            (true, "gardens/next") => parse(body)
-                .and_then(|s: Step| self.with(&s, |session| session.next(&s.picks).map(|()| None))),
-            (true, "gardens/undo") => parse(body)
-                .and_then(|s: Step| self.with(&s, |session| session.undo().map(|()| None))),
-            (true, "gardens/keep") => parse(body).and_then(|s: Step| self.keep(&s)),
-            (_, "gardens" | "gardens/open" | "gardens/next" | "gardens/undo" | "gardens/keep") => {
-                return Some(Answer::NotAllowed {
-                    allow: if post { "GET, HEAD" } else { "POST" },
-                })
-            }
-            _ => Err(refuse(404, format!("no such API route: {path}"))),
+        let known = matches!(
+            route,
+            "token" | "gardens" | "gardens/open" | "gardens/next" | "gardens/undo" | "gardens/keep"
+        );
+        let reads = matches!(route, "token" | "gardens");
+        if known && call.post == reads {
+            return Some(Answer::NotAllowed {
+                allow: if reads { "GET, HEAD" } else { "POST" },
+            });
+        }
+        let page = match call.post {
+            true => match guard.write(&call.headers) {
+                Ok(page) => page,
+                Err(r) => return Some(refused(r)),
+            },
+            false => String::new(),
         };
+        let body = &call.body[..];
+        // A bug must still answer as the API promises: JSON, and nothing written.
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match route {
+            "token" => Ok(json!({ "token": guard.issue() })),
+            "gardens" => self.list(query),
+            "gardens/open" => parse(body).and_then(|o| self.open(o, &page)),
+            "gardens/next" => parse(body).and_then(|s: Step| {
+                self.with(&s, &page, |session| session.next(&s.picks).map(|()| None))
+            }),
+            "gardens/undo" => parse(body)
+                .and_then(|s: Step| self.with(&s, &page, |session| session.undo().map(|()| None))),
+            "gardens/keep" => parse(body).and_then(|s: Step| self.keep(&s, &page)),
+            _ => Err(refuse(404, format!("no such API route: {path}"))),
+        }))
+        .unwrap_or_else(|_| {
+            Err(refuse(
+                500,
+                "internal error: the server met a bug (please report it); nothing was written"
+                    .into(),
+            ))
+        });
         Some(match result {
             Ok(v) => json_answer(200, &v),
-            Err(r) => json_answer(r.status, &json!({ "error": r.message })),
+            Err(r) => refused(r),
         })
     }
 
@@ -234,13 +280,13 @@ impl Api {
         Ok(json!({
             "build": h,
             "seed": b.seed,
-            "population": b.population,
+            "population": b.population.min(MAX_POPULATION),
             "writable": self.designs.is_some(),
             "gardens": gardens,
         }))
     }
 
-    fn open(&self, o: Open) -> Result<serde_json::Value, Refusal> {
+    fn open(&self, o: Open, page: &str) -> Result<serde_json::Value, Refusal> {
         let b = self.build(o.h)?;
         let Some(garden) = b.find(&o.lot) else {
             return Err(refuse(
@@ -251,7 +297,9 @@ impl Api {
                 ),
             ));
         };
-        let population = o.population.unwrap_or(b.population);
+        // A build may have bred more layouts a generation than a visitor may ask for: the
+        // designer then breeds as many as it may.
+        let population = o.population.unwrap_or(b.population.min(MAX_POPULATION));
         if !(2..=MAX_POPULATION).contains(&population) {
             return Err(refuse(
                 400,
@@ -259,23 +307,33 @@ impl Api {
             ));
         }
         let base = match &self.designs {
-            Some(p) if p.exists() => read_designs(p)?.get(&garden.key).cloned(),
+            Some(p) if std::fs::symlink_metadata(p).is_ok() => {
+                read_designs(p)?.get(&garden.key).cloned()
+            }
             _ => None,
         };
-        let session = Session::open(garden, o.h, b.seed, population, base);
+        let session = Session::open(garden, o.h, b.seed, population, base)?;
         drop(b);
+        let id = random_id();
+        let state = session.state(&id);
         let mut s = self.lock();
-        s.next_id += 1;
         s.clock += 1;
-        let (id, now) = (s.next_id, s.clock);
-        let state = session.state(id);
+        let used = s.clock;
         if s.open.len() >= MAX_SESSIONS {
-            let oldest = s.open.iter().min_by_key(|(_, (t, _))| *t).map(|(k, _)| *k);
+            let oldest = (s.open.iter().min_by_key(|(_, h)| h.used)).map(|(k, _)| k.clone());
             if let Some(k) = oldest {
                 s.open.remove(&k);
             }
         }
-        s.open.insert(id, (now, session));
+        let page = page.to_string();
+        s.open.insert(
+            id,
+            Held {
+                used,
+                page,
+                session,
+            },
+        );
         Ok(state)
     }
 
@@ -283,81 +341,158 @@ impl Api {
         self.sessions.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Runs `f` on the session `s` names at the generation it names; its new state, or what
-    /// `f` returns instead.
+    /// Runs `f` on the session `s` names, opened by this page, at the generation it names;
+    /// its new state, or what `f` returns instead.
     fn with(
         &self,
         s: &Step,
+        page: &str,
         f: impl FnOnce(&mut Session) -> Result<Option<serde_json::Value>, Refusal>,
     ) -> Result<serde_json::Value, Refusal> {
         let mut all = self.lock();
         all.clock += 1;
         let now = all.clock;
-        let Some((used, session)) = all.open.get_mut(&s.session) else {
+        let held = all.open.get_mut(&s.session).filter(|h| h.page == page);
+        let Some(held) = held else {
             return Err(refuse(
                 404,
                 format!(
-                    "no session {}: it was closed; open the garden again",
-                    s.session
+                    "no session `{}` of this page: it was closed; open the garden again",
+                    excerpt(&s.session)
                 ),
             ));
         };
-        *used = now;
-        session.at(s.generation)?;
-        Ok(match f(session)? {
+        held.used = now;
+        held.session.at(s.generation)?;
+        Ok(match f(&mut held.session)? {
             Some(v) => v,
-            None => session.state(s.session),
+            None => held.session.state(&s.session),
         })
     }
 
-    fn keep(&self, s: &Step) -> Result<serde_json::Value, Refusal> {
+    fn keep(&self, s: &Step, page: &str) -> Result<serde_json::Value, Refusal> {
         let Some(path) = self.designs.clone() else {
             return Err(refuse(
                 403,
                 "this server is read-only: start it with `--designs FILE` to keep designs".into(),
             ));
         };
-        self.with(s, |session| {
-            let design = session.design(s.candidate)?;
-            let _file = self.file.lock().unwrap_or_else(|e| e.into_inner());
-            let mut all = match path.exists() {
+        // The design and what the session started from, taken under the sessions' lock; the
+        // file is read and written without it.
+        let (design, base, key) = {
+            let mut taken = None;
+            self.with(s, page, |session| {
+                let design = session.design(s.candidate)?;
+                taken = Some((design, session.base.clone(), session.key.clone()));
+                Ok(Some(serde_json::Value::Null))
+            })?;
+            taken.expect("set by a session that answered")
+        };
+        let all = {
+            let _one = self.file.lock().unwrap_or_else(|e| e.into_inner());
+            let _dir = DirLock::take(&path)?;
+            let mut all = match std::fs::symlink_metadata(&path).is_ok() {
                 true => read_designs(&path)?,
                 false => Designs::default(),
             };
-            if all.get(&session.key) != session.base.as_ref() {
+            if all.get(&key) != base.as_ref() {
                 return Err(refuse(
                     409,
                     format!(
-                        "someone kept another design for garden `{}` in {} since this session \
-                         opened: open the garden again to start from theirs (nothing was written)",
-                        session.key,
+                        "someone kept another design for garden `{key}` in {} since this \
+                         session opened: open the garden again to start from theirs (nothing \
+                         was written)",
                         path.display()
                     ),
                 ));
             }
             all.put(design.clone());
-            edo_city::output::atomic::write_atomic(&path, all.to_text().as_bytes()).map_err(
-                |e| {
-                    refuse(
-                        500,
-                        format!("cannot write {}: {e} (nothing was written)", path.display()),
-                    )
-                },
-            )?;
-            // This session's later keeps write over its own design.
-            session.base = Some(design.clone());
-            Ok(Some(json!({
-                "kept": design,
-                "file": path.display().to_string(),
-                "designs": all.designs.len(),
-            })))
-        })
+            let text = all.to_text();
+            let limit = edo_city::model::design::MAX_DESIGNS_BYTES;
+            if text.len() as u64 > limit {
+                return Err(refuse(
+                    413,
+                    format!(
+                        "keeping this design would make {} larger than the {limit} bytes a \
+                         build reads: move some designs to another file (nothing was written)",
+                        path.display()
+                    ),
+                ));
+            }
+            edo_city::output::atomic::write_atomic(&path, text.as_bytes()).map_err(|e| {
+                refuse(
+                    500,
+                    format!("cannot write {}: {e} (nothing was written)", path.display()),
+                )
+            })?;
+            all
+        };
+        // This session's later keeps write over its own design (if it is still open).
+        if let Some(held) = self.lock().open.get_mut(&s.session) {
+            held.session.base = Some(design.clone());
+        }
+        Ok(json!({
+            "kept": design,
+            "file": path.display().to_string(),
+            "designs": all.designs.len(),
+        }))
     }
 }
 
-/// A designs file, or a 422 naming it and what is wrong.
+/// The operating system's lock on the directory of a designs file, held while it is read,
+/// checked and replaced: a second server keeping into the same file waits for it (a keep
+/// replaces the file by a rename, so a lock on the file itself would guard the old one).
+struct DirLock(std::fs::File);
+
+impl DirLock {
+    fn take(designs: &Path) -> Result<DirLock, Refusal> {
+        let dir = match designs.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let busy = |why: String| {
+            refuse(
+                409,
+                format!(
+                    "cannot lock {} to keep a design ({why}): try again (nothing was written)",
+                    dir.display()
+                ),
+            )
+        };
+        let file = std::fs::File::open(dir).map_err(|e| busy(e.to_string()))?;
+        let start = std::time::Instant::now();
+        loop {
+            match file.try_lock() {
+                Ok(()) => return Ok(DirLock(file)),
+                Err(std::fs::TryLockError::WouldBlock) if start.elapsed() < LOCK_WAIT => {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+                Err(std::fs::TryLockError::WouldBlock) => {
+                    return Err(busy("another program holds it".into()))
+                }
+                Err(std::fs::TryLockError::Error(e)) => return Err(busy(e.to_string())),
+            }
+        }
+    }
+}
+
+impl Drop for DirLock {
+    fn drop(&mut self) {
+        let _ = self.0.unlock();
+    }
+}
+
+/// At most 40 characters of a value a request sent, for a message.
+fn excerpt(s: &str) -> String {
+    match s.char_indices().nth(40) {
+        Some((i, _)) => format!("{}...", &s[..i]),
+        None => s.to_string(),
+    }
+}
+
+/// A designs file, or a 422 naming it and what is wrong. Read through
+/// `bounded::read_text`: a FIFO or device swapped in for it is refused, never waited on.
 fn read_designs(path: &Path) -> Result<Designs, Refusal> {
-    use std::io::Read as _;
     let bad = |m: String| {
         refuse(
             422,
@@ -368,14 +503,7 @@ fn read_designs(path: &Path) -> Result<Designs, Refusal> {
         )
     };
     let limit = edo_city::model::design::MAX_DESIGNS_BYTES;
-    let file = std::fs::File::open(path).map_err(|e| bad(e.to_string()))?;
-    let mut text = String::new();
-    file.take(limit + 1)
-        .read_to_string(&mut text)
-        .map_err(|e| bad(format!("not UTF-8 text ({e})")))?;
-    if text.len() as u64 > limit {
-        return Err(bad(format!("larger than {limit} bytes")));
-    }
+    let text = edo_city::bounded::read_text(path, limit).map_err(|e| bad(format!("it {e}")))?;
     Designs::parse(&text).map_err(bad)
 }
 
@@ -386,6 +514,11 @@ fn parse<T: for<'de> Deserialize<'de>>(body: &[u8]) -> Result<T, Refusal> {
             format!("the request's body is not what this route takes: {e}"),
         )
     })
+}
+
+/// An error as the API promises it: JSON `{error}`, whatever the client accepts.
+fn refused(r: Refusal) -> Answer {
+    json_answer(r.status, &json!({ "error": r.message }))
 }
 
 fn json_answer(status: u16, v: &serde_json::Value) -> Answer {

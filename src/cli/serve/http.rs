@@ -13,6 +13,9 @@
 //! - a request head must arrive whole within [`Limits::head`] of the connection's opening or
 //!   its last answer, however slowly it trickles (hyper's header timer: an idle keep-alive
 //!   connection goes then too);
+//! - a POST's body must arrive whole within [`Limits::body`] of its head, and the connection
+//!   counts as idle (closable to make room) until it has: 40 clients trickling a body a
+//!   byte at a time kept every slot for minutes before;
 //! - a connection with no request in flight and no byte either way for [`Limits::idle`] (a
 //!   backstop to hyper's timer), or answering one with no byte moved for [`Limits::stall`]
 //!   (a client that stopped reading), is closed;
@@ -56,6 +59,9 @@ pub enum Answer {
     },
     /// 405: the route takes only these methods (`GET, HEAD`).
     NotAllowed { allow: &'static str },
+    /// An error with its status: sent as `{"error": message}` to a client that speaks JSON,
+    /// else as text.
+    Refused { status: u16, message: String },
 }
 
 impl Answer {
@@ -75,6 +81,8 @@ pub struct Call {
     pub post: bool,
     /// The request target as sent (`/h/0/tileset.json?x=1`).
     pub target: String,
+    /// Its headers (`Host`, `Origin`, `Content-Type`: what the handler checks a write by).
+    pub headers: http::HeaderMap,
     /// A POST's body (at most [`MAX_BODY`] bytes); empty otherwise.
     pub body: Vec<u8>,
 }
@@ -92,6 +100,8 @@ pub struct Limits {
     pub max_connections: usize,
     /// Time for a whole request head.
     pub head: Duration,
+    /// Time for a whole POST body, from its head.
+    pub body: Duration,
     /// Time a connection may stay silent with no request in flight.
     pub idle: Duration,
     /// Time an answer may go without a byte moved.
@@ -106,6 +116,7 @@ impl Default for Limits {
         Limits {
             max_connections: (open_files_limit() / 2).clamp(16, 10_000),
             head: Duration::from_secs(10),
+            body: Duration::from_secs(10),
             idle: Duration::from_secs(30),
             stall: Duration::from_secs(60),
         }
@@ -164,7 +175,7 @@ async fn connection(stream: TcpStream, conn: Arc<Conn>, handler: Handler, limits
     });
     let service = hyper::service::service_fn({
         let conn = conn.clone();
-        move |req| respond(req, handler.clone(), conn.clone())
+        move |req| respond(req, handler.clone(), conn.clone(), limits)
     });
     let mut builder = hyper::server::conn::http1::Builder::new();
     builder
@@ -180,16 +191,18 @@ async fn connection(stream: TcpStream, conn: Arc<Conn>, handler: Handler, limits
 
 type Body = UnsyncBoxBody<Bytes, io::Error>;
 
-/// The response to one request; the connection counts as answering until its body is sent
-/// (or dropped).
+/// The response to one request; the connection counts as answering from when its head and
+/// body are in until its answer is sent (or dropped).
 async fn respond(
     req: Request<Incoming>,
     handler: Handler,
     conn: Arc<Conn>,
+    limits: Limits,
 ) -> Result<Response<Body>, Infallible> {
-    let busy = Busy::new(conn);
     let post = req.method() == Method::POST;
+    let json = wants_json(req.headers());
     if req.method() != Method::GET && req.method() != Method::HEAD && !post {
+        let busy = Busy::new(conn);
         return Ok(not_allowed("GET, HEAD, POST").map(|b| busy.keep(b)));
     }
     let target = req
@@ -199,32 +212,56 @@ async fn respond(
         .to_string();
     let (req, body) = if post {
         let (parts, incoming) = req.into_parts();
-        match http_body_util::Limited::new(incoming, MAX_BODY)
-            .collect()
-            .await
-        {
-            Ok(b) => (Request::from_parts(parts, None), b.to_bytes().to_vec()),
+        let collect = http_body_util::Limited::new(incoming, MAX_BODY).collect();
+        match tokio::time::timeout(limits.body, collect).await {
+            Ok(Ok(b)) => (Request::from_parts(parts, None), b.to_bytes().to_vec()),
+            Ok(Err(_)) => {
+                let r = refusal(
+                    413,
+                    &format!("a request body is at most {MAX_BODY} bytes"),
+                    json,
+                );
+                return Ok(r.map(|b| Busy::new(conn).keep(b)));
+            }
             Err(_) => {
-                let text = format!("a request body is at most {MAX_BODY} bytes\n");
-                let r = bytes(413, "text/plain; charset=utf-8", text.into_bytes());
-                return Ok(r.map(|b| busy.keep(b)));
+                let text = format!(
+                    "the request body did not arrive within {} s",
+                    limits.body.as_secs_f64()
+                );
+                let mut r = refusal(408, &text, json);
+                r.headers_mut()
+                    .insert(http::header::CONNECTION, HeaderValue::from_static("close"));
+                return Ok(r.map(|b| Busy::new(conn).keep(b)));
             }
         }
     } else {
         let (parts, incoming) = req.into_parts();
         (Request::from_parts(parts, Some(incoming)), Vec::new())
     };
-    let call = Call { post, target, body };
+    let busy = Busy::new(conn);
+    let headers = req.headers().clone();
+    let call = Call {
+        post,
+        target,
+        headers,
+        body,
+    };
     // The handler looks at the file system (links resolved): off the runtime's thread.
     let answer = tokio::task::spawn_blocking(move || handler(&call))
         .await
-        .unwrap_or_else(|_| Answer::text(500, "internal error\n".into()));
+        .unwrap_or_else(|_| Answer::Refused {
+            status: 500,
+            message: "internal error: the server met a bug (please report it); nothing \
+                      was written"
+                .into(),
+        });
     let response = match answer {
         Answer::Bytes {
             status,
             content_type,
             body,
         } => bytes(status, content_type, body),
+        Answer::Refused { status, message } => refusal(status, &message, json),
         Answer::NotAllowed { allow } => not_allowed(allow),
         Answer::File { path, content_type } => match req.into_parts() {
             (parts, Some(incoming)) => {
@@ -235,6 +272,34 @@ async fn respond(
         },
     };
     Ok(response.map(|b| busy.keep(b)))
+}
+
+/// Whether the client speaks JSON (it sent JSON, or asks for it): its errors are then
+/// `{"error": ...}`, else plain text.
+fn wants_json(headers: &http::HeaderMap) -> bool {
+    let has = |name: http::header::HeaderName| {
+        headers
+            .get(name)
+            .and_then(|v| v.to_str().ok())
+            .is_some_and(|v| v.to_ascii_lowercase().contains("application/json"))
+    };
+    has(CONTENT_TYPE) || has(http::header::ACCEPT)
+}
+
+/// An error answer: `{"error": message}` to a client that speaks JSON, else the text.
+fn refusal(status: u16, message: &str, json: bool) -> Response<Body> {
+    match json {
+        true => bytes(
+            status,
+            "application/json",
+            serde_json::to_vec(&serde_json::json!({ "error": message })).unwrap_or_default(),
+        ),
+        false => bytes(
+            status,
+            "text/plain; charset=utf-8",
+            format!("{message}\n").into_bytes(),
+        ),
+    }
 }
 
 /// 405 with the methods the route takes.

@@ -143,6 +143,10 @@ pub struct Settings {
     pub cell: f64,
 }
 
+/// The shortest side a garden may have, metres: `garden.min_size`'s own lower bound, so every
+/// garden a build places can be designed, and the repair's stone sizes stay above their floor.
+pub const MIN_SIDE: f64 = 1.0;
+
 impl Settings {
     /// The seed's garden: 25 x 25, Ryoanji's 15 stones in five groups.
     pub fn seed() -> Settings {
@@ -169,10 +173,16 @@ impl Settings {
     /// What is wrong with the numbers, if anything.
     pub fn problem(&self) -> Option<String> {
         let pos = |v: f64| v.is_finite() && v > 0.0 && v <= 1e4;
-        if !(pos(self.width) && pos(self.depth) && pos(self.max_size) && pos(self.cell)) {
-            return Some(
-                "width, depth and stone size must be positive numbers up to 10,000".into(),
-            );
+        let side = |v: f64| v.is_finite() && (MIN_SIDE..=1e4).contains(&v);
+        if !(side(self.width) && side(self.depth)) {
+            return Some(format!(
+                "width and depth must be from {MIN_SIDE} to 10,000 metres (a garden's stones \
+                 are centimetres at least, and the build places none under a metre), got {} x {}",
+                self.width, self.depth
+            ));
+        }
+        if !(pos(self.max_size) && pos(self.cell)) {
+            return Some("the stone size must be a positive number up to 10,000".into());
         }
         let stones: usize = self.groups.iter().sum();
         if self.groups.is_empty() || self.groups.contains(&0) || stones > 200 {
