@@ -365,6 +365,9 @@ pub fn write_gpkg(
     dir_b: &Path,
     path: &Path,
 ) -> Result<usize, BuildError> {
+    let reads = [(dir_a, "build A"), (dir_b, "build B")];
+    crate::output::target::check(path, crate::output::target::Kind::GeoPackage, &reads)
+        .map_err(|e| BuildError::Config(e.to_string()))?;
     let t = &c.tiles;
     crate::output::gpkg::write_diff(dir_a, dir_b, &t.differ, &t.only_a, &t.only_b, path).map_err(
         |e| match e {

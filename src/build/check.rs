@@ -21,6 +21,12 @@ pub fn check(
     templates: Option<&Path>,
     gpkg: Option<&Path>,
 ) -> Result<report::Report, BuildError> {
+    if let Some(path) = gpkg {
+        let mut reads = vec![(input, "the input directory")];
+        reads.extend(templates.map(|t| (t, "the templates directory")));
+        output::target::check(path, output::target::Kind::GeoPackage, &reads)
+            .map_err(|e| BuildError::Config(e.to_string()))?;
+    }
     let catalog = load_catalog(params, templates)?;
     let (data, plan, _, _) = read_and_analyse(input, params, &catalog, &NoProgress)?;
     let files = layer_files(input, params);

@@ -192,6 +192,8 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         print!("{}", edo_city::compare::render(&c));
     }
     if let Some(path) = plan {
+        let reads = [(a.as_path(), "build A"), (b.as_path(), "build B")];
+        edo_city::output::target::check(&path, edo_city::output::target::Kind::Png, &reads)?;
         let png = edo_city::compare::difference_map(&c, &a)?;
         edo_city::output::atomic::write_atomic(&path, &png)
             .with_context(|| format!("cannot write {}", path.display()))?;
@@ -222,6 +224,9 @@ pub fn plan_command(args: PlanArgs) -> Result<()> {
         templates,
         params,
     } = args;
+    let mut reads = vec![(out.as_path(), "the build")];
+    reads.extend(input.as_deref().map(|i| (i, "the input directory")));
+    edo_city::output::target::check(&output, edo_city::output::target::Kind::Png, &reads)?;
     let params = params.map(|p| load_params(Some(&p))).transpose()?;
     let png = edo_city::build::draw_plan_of(
         &out,

@@ -78,15 +78,86 @@ struct Build {
     path: PathBuf,
 }
 
+/// SQLite virtual-machine steps between two looks at the budget.
+const STEPS_A_LOOK: i32 = 10_000;
+/// Looks at the budget a build's `plan.gpkg` may take: 2e9 steps, about a minute; a
+/// million lots' layers are read in a few hundred million.
+const LOOKS: u64 = 200_000;
+/// The longest string or blob a value may be (a lot's geometry is a few hundred bytes).
+const MAX_VALUE_BYTES: i32 = 64 << 20;
+/// The tables read, each of which must be a plain table.
+const READ: [&str; 4] = [
+    "lots",
+    "tiles",
+    "gpkg_spatial_ref_sys",
+    "gpkg_geometry_columns",
+];
+
 impl Build {
+    /// Opens another build's `plan.gpkg` as untrusted input (issue 57: a `lots` VIEW over an
+    /// endless recursive query, a few hundred bytes, ran on with gigabytes of temporary
+    /// files): read-only and `query_only`, every table read checked to be a plain table
+    /// (no view, virtual table or generated column runs code of the file's), values bounded
+    /// in length, and the whole read bounded in steps, which is the same for any machine.
     fn open(dir: &Path) -> Result<Build, DiffError> {
         let path = dir.join("plan.gpkg");
         if !path.is_file() {
             return Err(DiffError::Missing(path));
         }
-        let conn = Connection::open_with_flags(&path, OpenFlags::SQLITE_OPEN_READ_ONLY)
+        let flags = OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX;
+        let conn = Connection::open_with_flags(&path, flags).map_err(|e| unreadable(&path, e))?;
+        conn.pragma_update(None, "query_only", true)
             .map_err(|e| unreadable(&path, e))?;
-        Ok(Build { conn, path })
+        conn.set_limit(
+            rusqlite::limits::Limit::SQLITE_LIMIT_LENGTH,
+            MAX_VALUE_BYTES,
+        )
+        .map_err(|e| unreadable(&path, e))?;
+        let mut looks = 0u64;
+        conn.progress_handler(
+            STEPS_A_LOOK,
+            Some(move || {
+                looks += 1;
+                looks > LOOKS
+            }),
+        );
+        let build = Build { conn, path };
+        for table in READ {
+            build.plain_table(table)?;
+        }
+        Ok(build)
+    }
+
+    /// Refuses `table` unless it is an ordinary table without generated columns.
+    fn plain_table(&self, table: &str) -> Result<(), DiffError> {
+        let not = |why: &str| DiffError::Unreadable {
+            path: self.path.clone(),
+            why: format!("its `{table}` {why}"),
+        };
+        let sql: Option<String> = self
+            .conn
+            .query_row(
+                "SELECT sql FROM sqlite_master WHERE type = 'table' AND name = ?1",
+                [table],
+                |r| r.get(0),
+            )
+            .map_err(|_| not("is not a table (a view, or missing)"))?;
+        let sql = sql.unwrap_or_default().to_ascii_uppercase();
+        if sql.trim_start().starts_with("CREATE VIRTUAL") {
+            return Err(not("is a virtual table"));
+        }
+        let generated: i64 = self
+            .conn
+            .query_row(
+                "SELECT count(*) FROM pragma_table_xinfo(?1) WHERE hidden <> 0",
+                [table],
+                |r| r.get(0),
+            )
+            .map_err(|e| unreadable(&self.path, e))?;
+        match generated {
+            0 => Ok(()),
+            _ => Err(not("has generated or hidden columns")),
+        }
     }
 
     fn lots(&self) -> Result<BTreeMap<String, LotRow>, DiffError> {
