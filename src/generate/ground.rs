@@ -13,6 +13,8 @@ use std::collections::BTreeMap;
 use geo::{BooleanOps, TriangulateEarcut};
 use geo_types::{Coord, LineString, MultiPolygon, Polygon, Rect};
 
+use crate::geom::union::cascaded;
+
 use super::clip::{clip_band, clip_band_u, LocalPoly, LocalRing};
 use super::mesh::{Frame, Mesh};
 use crate::materials;
@@ -37,15 +39,13 @@ pub fn tile_ground(
     )
     .to_polygon()]);
     let streets = match &g.blocks {
-        Some(blocks) => square.difference(&geo::unary_union(blocks)),
-        None => geo::unary_union(&g.streets).intersection(&square),
+        Some(blocks) => square.difference(&cascaded(blocks)),
+        None => cascaded(&g.streets).intersection(&square),
     };
     let mut taken = streets.clone();
     let mut layers: Vec<(u16, MultiPolygon<f64>)> = Vec::new();
     if !g.water.is_empty() {
-        let water = geo::unary_union(&g.water)
-            .intersection(&square)
-            .difference(&taken);
+        let water = cascaded(&g.water).intersection(&square).difference(&taken);
         taken = taken.union(&water);
         layers.push((materials::id("water"), water));
     }
@@ -67,9 +67,7 @@ pub fn tile_ground(
         }
     }
     for (m, polys) in by_material {
-        let lots = geo::unary_union(polys)
-            .intersection(&square)
-            .difference(&taken);
+        let lots = cascaded(polys).intersection(&square).difference(&taken);
         taken = taken.union(&lots);
         layers.push((m, lots));
     }

@@ -14,3 +14,4 @@ pub mod frame;
 pub mod meshopt;
 pub mod ring;
 pub mod segment;
+pub mod union;
