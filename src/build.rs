@@ -251,6 +251,14 @@ pub fn read_and_analyse(
     let data = input::read_dataset(input, params)?;
     progress.finish();
     let read = t.elapsed();
+    let touched = analyse::ground::tiles_touched(&data, params, MAX_TILES);
+    if touched > MAX_TILES {
+        return Err(BuildError::Config(format!(
+            "`tile_size` = {} m cuts this city into more than {MAX_TILES} tiles (files of each \
+             format, and a tileset node, each): raise `tile_size` (the default is 250 m)",
+            params.tile_size
+        )));
+    }
     let t = Instant::now();
     let lots_file = input.join(&params.layers.lots.file).display().to_string();
     let machiya_lots = data
@@ -259,10 +267,28 @@ pub fn read_and_analyse(
         .filter(|l| l.lot_use == LotUse::Machiya)
         .count();
     progress.start("analysing", machiya_lots as u64);
-    let plan = analyse::analyse(&data, params, catalog, &lots_file, &|n| progress.inc(n));
+    let mut plan = analyse::analyse(&data, params, catalog, &lots_file, &|n| progress.inc(n));
     progress.finish();
+    let houses = data.lots.len() + data.footprints.len();
+    if plan.tiles.len() > houses.max(TILES_BEFORE_A_WARNING) {
+        plan.warnings.push(crate::model::Warning::new(
+            crate::model::WarningClass::Build,
+            format!(
+                "`tile_size` = {} m makes {} tiles for {houses} lots and footprints: a tile \
+                 should hold many houses (the default 250 m holds hundreds); raise `tile_size`",
+                params.tile_size,
+                plan.tiles.len()
+            ),
+        ));
+    }
     Ok((data, plan, read, t.elapsed()))
 }
+
+/// The most tiles a city may be cut into (`tile_size`): each is a file of every format, a
+/// node of the tileset and a row of its plan; a million lots at 250 m make about 2,000.
+pub const MAX_TILES: usize = 200_000;
+/// Tiles past which a city of fewer houses than tiles is warned of (`tile_size` too small).
+const TILES_BEFORE_A_WARNING: usize = 1000;
 
 /// The most shards a city may be split into (`--shard I/N`).
 pub const MAX_SHARDS: usize = 10_000;

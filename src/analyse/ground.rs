@@ -50,6 +50,51 @@ fn near(index: &Index, b: [f64; 4]) -> Vec<usize> {
     ids
 }
 
+/// The tiles (column, row) a polygon's box touches, when they are few enough to be a lot's
+/// ([`MAX_TILES_A_LOT`]) and its coordinates sane.
+fn tiles_of(p: &Polygon<f64>, size: f64, origin: [f64; 2]) -> Option<(Range, Range)> {
+    let r = p.bounding_rect()?;
+    if !(sane(r.min()) && sane(r.max())) {
+        return None;
+    }
+    let col = |x: f64| ((x - origin[0]) / size).floor() as i64;
+    let row = |y: f64| ((y - origin[1]) / size).floor() as i64;
+    let (c0, c1, r0, r1) = (
+        col(r.min().x),
+        col(r.max().x),
+        row(r.min().y),
+        row(r.max().y),
+    );
+    ((c1 - c0 + 1) * (r1 - r0 + 1) <= MAX_TILES_A_LOT).then_some((c0..=c1, r0..=r1))
+}
+
+type Range = std::ops::RangeInclusive<i64>;
+
+/// How many tiles the lots and footprints touch with `params`' grid, counted up to `cap`
+/// (one more when there are more): what a build would write, known before anything is
+/// analysed, so a `tile_size` of 2 m over a city is refused or warned of by its key before
+/// it makes tens of thousands of files (issue 57).
+pub fn tiles_touched(data: &Dataset, params: &Params, cap: usize) -> usize {
+    let (size, origin) = (params.tile_size, params.tile_origin);
+    let outlines =
+        (data.lots.iter().map(|l| &l.outline)).chain(data.footprints.iter().map(|f| &f.outline));
+    let mut seen = std::collections::HashSet::new();
+    for p in outlines {
+        let Some((cols, rows)) = tiles_of(p, size, origin) else {
+            continue;
+        };
+        for c in cols {
+            for r in rows.clone() {
+                seen.insert((c, r));
+                if seen.len() > cap {
+                    return seen.len();
+                }
+            }
+        }
+    }
+    seen.len()
+}
+
 /// Fills `plan.grounds` for every tile to write, adding the tiles the lots touch.
 pub fn plan_ground(data: &Dataset, plan: &mut Plan, params: &Params) {
     let g = &params.ground;
@@ -58,25 +103,11 @@ pub fn plan_ground(data: &Dataset, plan: &mut Plan, params: &Params) {
     }
     let (size, origin) = (params.tile_size, params.tile_origin);
     for lot in &data.lots {
-        let Some(r) = lot.outline.bounding_rect() else {
+        let Some((cols, rows)) = tiles_of(&lot.outline, size, origin) else {
             continue;
         };
-        if !(sane(r.min()) && sane(r.max())) {
-            continue;
-        }
-        let col = |x: f64| ((x - origin[0]) / size).floor() as i64;
-        let row = |y: f64| ((y - origin[1]) / size).floor() as i64;
-        let (c0, c1, r0, r1) = (
-            col(r.min().x),
-            col(r.max().x),
-            row(r.min().y),
-            row(r.max().y),
-        );
-        if (c1 - c0 + 1) * (r1 - r0 + 1) > MAX_TILES_A_LOT {
-            continue;
-        }
-        for c in c0..=c1 {
-            for rr in r0..=r1 {
+        for c in cols {
+            for rr in rows.clone() {
                 plan.tiles.insert(format!("{c}_{rr}"));
             }
         }
