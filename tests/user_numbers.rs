@@ -224,6 +224,43 @@ fn the_numbers_that_once_panicked_aborted_or_ran_for_minutes_are_refused() {
             ],
             "--lots must be from 1 to 10000000",
         ),
+        // Issue 57: a garden of 5 mm panicked in the repair's clamp.
+        (
+            vec![
+                "garden".into(),
+                "--width".into(),
+                "0.005".into(),
+                "--depth".into(),
+                "0.005".into(),
+                "-o".into(),
+                dir.path().join("g.obj").display().to_string(),
+            ],
+            "width and depth must be from 1 to 10,000 metres",
+        ),
+        // Issue 57: 1 m tiles over a town of 2,000 lots are half a million tiles.
+        (
+            {
+                let town = dir.path().join("town");
+                common::edo_city()
+                    .args([
+                        "synth",
+                        town.to_str().unwrap(),
+                        "--lots",
+                        "2000",
+                        "--seed",
+                        "3",
+                    ])
+                    .output()
+                    .unwrap();
+                vec![
+                    "tiles".into(),
+                    town.display().to_string(),
+                    "--params".into(),
+                    params("g.toml", "tile_size = 1.0\n"),
+                ]
+            },
+            "`tile_size` = 1 m cuts this city into more than 200000 tiles",
+        ),
     ];
     for (args, says) in cases {
         let (code, stderr) = run_limited(&args);

@@ -248,3 +248,40 @@ fn slow_clients_are_let_go() {
     );
     assert!(answer.ends_with("hello"), "{answer}");
 }
+
+/// Clients trickling POST bodies a byte at a time (issue 57: 40 of them kept every slot of
+/// 32 for minutes): a body has its own deadline, and a connection waiting for one is idle,
+/// closable to make room, so a real request is answered.
+#[test]
+fn slow_bodies_never_keep_a_request_out() {
+    let (_dir, path) = file_of(10);
+    let limits = Limits {
+        max_connections: 32,
+        body: Duration::from_millis(500),
+        ..Limits::default()
+    };
+    let port = start(limits, path);
+    let mut slow: Vec<TcpStream> = (0..40)
+        .map(|_| {
+            let mut s = connect(port);
+            s.write_all(b"POST /echo HTTP/1.1\r\nHost: x\r\nContent-Length: 100\r\n\r\nx")
+                .unwrap();
+            s
+        })
+        .collect();
+    // A byte more each, as a trickle would.
+    for s in &mut slow {
+        let _ = s.write_all(b"y");
+    }
+    let answer = ask(
+        port,
+        "GET / HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n",
+    );
+    assert!(answer.ends_with("hello"), "{answer}");
+    // A trickler still open past its body's deadline gets 408 and is closed.
+    std::thread::sleep(Duration::from_secs(1));
+    let last = slow.last_mut().unwrap();
+    let mut got = String::new();
+    let _ = last.read_to_string(&mut got);
+    assert!(got.is_empty() || got.starts_with("HTTP/1.1 408"), "{got}");
+}
