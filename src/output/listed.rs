@@ -114,10 +114,7 @@ pub fn copy(from: &Path, to: &Path, f: &ManifestFile) -> Result<Staged, Unlisted
     let staged = Staged { tmp, target };
     let mut out = std::io::BufWriter::new(std::fs::File::create(&staged.tmp).map_err(io)?);
     stream(&real, f, &mut out)?;
-    out.into_inner()
-        .map_err(|e| io(e.into_error()))?
-        .sync_data()
-        .map_err(io)?;
+    out.into_inner().map_err(|e| io(e.into_error()))?;
     Ok(staged)
 }
 
