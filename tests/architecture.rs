@@ -78,6 +78,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "templates",
             "geom",
             "growers",
+            "bounded",
         ],
     ),
 ];
