@@ -11,7 +11,6 @@
 //! a shard (`--shard`) sees its neighbours and comes out byte-identical to a full build's.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
@@ -19,7 +18,6 @@ use thiserror::Error;
 
 use crate::analyse;
 use crate::generate;
-use crate::generate::mesh::Mesh;
 use crate::input::{self, InputError};
 use crate::model::{Dataset, LotUse, Plan};
 use crate::output::{self, report};
@@ -28,13 +26,13 @@ use crate::templates::{Catalog, Kind, TemplateError};
 
 pub mod cache;
 mod check;
+mod city;
 mod names;
 mod plan_files;
 pub mod shards;
 mod writing;
 
 pub use check::check;
-use check::input_summary;
 pub use plan_files::{draw_plan_from, draw_plan_of, merge_plan_files};
 
 /// Progress of the long stages; the CLI draws bars, tests pass [`NoProgress`].
@@ -463,24 +461,22 @@ fn run(
 }
 
 /// Generates and writes the tiles, the plan, the manifest and the report of an analysed city
-/// into a locked output directory.
+/// into a locked output directory, by the steps of [`city::CityWriter`].
 #[allow(clippy::too_many_arguments)]
 fn write_city(
     opts: &BuildOptions,
     catalog: &Catalog,
     library: &Library,
     progress: &dyn Progress,
-    owned_data: std::sync::Arc<Dataset>,
-    owned_plan: std::sync::Arc<Plan>,
+    data: std::sync::Arc<Dataset>,
+    plan: std::sync::Arc<Plan>,
     mut timings: Timings,
     t0: Instant,
     reused: bool,
 ) -> Result<BuildOutcome, BuildError> {
     let params = &opts.params;
-    let (data, plan): (&Dataset, &Plan) = (&owned_data, &owned_plan);
-
     let t = Instant::now();
-    let selected = shards::select(plan, &opts.selection)?;
+    let selected = shards::select(&plan, &opts.selection)?;
     let previous = match &opts.selection {
         Selection::Tiles(_) => Some(shards::previous_manifest(
             &opts.out,
@@ -488,172 +484,31 @@ fn write_city(
         )?),
         _ => None,
     };
-    let tiles_dir = opts.out.join("tiles");
-    std::fs::create_dir_all(&tiles_dir).map_err(|e| write_err(&tiles_dir, e))?;
-    let crowds_dir = opts.out.join(output::crowds::DIR);
-    if !plan.walks.is_empty() {
-        std::fs::create_dir_all(&crowds_dir).map_err(|e| write_err(&crowds_dir, e))?;
-    }
-    // A run killed before its renames leaves temporaries; they are never valid output. Shards
-    // leave them (the shards beside them are writing theirs); a full build or merge sweeps.
-    let alone = !opts.selection.is_shard();
-    if alone {
-        for dir in [
-            &opts.out,
-            &tiles_dir,
-            &opts.out.join(output::TEXTURE_DIR),
-            &opts.out.join(output::gltf::models::DIR),
-            &crowds_dir,
-        ] {
-            output::atomic::remove_leftover_temporaries(dir);
-        }
-    }
-    let mut textures = output::write_textures(&opts.out, library.textures)
-        .map_err(|e| write_err(&opts.out.join(output::TEXTURE_DIR), e))?;
-    textures.extend(
-        output::write_model_textures(&opts.out, &plan.model_textures)
-            .map_err(|e| write_err(&opts.out.join(output::TEXTURE_DIR), e))?,
-    );
-    let species = output::species::write_species(&opts.out, plan, catalog, params, alone)
-        .map_err(|e| write_err(&opts.out.join("species"), e))?;
-
-    let files = layer_files(&opts.input, params);
-    let sinks = output::sink::sinks(&params.output, library.atlas);
-    let directory = output::features::Directory::of(data, plan, params);
-    let tiles: Vec<&String> = plan
-        .tiles
-        .iter()
+    let writer = city::CityWriter::prepare(opts, catalog, library, &plan)?;
+    let directory = output::features::Directory::of(&data, &plan, params);
+    let tiles: Vec<&String> = (plan.tiles.iter())
         .filter(|id| selected.contains(id.as_str()))
         .collect();
     progress.start("writing tiles", tiles.len() as u64);
-    // Nanoseconds per stage summed over threads, to compare the writer with a raw write.
-    let (gen_ns, write_ns) = (AtomicU64::new(0), AtomicU64::new(0));
-    // The plan image is drawn on one thread while the tiles are made on the others (it used
-    // to follow them, a third of a build on one core); it is written after them, as before.
-    let draw_plan = || {
-        let t = Instant::now();
-        let image = opts
-            .plan_image
-            .then(|| {
-                let grid = (params.tile_size, params.tile_origin);
-                output::plan::View::fit(data, None).and_then(|view| {
-                    output::plan::draw_plan(data, plan, &view, grid, kura_view(params))
-                })
-            })
-            .flatten();
-        (image, t.elapsed())
-    };
     let make_tiles = || -> Vec<Result<report::ManifestTile, BuildError>> {
         tiles
             .par_iter()
             .map(|&id| {
-                let t = Instant::now();
-                let tile = generate::TilePlan {
-                    ground: terrain_of(data, params, id),
-                    ..generate::TilePlan::of(plan, id)
-                };
-                let mut meshes =
-                    generate::generate_tile(&tile, catalog, params, plan.origin, &files);
-                gen_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
-                let t = Instant::now();
-                let features = directory.features(&meshes.meshes);
-                let instance_features = directory.instance_features(&meshes.instanced);
-                let extent = output::sink::union(
-                    output::sink::extent(&meshes.meshes),
-                    meshes.crowd.as_ref().and_then(|c| c.reach(plan.origin)),
-                );
-                let centre = output::sink::tile_centre(
-                    id,
-                    plan.origin,
-                    params.tile_size,
-                    params.tile_origin,
-                    extent,
-                );
-                let content = output::sink::TileContent {
-                    id,
-                    origin: plan.origin,
-                    centre,
-                    meshes: &meshes.meshes,
-                    features: &features,
-                    instanced: &meshes.instanced,
-                    instance_features: &instance_features,
-                    crowd: meshes.crowd.as_ref(),
-                    palette: output::palette::Palette::new(&plan.palette),
-                };
-                let mut entry = report::ManifestTile {
-                    id: id.clone(),
-                    obj: None,
-                    mtl: None,
-                    glb: None,
-                    crowds: None,
-                    models: Vec::new(),
-                    bounds: extent.map(|(lo, hi)| {
-                        // Output frame (x east, y up, z south) to east, north, up.
-                        let m = |v: i64| v as f64 / 1000.0;
-                        [m(lo[0]), -m(hi[2]), m(lo[1]), m(hi[0]), -m(lo[2]), m(hi[1])]
-                    }),
-                    centre: [centre[0] as f64 / 1000.0, -(centre[2] as f64) / 1000.0],
-                    stats: Default::default(),
-                };
-                let mut mesh_bytes = None;
-                for sink in &sinks {
-                    let written = sink.write_tile(&opts.out, &content).map_err(|e| {
-                        write_err(&tiles_dir.join(format!("{id}.{}", sink.format())), e)
-                    });
-                    match written {
-                        Ok(w) => {
-                            entry.add_files(w.files);
-                            mesh_bytes = mesh_bytes.or(w.mesh_bytes);
-                        }
-                        Err(e) => {
-                            progress.inc(1);
-                            return Err(e);
-                        }
-                    }
-                }
-                if let Some(walks) = plan.walks.get(id.as_str()).filter(|w| !w.is_empty()) {
-                    let path = output::crowds::path(id);
-                    let text = output::crowds::csv(walks);
-                    match output::write_listed(&opts.out, path, &[text.as_bytes()]) {
-                        Ok(f) => entry.crowds = Some(f),
-                        Err(e) => {
-                            progress.inc(1);
-                            return Err(write_err(&opts.out.join(output::crowds::path(id)), e));
-                        }
-                    }
-                }
-                write_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+                let entry = writer.tile(id, &data, &plan, &directory);
                 progress.inc(1);
-                // The bytes the trees' and the ground's objects take in the OBJ, exactly (the
-                // OBJ writer's count when it wrote one).
-                let bytes_of = |names: [&str; 2]| -> u64 {
-                    let of = |m: &Mesh| names.contains(&m.name.as_str());
-                    match &mesh_bytes {
-                        Some(sizes) => meshes
-                            .meshes
-                            .iter()
-                            .zip(sizes)
-                            .filter(|(m, _)| of(m))
-                            .map(|(_, &n)| n as u64)
-                            .sum(),
-                        None => output::obj_bytes(meshes.meshes.iter().filter(|m| of(m))) as u64,
-                    }
-                };
-                meshes.stats.tree_bytes = bytes_of(["trees", "trees_grown"]);
-                meshes.stats.ground_bytes = bytes_of(["ground", "streets"]);
-                entry.stats = meshes.stats;
-                Ok(entry)
+                entry
             })
             .collect()
     };
-    // plan.gpkg: the layers analysis alone decides are written while the tiles are made,
-    // the rest once their manifest is known. A `--tiles` run whose analysis came from the
-    // cache leaves the full build's file as it is: the same analysis wrote it.
+    // Beside the tiles, on the cores they leave: plan.png's image (drawn on one thread; it
+    // used to follow them, a third of a build on one core) and plan.gpkg's layers that
+    // analysis alone decides. A `--tiles` run whose analysis came from the cache leaves the
+    // full build's plan.gpkg as it is: the same analysis wrote it.
     let gpkg_path = opts.out.join(output::PLAN_GPKG);
     let band = |m: &crate::model::PlannedHouse| analyse::house::house_band(m, catalog, params);
     let sources = output::gpkg::PlanSources {
-        data,
-        plan,
+        data: &data,
+        plan: &plan,
         params,
         band: &band,
     };
@@ -666,18 +521,15 @@ fn write_city(
             .then(|| output::gpkg::PlanWriter::start(&gpkg_path, &sources).map_err(gpkg_err));
         (started, t.elapsed())
     };
+    let draw = || city::draw_plan(&data, &plan, params, opts.plan_image);
     let (((image, plan_time), (gpkg, gpkg_time)), results) =
-        rayon::join(|| rayon::join(draw_plan, start_gpkg), make_tiles);
+        rayon::join(|| rayon::join(draw, start_gpkg), make_tiles);
     progress.finish();
     // Its maps of every lot and house are not needed by the levels of detail, the slowest
     // and largest step after the tiles (1,000,000 lots: tens of MB).
     drop(directory);
-    timings.generate_cpu = Duration::from_nanos(gen_ns.into_inner());
-    timings.write_cpu = Duration::from_nanos(write_ns.into_inner());
-    let mut written = Vec::with_capacity(results.len());
-    for r in results {
-        written.push(r?);
-    }
+    (timings.generate_cpu, timings.write_cpu) = writer.cpu();
+    let written = results.into_iter().collect::<Result<Vec<_>, _>>()?;
     let tiles_written = written.len();
     // Each shared model once, however many tiles draw it.
     let models: std::collections::BTreeMap<&str, u64> = (written.iter())
@@ -685,94 +537,19 @@ fn write_city(
         .collect();
     let bytes_written: u64 =
         written.iter().map(|t| t.bytes()).sum::<u64>() + models.values().sum::<u64>();
-
-    // The manifest's tiles: what this run wrote, plus (for --tiles) the earlier build's
-    // entries for the tiles it did not touch.
-    let manifest_tiles = match previous {
-        Some(prev) => {
-            let mut new: std::collections::BTreeMap<String, report::ManifestTile> =
-                written.into_iter().map(|t| (t.id.clone(), t)).collect();
-            let mut out = Vec::new();
-            for id in &plan.tiles {
-                if let Some(t) = new.remove(id) {
-                    out.push(t);
-                } else if let Some(t) = prev.tiles.iter().find(|t| &t.id == id) {
-                    out.push(t.clone());
-                }
-            }
-            out
-        }
-        None => written,
-    };
-    let manifest = report::Manifest {
-        tool: "edo-city".into(),
-        version: env!("CARGO_PKG_VERSION").into(),
-        shard: match opts.selection {
-            Selection::Shard { index, count } => Some([index, count]),
-            _ => None,
-        },
-        origin: plan.origin,
-        frame: "x = east - origin[0], y = up, z = -(north - origin[1]); metres".into(),
-        crs: data.crs.clone(),
-        crs_wkt: data.crs_wkt.clone(),
-        tile_size: params.tile_size,
-        params: params.clone(),
-        input: input_summary(&opts.input, opts.templates.as_deref(), data, plan),
-        tiles: manifest_tiles,
-        formats: sinks.iter().map(|s| s.format().to_string()).collect(),
-        files: Vec::new(),
-        textures,
-        species,
-    };
-    let mut manifest = manifest;
-    if let Some(why) = &library.no_atlas {
-        manifest.input.warnings.push(crate::model::Warning::new(
-            crate::model::WarningClass::Build,
-            why.clone(),
-        ));
-    }
-    let links = output::links::write_links(&opts.out, data, plan.origin)
-        .map_err(|e| write_err(&opts.out.join("links.json"), e))?;
-    manifest.files.extend(links);
-    // plan.gpkg before the tileset: it needs the analysis, which the levels of detail do not
-    // (they read the leaves' files back), and its layers need none of the tileset's files.
-    let t_gpkg = Instant::now();
-    match gpkg {
-        Some(writer) => writer?.finish(&sources, &manifest).map_err(gpkg_err)?,
-        // A whole build without gpkg leaves no plan.gpkg of an earlier one beside its tiles.
-        None if opts.selection == Selection::All => {
-            let _ = std::fs::remove_file(&gpkg_path);
-        }
-        None => {}
-    }
-    let gpkg_finish = t_gpkg.elapsed();
-    let t_png = Instant::now();
-    if let Some(png) = image {
-        let path = opts.out.join("plan.png");
-        output::atomic::write_atomic(&path, &png).map_err(|e| write_err(&path, e))?;
-    }
-    let png_time = t_png.elapsed();
-    // The analysis is let go before the levels of detail, the longest step after the tiles:
-    // at 1,000,000 lots it was most of the 1.3 GB live while the parents were made. Freeing
-    // its millions of small allocations takes a moment nobody waits for.
-    std::thread::spawn(move || drop((owned_data, owned_plan)));
-    // A shard's tiles are only part of the city: `merge` writes the tileset.
-    if manifest.shard.is_none() {
-        shards::finish_formats(&opts.out, &mut manifest)?;
-    }
-    timings.gpkg = [gpkg_time, gpkg_finish];
-    timings.generate_and_write = t.elapsed() - png_time;
-    let t = Instant::now();
-    if opts.selection == Selection::All {
-        shards::remove_stale_tiles(&opts.out, &manifest);
-        shards::remove_stale_textures(&opts.out, &manifest.textures);
-    }
+    let mut manifest = writer.manifest(&data, &plan, written, previous);
+    let beside = city::Beside { image, gpkg };
+    let (gpkg_after, png_time) = writer.plan_files(&mut manifest, &data, beside, &sources)?;
+    // Freeing the analysis's millions of small allocations takes a moment nobody waits for.
+    std::thread::spawn(move || drop((data, plan)));
+    let (report, stale_time) = writer.finish(manifest)?;
+    timings.gpkg = [gpkg_time, gpkg_after];
+    timings.generate_and_write = t.elapsed() - png_time - stale_time;
     // Drawn beside the tiles: its own time, not the wall time it added.
-    timings.plan = plan_time + png_time + t.elapsed();
-    let rep = shards::write_manifest_and_report(&opts.out, &manifest)?;
+    timings.plan = plan_time + png_time + stale_time;
     timings.total = t0.elapsed();
     Ok(BuildOutcome {
-        report: rep,
+        report,
         timings,
         bytes_written,
         tiles_written,
