@@ -223,7 +223,7 @@ fn garden_meshes(c: &Candidate, s: &Settings, seed: u64) -> Vec<Mesh> {
         ground: 0.0,
     };
     garden::build(
-        "garden",
+        &edo_city::model::object::Owner::of(Default::default(), "garden"),
         &c.layout,
         s,
         site,

@@ -77,6 +77,23 @@ pub fn build_segment(
     Ok(len)
 }
 
+/// What a segment's object is: a lot's or a line's walls, or a gate.
+pub fn object_kind(f: &PlannedFence) -> crate::model::object::ObjectKind {
+    match f.kind {
+        FenceKind::Wall => crate::model::object::ObjectKind::Fence,
+        FenceKind::Gate => crate::model::object::ObjectKind::Gate,
+    }
+}
+
+/// Whose a segment is: its walled lot's, or its fence line's.
+pub fn owner(f: &PlannedFence) -> crate::model::object::Owner {
+    use crate::model::object::{Owner, OwnerLayer};
+    match f.layer == "fences" {
+        true => Owner::of(OwnerLayer::Fences, &f.id),
+        false => Owner::of(OwnerLayer::Lots, &f.id),
+    }
+}
+
 /// The object a segment goes into.
 /// `fence_<lot>` / `gate_<lot>_<edge>` for a walled lot, `fenceline_<id>` /
 /// `gateline_<id>_<edge>` for a line of the fences layer (ids of two layers may coincide).

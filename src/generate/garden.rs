@@ -13,6 +13,7 @@ use smallvec::smallvec;
 use super::mesh::{Corners, Frame, Mesh};
 use crate::growers::garden::{Layout, Settings};
 use crate::materials;
+use crate::model::object::{ObjectKind, Owner};
 
 /// Where a garden lies on the map.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,7 +43,7 @@ const GRAVEL: f64 = 0.03;
 /// Every object of a garden: the bed (gravel, rings, moss, wall) named `garden_<id>`, then
 /// one `stone_<id>_<group>_<role>_<k>` per stone. `stone_rng(k)` gives the k-th stone's RNG.
 pub fn build(
-    id: &str,
+    owner: &Owner,
     layout: &Layout,
     s: &Settings,
     site: GardenSite,
@@ -50,7 +51,8 @@ pub fn build(
     frame: Frame,
     stone_rng: &mut dyn FnMut(usize) -> rand_pcg::Pcg64,
 ) -> Vec<Mesh> {
-    let mut bed = Mesh::new(format!("garden_{id}"));
+    let id = &owner.id;
+    let mut bed = Mesh::object(format!("garden_{id}"), ObjectKind::Garden, owner.clone());
     let z = site.ground + GRAVEL;
     let v = |m: &mut Mesh, x: f64, y: f64, h: f64| m.vertex(frame, site.map(x, y), h);
     // The gravel: one quad, its rake lines running along the viewing side.
@@ -97,11 +99,8 @@ pub fn build(
     let mut out = vec![bed.finish()];
     for (k, st) in layout.stones.iter().enumerate() {
         let mut rng = stone_rng(k);
-        let mut m = Mesh::new(format!(
-            "stone_{id}_{}_{}_{k}",
-            st.group + 1,
-            st.role.name()
-        ));
+        let name = format!("stone_{id}_{}_{}_{k}", st.group + 1, st.role.name());
+        let mut m = Mesh::object(name, ObjectKind::Stone, owner.clone());
         stone(&mut m, &site, frame, st.x, st.y, st.size, &mut rng);
         out.push(m.finish());
     }
@@ -364,7 +363,13 @@ pub fn planned(g: &crate::model::PlannedGarden, seed: u64, frame: Frame) -> Vec<
         angle: g.angle,
         ground: g.ground,
     };
-    build(&g.lot, &layout, &settings, site, false, frame, &mut |k| {
-        crate::rng::feature_rng(seed, "garden/stone", &format!("{}/{k}", g.lot))
-    })
+    build(
+        &g.owner(),
+        &layout,
+        &settings,
+        site,
+        false,
+        frame,
+        &mut |k| crate::rng::feature_rng(seed, "garden/stone", &format!("{}/{k}", g.lot)),
+    )
 }

@@ -14,6 +14,7 @@ use geo::{BooleanOps, TriangulateEarcut};
 use geo_types::{Coord, LineString, MultiPolygon, Polygon, Rect};
 
 use crate::geom::union::cascaded;
+use crate::model::object::ObjectKind;
 
 use super::clip::{clip_band, clip_band_u, LocalPoly, LocalRing};
 use super::mesh::{Frame, Mesh};
@@ -73,7 +74,7 @@ pub fn tile_ground(
     }
     layers.push((default, square.difference(&taken)));
     let height = Height::new(&g.height, dem);
-    let mut ground = Mesh::new("ground".into());
+    let mut ground = Mesh::object("ground".into(), ObjectKind::Ground, Default::default());
     for (m, area) in &layers {
         lay(
             &mut ground,
@@ -87,7 +88,7 @@ pub fn tile_ground(
         );
     }
     let street_mesh = (!streets.0.is_empty()).then(|| {
-        let mut mesh = Mesh::new("streets".into());
+        let mut mesh = Mesh::object("streets".into(), ObjectKind::Streets, Default::default());
         let m = materials::id("street");
         lay(
             &mut mesh,

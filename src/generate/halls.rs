@@ -48,7 +48,9 @@ pub fn build(
     }
     .slots();
     let slots = t.evaluate(&x, overrides, &[], &site as &dyn Lot)?;
-    let mut mesh = Mesh::new(h.object_name());
+    use crate::model::object::{ObjectKind, Owner, OwnerLayer};
+    let owner = Owner::of(OwnerLayer::Lots, &h.lot);
+    let mut mesh = Mesh::object(h.object_name(), ObjectKind::Hall, owner);
     instantiate(t, &slots, &site, frame, &mut mesh)?;
     Ok(mesh.finish())
 }

@@ -63,7 +63,8 @@ pub fn build(
     }
     .slots();
     let slots = t.evaluate(&x, overrides, &[], &site as &dyn Lot)?;
-    let mut mesh = Mesh::new(format!("kura_{}", m.id));
+    let kind = crate::model::object::ObjectKind::Kura;
+    let mut mesh = Mesh::object(format!("kura_{}", m.id), kind, m.owner());
     instantiate(t, &slots, &site, frame, &mut mesh)?;
     Ok(mesh.finish())
 }

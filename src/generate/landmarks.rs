@@ -9,7 +9,9 @@ use crate::model::PlannedLandmark;
 /// The object `landmark_<id>`.
 pub fn mesh(l: &PlannedLandmark, frame: Frame) -> Mesh {
     let model = &l.model;
-    let mut mesh = Mesh::new(l.object_name());
+    use crate::model::object::{ObjectKind, Owner, OwnerLayer};
+    let owner = Owner::of(OwnerLayer::Landmarks, &l.id);
+    let mut mesh = Mesh::object(l.object_name(), ObjectKind::Landmark, owner);
     // Each model vertex once, placed; the mesh welds what rounds to the same millimetre.
     let ids: Vec<u32> = model
         .positions

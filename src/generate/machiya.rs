@@ -101,7 +101,7 @@ pub fn build(
         &m.attrs,
         &site as &dyn Lot,
     )?;
-    let mut mesh = Mesh::new(m.object_name());
+    let mut mesh = Mesh::object(m.object_name(), m.object_kind(), m.owner());
     instantiate(t, &slots, &site, frame, &mut mesh)?;
     if mesh.faces.is_empty() {
         return Err(format!("template {} gives no faces on this lot", t.name));

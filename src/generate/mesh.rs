@@ -6,6 +6,8 @@
 
 use geo_types::Coord;
 
+use crate::model::object::{ObjectKind, Owner};
+
 /// The positions or texture coordinates of a mesh by value: a table of indices into the
 /// mesh's own list, hashed by [`word`]. An entry is 4 bytes, not the key's 24 plus the
 /// index: a tile of grown trees holds a million positions, and a map of keys missed the
@@ -82,8 +84,13 @@ pub struct Face {
 /// One OBJ object (`o <name>`).
 #[derive(Debug, Clone, Default)]
 pub struct Mesh {
-    /// The OBJ object's name (`machiya_<id>`, `kura_<id>`, `people`, ...).
+    /// The OBJ object's name (`machiya_<id>`, `kura_<id>`, `people`, ...): what the files
+    /// call it, never parsed back.
     pub name: String,
+    /// What it is.
+    pub kind: ObjectKind,
+    /// Whose it is (its lot, footprint, fence line, garden area or landmark).
+    pub owner: Owner,
     /// Output frame, millimetres: x east, y up, z south, relative to the dataset origin.
     pub positions: Vec<[i64; 3]>,
     /// Texture coordinates in units of 1/10000.
@@ -102,10 +109,20 @@ pub struct Frame {
 }
 
 impl Mesh {
-    /// An empty mesh named `name`.
+    /// An empty mesh named `name`, of no kind (a template or tree alone).
     pub fn new(name: String) -> Mesh {
         Mesh {
             name,
+            ..Mesh::default()
+        }
+    }
+
+    /// An empty mesh of a city's object: named `name`, of `kind`, `owner`'s.
+    pub fn object(name: String, kind: ObjectKind, owner: Owner) -> Mesh {
+        Mesh {
+            name,
+            kind,
+            owner,
             ..Mesh::default()
         }
     }

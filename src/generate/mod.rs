@@ -8,6 +8,7 @@ pub mod clip;
 pub mod crowd;
 pub mod envelope;
 pub mod fences;
+pub mod figure;
 pub mod garden;
 pub mod ground;
 pub mod halls;
@@ -189,7 +190,10 @@ pub fn generate_tile(
                 out.meshes.push(mesh);
                 out.stats.kura += 1;
             }
-            Err(reason) => out.stats.skipped.push(skip(format!("its kura: {reason}"))),
+            Err(reason) => out
+                .stats
+                .skipped
+                .push(skip(Skipped::part_reason("kura", &reason))),
         }
     }
     for l in tile.landmarks {
@@ -270,7 +274,7 @@ fn build_halls(
                 file: files.lots.clone(),
                 id: h.lot.clone(),
                 record: Some(h.record),
-                reason: format!("its {}: {reason}", h.template),
+                reason: Skipped::part_reason(&h.template, &reason),
             }),
         }
     }
@@ -299,7 +303,11 @@ fn build_fences(
         groups[k].1.push(f);
     }
     for (name, segments) in groups {
-        let mut mesh = Mesh::new(name);
+        let mut mesh = Mesh::object(
+            name,
+            fences::object_kind(segments[0]),
+            fences::owner(segments[0]),
+        );
         let mut built: Result<Vec<(String, f64)>, String> = Ok(Vec::new());
         for f in &segments {
             let random = template_random(params.seed, "fences", &format!("{}/{}", f.id, f.edge));
@@ -333,7 +341,7 @@ fn build_fences(
                 },
                 id: first.id.clone(),
                 record: Some(first.record),
-                reason: format!("its fence: {reason}"),
+                reason: Skipped::part_reason("fence", &reason),
             }),
         }
     }

@@ -71,7 +71,8 @@ pub fn build<'a>(
 ) -> Planted<'a> {
     let mut order = trees;
     order.sort_by(|a, b| b.height.total_cmp(&a.height).then_with(|| a.id.cmp(&b.id)));
-    let mut mesh = Mesh::new("trees_grown".into());
+    let kind = crate::model::object::ObjectKind::GrownTrees;
+    let mut mesh = Mesh::object("trees_grown".into(), kind, Default::default());
     let mut used = 0u64;
     let mut rest = Vec::new();
     // Bytes per square metre of height of the trees of each species meshed so far: once the

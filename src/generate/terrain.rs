@@ -49,7 +49,8 @@ pub fn terrain_mesh(name: String, dem: &Dem, bounds: [f64; 4], frame: Frame) -> 
     }
     let xs = stops(x0, x1, dx0 + dem.cell / 2.0, dem.cell);
     let ys = stops(y0, y1, dy0 + dem.cell / 2.0, dem.cell);
-    let mut mesh = Mesh::new(name);
+    let kind = crate::model::object::ObjectKind::Terrain;
+    let mut mesh = Mesh::object(name, kind, Default::default());
     let material = materials::id("ground");
     let mut ids = vec![vec![(0u32, 0u32); xs.len()]; ys.len()];
     for (j, &y) in ys.iter().enumerate() {

@@ -10,6 +10,7 @@ pub mod crowd;
 pub mod dem;
 pub mod design;
 pub mod landmark;
+pub mod object;
 pub mod precinct;
 pub mod source;
 pub mod tile;
@@ -237,6 +238,21 @@ pub struct Skipped {
     pub record: Option<usize>,
     /// Why it was left out, and what to do.
     pub reason: String,
+}
+
+impl Skipped {
+    /// The reason for a part of a feature left out while the feature stands (its kura, its
+    /// walls, one of its halls): "its <part>: <why>". [`Skipped::is_part`] reads it back; the
+    /// report keeps the words, so the scope travels through merged manifests with them.
+    pub fn part_reason(part: &str, why: &str) -> String {
+        format!("its {part}: {why}")
+    }
+
+    /// Whether a part of the feature was left out ([`Skipped::part_reason`]), the feature
+    /// itself standing; else the whole feature was skipped.
+    pub fn is_part(&self) -> bool {
+        self.reason.starts_with("its ")
+    }
 }
 
 /// The outline of a record skipped while reading, where it had a usable one (a repeated id,
@@ -650,6 +666,23 @@ impl PlannedHouse {
             HouseSource::Lot => format!("machiya_{}", self.id),
             HouseSource::Footprint { .. } => format!("footprint_{}", self.id),
         }
+    }
+
+    /// What its house is: a machiya or a house on a footprint.
+    pub fn object_kind(&self) -> object::ObjectKind {
+        match self.source {
+            HouseSource::Lot => object::ObjectKind::Machiya,
+            HouseSource::Footprint { .. } => object::ObjectKind::Footprint,
+        }
+    }
+
+    /// Whose its house and kura are: its lot's, or its footprint's.
+    pub fn owner(&self) -> object::Owner {
+        let layer = match self.source {
+            HouseSource::Lot => object::OwnerLayer::Lots,
+            HouseSource::Footprint { .. } => object::OwnerLayer::Footprints,
+        };
+        object::Owner::of(layer, &self.id)
     }
 }
 

@@ -146,6 +146,15 @@ pub struct PlannedGarden {
 }
 
 impl PlannedGarden {
+    /// Whose it is: its lot's, or (`area-<id>`) the gardens layer's polygon's.
+    pub fn owner(&self) -> super::object::Owner {
+        use super::object::{Owner, OwnerLayer};
+        match self.lot.starts_with("area-") {
+            true => Owner::of(OwnerLayer::Gardens, &self.lot),
+            false => Owner::of(OwnerLayer::Lots, &self.lot),
+        }
+    }
+
     /// Its outline on the map, counter-clockwise.
     pub fn outline(&self) -> Vec<Coord<f64>> {
         let (s, c) = self.angle.sin_cos();

@@ -1,11 +1,12 @@
 //! What each object of a tile is, for the formats that carry metadata (the GLB's
-//! `EXT_structural_metadata` table, the viewer's info panel): its kind, its lot and the lot's
-//! attributes, read back from the object's name and the plan. Format-neutral: every sink
-//! gets the same list, one [`Feature`] per mesh.
+//! `EXT_structural_metadata` table, the viewer's info panel): its kind and owner as
+//! generation set them (`Mesh::kind`, `Mesh::owner`), and the owner's attributes from the
+//! plan. Format-neutral: every sink gets the same list, one [`Feature`] per mesh.
 
 use std::collections::{HashMap, HashSet};
 
 use crate::generate::mesh::Mesh;
+use crate::model::object::{ObjectKind, OwnerLayer};
 use crate::model::{Dataset, Plan};
 use crate::params::Params;
 
@@ -31,23 +32,6 @@ pub struct Feature {
     /// The layer file (relative to the input directory) the object came from.
     pub source: String,
 }
-
-/// The kinds an object name can start with, longest first where one is a prefix of another.
-const KINDS: &[(&str, &str)] = &[
-    ("trees_grown", "trees"),
-    ("people_walking", "people"),
-    ("fenceline_", "fence"),
-    ("gateline_", "gate"),
-    ("machiya_", "machiya"),
-    ("footprint_", "footprint"),
-    ("kura_", "kura"),
-    ("fence_", "fence"),
-    ("gate_", "gate"),
-    ("garden_", "garden"),
-    ("stone_", "stone"),
-    ("hall_", "hall"),
-    ("landmark_", "landmark"),
-];
 
 /// The lookup from names to lots and houses, built once per build.
 pub struct Directory<'a> {
@@ -78,12 +62,10 @@ impl<'a> Directory<'a> {
     pub fn features(&self, meshes: &[Mesh]) -> Vec<Feature> {
         let with_kura: HashSet<&str> = meshes
             .iter()
-            .filter_map(|m| m.name.strip_prefix("kura_"))
+            .filter(|m| m.kind == ObjectKind::Kura)
+            .map(|m| m.owner.id.as_str())
             .collect();
-        meshes
-            .iter()
-            .map(|m| self.feature(&m.name, &with_kura))
-            .collect()
+        meshes.iter().map(|m| self.feature(m, &with_kura)).collect()
     }
 
     /// One feature per instanced grown tree, variant by variant in the order given:
@@ -114,43 +96,30 @@ impl<'a> Directory<'a> {
             .collect()
     }
 
-    fn feature(&self, name: &str, with_kura: &HashSet<&str>) -> Feature {
+    fn feature(&self, m: &Mesh, with_kura: &HashSet<&str>) -> Feature {
         let l = &self.params.layers;
-        let (kind, rest) = KINDS
-            .iter()
-            .find_map(|(prefix, kind)| name.strip_prefix(prefix).map(|r| (*kind, r)))
-            .unwrap_or((name, ""));
-        // The id inside the name: gates end in `_<edge>`, halls in `_<template>`, stones in
-        // `_<group>_<role>_<k>`.
-        let id = match kind {
-            "gate" | "hall" => drop_words(rest, 1),
-            "stone" => drop_words(rest, 3),
-            _ => rest,
-        };
+        let id = m.owner.id.as_str();
         let mut f = Feature {
-            name: name.to_string(),
-            kind: kind.to_string(),
+            name: m.name.clone(),
+            kind: m.kind.name().to_string(),
             lot: id.to_string(),
             ..Feature::default()
         };
-        if kind == "landmark" {
-            // Its own layer's id: no lot, type or use of ours.
-            f.source = l.landmarks.file.clone();
-            return f;
-        }
-        let drawn = id.strip_prefix("area-");
-        f.source = match (name.split('_').next().unwrap_or(""), drawn) {
-            ("people", _) if self.given[0] => l.people.file.clone(),
-            ("trees", _) if self.given[1] => l.trees.file.clone(),
-            ("people" | "trees", _) => String::new(),
-            ("fenceline" | "gateline", _) => l.fences.file.clone(),
-            ("footprint", _) => l.footprints.file.clone(),
-            (_, Some(_)) => l.gardens.file.clone(),
-            _ if id.is_empty() => String::new(),
-            _ => l.lots.file.clone(),
+        f.source = match (m.kind, m.owner.layer) {
+            (ObjectKind::People | ObjectKind::Walkers, _) if self.given[0] => l.people.file.clone(),
+            (ObjectKind::Trees | ObjectKind::GrownTrees, _) if self.given[1] => {
+                l.trees.file.clone()
+            }
+            (_, OwnerLayer::None | OwnerLayer::People | OwnerLayer::Trees) => String::new(),
+            (_, OwnerLayer::Lots) => l.lots.file.clone(),
+            (_, OwnerLayer::Footprints) => l.footprints.file.clone(),
+            (_, OwnerLayer::Fences) => l.fences.file.clone(),
+            (_, OwnerLayer::Gardens) => l.gardens.file.clone(),
+            (_, OwnerLayer::Landmarks) => l.landmarks.file.clone(),
         };
-        if matches!(kind, "people" | "trees") {
-            f.lot.clear();
+        if m.kind == ObjectKind::Landmark {
+            // Its own layer's id: no lot, type or use of ours.
+            return f;
         }
         if let Some(house) = self.houses.get(id) {
             f.mtype = house.mtype.clone();
@@ -167,47 +136,94 @@ impl<'a> Directory<'a> {
     }
 }
 
-/// `s` without its last `n` `_`-separated words.
-fn drop_words(s: &str, n: usize) -> &str {
-    let mut end = s.len();
-    for _ in 0..n {
-        match s[..end].rfind('_') {
-            Some(i) => end = i,
-            None => return s,
-        }
-    }
-    &s[..end]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn names_give_their_kind_and_lot() {
+    fn kinds_and_owners_give_the_columns() {
+        use crate::model::object::Owner;
         let (data, plan, params) = (Dataset::default(), Plan::default(), Params::default());
         let dir = Directory::of(&data, &plan, &params);
         let kura: HashSet<&str> = ["12_3"].into_iter().collect();
-        let f = |n: &str| dir.feature(n, &kura);
+        let mesh = |name: &str, kind, layer, id: &str| {
+            Mesh::object(name.into(), kind, Owner::of(layer, id))
+        };
+        let f = |m: Mesh| dir.feature(&m, &kura);
+        let house = f(mesh(
+            "machiya_12_3",
+            ObjectKind::Machiya,
+            OwnerLayer::Lots,
+            "12_3",
+        ));
         assert_eq!(
-            (f("machiya_12_3").kind, f("machiya_12_3").lot),
-            ("machiya".into(), "12_3".into())
+            (house.kind.as_str(), house.lot.as_str()),
+            ("machiya", "12_3")
         );
-        assert!(f("machiya_12_3").kura);
-        assert!(!f("machiya_4").kura);
-        assert_eq!(f("gate_7_2").lot, "7");
-        assert_eq!(f("gateline_7_2").kind, "gate");
-        assert_eq!(f("stone_area-g1_2_soe_5").lot, "area-g1");
-        assert_eq!(f("stone_area-g1_2_soe_5").source, "gardens.shp");
-        assert_eq!(f("trees_grown").kind, "trees");
-        assert_eq!(f("trees_grown").lot, "");
-        assert_eq!(f("people").kind, "people");
-        assert_eq!(f("kura_9").source, "lots.shp");
-        assert_eq!(f("hall_4_2_goju-no-to").kind, "hall");
-        assert_eq!(f("hall_4_2_goju-no-to").lot, "4_2");
-        assert_eq!(f("landmark_nijo-keep").kind, "landmark");
-        assert_eq!(f("landmark_nijo-keep").lot, "nijo-keep");
-        assert_eq!(f("ground").kind, "ground");
-        assert_eq!(f("streets").source, "");
+        assert!(house.kura);
+        assert_eq!(house.source, "lots.shp");
+        assert!(
+            !f(mesh(
+                "machiya_4",
+                ObjectKind::Machiya,
+                OwnerLayer::Lots,
+                "4"
+            ))
+            .kura
+        );
+        let gate = f(mesh(
+            "gateline_7_2",
+            ObjectKind::Gate,
+            OwnerLayer::Fences,
+            "7",
+        ));
+        assert_eq!((gate.kind.as_str(), gate.lot.as_str()), ("gate", "7"));
+        assert_eq!(gate.source, params.layers.fences.file);
+        let stone = f(mesh(
+            "stone_area-g1_2_soe_5",
+            ObjectKind::Stone,
+            OwnerLayer::Gardens,
+            "area-g1",
+        ));
+        assert_eq!(
+            (stone.lot.as_str(), stone.source.as_str()),
+            ("area-g1", "gardens.shp")
+        );
+        let trees = f(mesh(
+            "trees_grown",
+            ObjectKind::GrownTrees,
+            OwnerLayer::None,
+            "",
+        ));
+        assert_eq!((trees.kind.as_str(), trees.lot.as_str()), ("trees", ""));
+        let walkers = f(mesh(
+            "people_walking",
+            ObjectKind::Walkers,
+            OwnerLayer::None,
+            "",
+        ));
+        assert_eq!(walkers.kind, "people");
+        let hall = f(mesh(
+            "hall_4_2_goju-no-to",
+            ObjectKind::Hall,
+            OwnerLayer::Lots,
+            "4_2",
+        ));
+        assert_eq!((hall.kind.as_str(), hall.lot.as_str()), ("hall", "4_2"));
+        let landmark = f(mesh(
+            "landmark_nijo-keep",
+            ObjectKind::Landmark,
+            OwnerLayer::Landmarks,
+            "nijo-keep",
+        ));
+        assert_eq!(
+            (landmark.kind.as_str(), landmark.lot.as_str()),
+            ("landmark", "nijo-keep")
+        );
+        let ground = f(mesh("ground", ObjectKind::Ground, OwnerLayer::None, ""));
+        assert_eq!(
+            (ground.kind.as_str(), ground.source.as_str()),
+            ("ground", "")
+        );
     }
 }
