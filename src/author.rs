@@ -73,7 +73,7 @@ pub fn build_alone(
                     t.param_names().join(", ")
                 )
             })?;
-        if let Some(why) = crate::templates::template::value_problem(*v) {
+        if let Some(why) = crate::templates::file::value_problem(*v) {
             return Err(format!("--set {k}={v}: {why}"));
         }
         overrides.push((slot, *v));

@@ -2,7 +2,7 @@
 //! name which (`crate::x` paths and `use` lines), and which may touch the file system. A new
 //! edge that runs back up the stages fails here, naming the file and the line.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// What the two middle stages, analyse and generate, may name.
@@ -253,4 +253,194 @@ fn the_checker_sees_an_edge_and_ignores_comments() {
         named("let d: crate::model::dem::Dem; // crate::output"),
         vec!["model"]
     );
+}
+
+/// The sibling modules (children of the same parent) `text` (one file's code, comments
+/// gone) names: by `super::x` when the file is the sibling's own (`p/f.rs`, `p/f/mod.rs`),
+/// and by `crate::<parent>::x` from anywhere below it.
+fn siblings_named(text: &str, parent: &str, direct: bool) -> BTreeSet<String> {
+    let ident = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let mut out = BTreeSet::new();
+    let mut prefixes = vec![format!("crate::{parent}::")];
+    if direct {
+        prefixes.push("super::".to_string());
+    }
+    for prefix in &prefixes {
+        let mut rest = text;
+        while let Some(i) = rest.find(prefix.as_str()) {
+            // `super::` inside `crate::a::super::`? Not Rust; but skip `xsuper::`.
+            let before = rest[..i].chars().last();
+            let after = &rest[i + prefix.len()..];
+            rest = after;
+            if prefix == "super::"
+                && before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_' || c == ':')
+            {
+                continue;
+            }
+            if let Some(group) = after.strip_prefix('{') {
+                // `super::{a, b::C, c::{D}}`: the first word of each top-level item.
+                let (mut depth, mut item) = (0, String::new());
+                for ch in group.chars() {
+                    match ch {
+                        '{' => depth += 1,
+                        '}' if depth == 0 => break,
+                        '}' => depth -= 1,
+                        ',' if depth == 0 => {
+                            out.insert(ident(item.trim()));
+                            item.clear();
+                            continue;
+                        }
+                        _ => {}
+                    }
+                    if depth == 0 {
+                        item.push(ch);
+                    }
+                }
+                out.insert(ident(item.trim()));
+            } else {
+                out.insert(ident(after));
+            }
+        }
+    }
+    out.retain(|n| !n.is_empty() && n != "self");
+    out
+}
+
+/// Every module's children and which of them each one names, from the files under `src/`.
+fn sibling_edges() -> BTreeMap<String, BTreeMap<String, BTreeSet<String>>> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    walk(&src(), &mut files);
+    // parent module path -> child -> the siblings it names
+    let mut edges: BTreeMap<String, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
+    for f in files {
+        let rel = f.strip_prefix(src()).unwrap().with_extension("");
+        let mut parts: Vec<String> = rel
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy().to_string())
+            .collect();
+        if parts.last().is_some_and(|l| l == "mod") {
+            parts.pop();
+        }
+        if parts.first().is_some_and(|p| p == "lib" || p == "main") || parts.len() < 2 {
+            continue;
+        }
+        // The code, without comments and without its unit tests (a test may build its case
+        // from a sibling's helper).
+        let whole = std::fs::read_to_string(&f).unwrap();
+        let text: String = whole[..whole.find("#[cfg(test)]").unwrap_or(whole.len())]
+            .lines()
+            .map(|l| format!("{}\n", code(l)))
+            .collect();
+        // The file belongs to the child `parts[k]` of every ancestor `parts[..k]`.
+        for k in 1..parts.len() {
+            let parent = parts[..k].join("::");
+            let child = parts[k].clone();
+            let direct = k == parts.len() - 1;
+            let named = siblings_named(&text, &parent, direct);
+            let entry = edges.entry(parent).or_default();
+            let set = entry.entry(child.clone()).or_default();
+            set.extend(named.into_iter().filter(|n| *n != child));
+        }
+    }
+    edges
+}
+
+/// A circle among `graph`'s nodes, if there is one, as the nodes around it.
+fn circle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        n: &str,
+        graph: &BTreeMap<String, BTreeSet<String>>,
+        state: &mut BTreeMap<String, u8>,
+        path: &mut Vec<String>,
+    ) -> Option<Vec<String>> {
+        state.insert(n.to_string(), 1);
+        path.push(n.to_string());
+        for m in graph.get(n).into_iter().flatten() {
+            if !graph.contains_key(m) {
+                continue;
+            }
+            match state.get(m).copied().unwrap_or(0) {
+                1 => {
+                    let start = path.iter().position(|p| p == m).unwrap();
+                    return Some(path[start..].to_vec());
+                }
+                0 => {
+                    if let Some(c) = visit(m, graph, state, path) {
+                        return Some(c);
+                    }
+                }
+                _ => {}
+            }
+        }
+        path.pop();
+        state.insert(n.to_string(), 2);
+        None
+    }
+    let mut state = BTreeMap::new();
+    for n in graph.keys() {
+        if state.get(n).copied().unwrap_or(0) == 0 {
+            if let Some(c) = visit(n, graph, &mut state, &mut Vec::new()) {
+                return Some(c);
+            }
+        }
+    }
+    None
+}
+
+/// ARCHITECTURE.md: no module imports its own parent's children in a circle (issue 58:
+/// `output/sink.rs` and the sinks, `gltf/` and `tiles3d/lod/`, the gpkg layers' files).
+#[test]
+fn no_children_of_one_module_import_each_other_in_a_circle() {
+    let mut found = Vec::new();
+    for (parent, graph) in sibling_edges() {
+        if let Some(c) = circle(&graph) {
+            found.push(format!("{parent}: {}", c.join(" -> ")));
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "circles among siblings:\n{}",
+        found.join("\n")
+    );
+}
+
+#[test]
+fn the_circle_finder_sees_a_circle_through_super_and_crate_paths() {
+    let a = siblings_named(
+        "use super::{b, c::{D, E}};\nlet x = crate::m::d::f();",
+        "m",
+        true,
+    );
+    assert_eq!(a, ["b", "c", "d"].iter().map(|s| s.to_string()).collect());
+    assert!(
+        siblings_named("use super::b;", "m", false).is_empty(),
+        "not its own"
+    );
+    let graph: BTreeMap<String, BTreeSet<String>> = [
+        ("a", vec!["b"]),
+        ("b", vec!["c"]),
+        ("c", vec!["a"]),
+        ("d", vec!["a"]),
+    ]
+    .iter()
+    .map(|(k, v)| (k.to_string(), v.iter().map(|s| s.to_string()).collect()))
+    .collect();
+    assert_eq!(circle(&graph).unwrap().len(), 3);
+    let mut open = graph.clone();
+    open.get_mut("c").unwrap().clear();
+    assert!(circle(&open).is_none());
 }

@@ -25,6 +25,7 @@ use super::{
     check::input_summary, shards, write_err, BuildError, BuildOptions, Library, Selection,
 };
 use crate::generate::{self, mesh::Mesh};
+use crate::model::object::ObjectKind;
 use crate::model::{Dataset, Plan};
 use crate::output::{self, report, sink::Sink};
 use crate::params::Params;
@@ -68,7 +69,7 @@ impl<'a> CityWriter<'a> {
                 &opts.out,
                 &tiles_dir,
                 &opts.out.join(output::TEXTURE_DIR),
-                &opts.out.join(output::gltf::models::DIR),
+                &opts.out.join(output::glb::MODELS_DIR),
                 &crowds_dir,
             ] {
                 output::atomic::remove_leftover_temporaries(dir);
@@ -87,7 +88,7 @@ impl<'a> CityWriter<'a> {
             catalog,
             library,
             tiles_dir,
-            sinks: output::sink::sinks(&params.output, library.atlas),
+            sinks: output::sinks(&params.output, library.atlas),
             files: super::layer_files(&opts.input, params),
             textures,
             species,
@@ -159,8 +160,8 @@ impl<'a> CityWriter<'a> {
         self.write_ns
             .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
         let bytes_of = |names| object_bytes(&meshes.meshes, mesh_bytes.as_deref(), names);
-        meshes.stats.tree_bytes = bytes_of(["trees", "trees_grown"]);
-        meshes.stats.ground_bytes = bytes_of(["ground", "streets"]);
+        meshes.stats.tree_bytes = bytes_of([ObjectKind::Trees, ObjectKind::GrownTrees]);
+        meshes.stats.ground_bytes = bytes_of([ObjectKind::Ground, ObjectKind::Streets]);
         entry.stats = meshes.stats;
         Ok(entry)
     }
@@ -312,10 +313,10 @@ fn entry(id: &str, extent: Option<([i64; 3], [i64; 3])>, centre: [i64; 3]) -> re
     }
 }
 
-/// The bytes the objects named `names` take in the OBJ, exactly: the OBJ writer's count of
+/// The bytes the objects of `kinds` take in the OBJ, exactly: the OBJ writer's count of
 /// each mesh when it wrote one (`sizes`), else counted.
-fn object_bytes(meshes: &[Mesh], sizes: Option<&[usize]>, names: [&str; 2]) -> u64 {
-    let of = |m: &Mesh| names.contains(&m.name.as_str());
+fn object_bytes(meshes: &[Mesh], sizes: Option<&[usize]>, kinds: [ObjectKind; 2]) -> u64 {
+    let of = |m: &Mesh| kinds.contains(&m.kind);
     match sizes {
         Some(sizes) => meshes
             .iter()

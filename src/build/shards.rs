@@ -297,7 +297,7 @@ pub fn remove_stale_tiles(out: &Path, manifest: &Manifest) {
         }
     }
     let _ = std::fs::remove_dir(out.join(crate::output::tiles3d::LOD_DIR));
-    let _ = std::fs::remove_dir(out.join(crate::output::gltf::models::DIR));
+    let _ = std::fs::remove_dir(out.join(crate::output::glb::MODELS_DIR));
     let _ = std::fs::remove_dir(out.join(crate::output::crowds::DIR));
 }
 
@@ -493,7 +493,7 @@ pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildEr
         ..manifest.params.output.clone()
     };
     // The whole-build steps draw no tile: no atlas needed.
-    for sink in crate::output::sink::sinks(&output, None) {
+    for sink in crate::output::sinks(&output, None) {
         let files = sink
             .finish(out, manifest, &mut warnings)
             .map_err(|e| write_err(out, e))?;

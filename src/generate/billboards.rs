@@ -2,16 +2,10 @@
 //! point, people in one object `people` and trees in one object `trees`, so a viewer can hide
 //! either at once. The template's `picture` material slot takes the texture drawn for each.
 
-use geo_types::Coord;
-
-use super::clip::LocalPoly;
-use super::instance::{instantiate, Local, Site};
 use super::mesh::{Frame, Mesh};
 use crate::materials;
 use crate::model::{BillboardKind, PlannedBillboard, Skipped, TileStats};
 use crate::params::Params;
-use crate::templates::expr::Lot;
-use crate::templates::template::SiteInputs;
 use crate::templates::Catalog;
 
 /// What [`build`] made of a tile's people and trees.
@@ -54,8 +48,14 @@ pub fn build(
             BillboardKind::Person => (&params.people.template, &files.people),
             BillboardKind::Tree => (&params.trees.template, &files.trees),
         };
-        let mut still = Mesh::new(kind.layer().to_string());
-        let mut walking = Mesh::new(WALKING.to_string());
+        use crate::model::object::ObjectKind;
+        let object = match kind {
+            BillboardKind::Person => ObjectKind::People,
+            BillboardKind::Tree => ObjectKind::Trees,
+        };
+        let mut still = Mesh::object(kind.layer().to_string(), object, Default::default());
+        let mut walking =
+            Mesh::object(WALKING.to_string(), ObjectKind::Walkers, Default::default());
         for b in billboards.iter().filter(|b| b.kind == kind) {
             let mesh = match kind == BillboardKind::Person && walkers.contains(b.id.as_str()) {
                 true => &mut walking,
@@ -75,7 +75,7 @@ pub fn build(
                         .or_default() += 1;
                     Ok(())
                 }
-                None => build_one(b, template, catalog, params.seed, frame, mesh),
+                None => super::figure::build_one(b, template, catalog, params.seed, frame, mesh),
             };
             match built {
                 Ok(()) => {
@@ -140,62 +140,4 @@ fn species_billboard(
         rotation: b.facing,
     };
     super::tree::billboard_of(form.crown, b.height, material, place, frame, mesh);
-}
-
-/// One billboard into `mesh`: the template on a site whose v axis is the facing direction,
-/// centred on the point, its picture slot given the billboard's texture.
-pub(super) fn build_one(
-    b: &PlannedBillboard,
-    template: &str,
-    catalog: &Catalog,
-    seed: u64,
-    frame: Frame,
-    mesh: &mut Mesh,
-) -> Result<(), String> {
-    let t = catalog
-        .get(template)
-        .ok_or_else(|| format!("billboard template `{template}` does not exist"))?;
-    let picture = materials::find(&b.texture)
-        .ok_or_else(|| format!("texture `{}` is not in the library", b.texture))?;
-    let v = Coord {
-        x: b.facing.cos(),
-        y: b.facing.sin(),
-    };
-    let u = Coord { x: v.y, y: -v.x };
-    let site = Site {
-        lot: LocalPoly::simple(vec![[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]),
-        local: Local { a: b.at, u, v },
-        ground: b.ground,
-        slope: 0.0,
-    };
-    let x = SiteInputs {
-        width: 0.0,
-        lot_depth: 0.0,
-        a: b.at,
-        b: b.at,
-        centroid: b.at,
-        ground: b.ground,
-        id: &b.id,
-        district: b.district.as_deref(),
-        random: super::template_random(seed, b.kind.layer(), &b.id),
-        billboard_height: b.height,
-        ..SiteInputs::default()
-    }
-    .slots();
-    let overrides = catalog.overrides(&t.name, b.district.as_deref());
-    let slots = t.evaluate(&x, &overrides, &[], &site as &dyn Lot)?;
-    let first = mesh.faces.len();
-    if let Err(e) = instantiate(t, &slots, &site, frame, mesh) {
-        mesh.faces.truncate(first);
-        return Err(e);
-    }
-    if let Some(slot) = t.material_slot("picture") {
-        for f in mesh.faces[first..]
-            .iter_mut()
-            .filter(|f| f.material == slot)
-        {
-            f.material = picture;
-        }
-    }
-    Ok(())
 }

@@ -86,7 +86,7 @@ pub fn build(
             };
             let frame = Frame { origin: [0.0, 0.0] };
             let template = &params.people.template;
-            super::billboards::build_one(&model, template, catalog, params.seed, frame, &mut mesh)
+            super::figure::build_one(&model, template, catalog, params.seed, frame, &mut mesh)
                 .ok()
                 .filter(|()| !mesh.faces.is_empty())
                 .map(|()| {

@@ -12,6 +12,7 @@ pub mod chart;
 pub mod crowds;
 pub mod cutout;
 pub mod features;
+pub mod glb;
 pub mod gltf;
 pub mod gpkg;
 pub mod links;
@@ -62,6 +63,36 @@ pub fn write_listed(out: &Path, path: String, parts: &[&[u8]]) -> std::io::Resul
         path,
         sha256,
     })
+}
+
+/// The sinks of `output.formats` (names as [`crate::params::output::FORMATS`] has them), in
+/// the order given; unknown names were refused when the parameters were read.
+/// `atlas` is the cut-out atlas the build wrote beside the textures, for the GLB tiles.
+/// The registry is the folder's front door: the trait sits in `sink.rs` with nothing of the
+/// formats, each format imports the trait, and only this names the formats (issue 58: the
+/// registry beside the trait made the two import each other).
+pub fn sinks(
+    output: &crate::params::OutputParams,
+    atlas: Option<&atlas::Atlas>,
+) -> Vec<Box<dyn sink::Sink>> {
+    let mut out: Vec<Box<dyn sink::Sink>> = Vec::new();
+    for f in &output.formats {
+        let s: Box<dyn sink::Sink> = match f.as_str() {
+            "obj" => Box::new(obj::ObjSink {
+                by_kind: output.obj_objects == "kind",
+            }),
+            "glb" => Box::new(gltf::GlbSink {
+                meshopt: output.glb_compression == "meshopt",
+                atlas: atlas.cloned(),
+                shared: Default::default(),
+            }),
+            _ => continue,
+        };
+        if !out.iter().any(|o| o.format() == s.format()) {
+            out.push(s);
+        }
+    }
+    out
 }
 
 /// Where the texture library is written, relative to the output directory: inside `tiles/`,

@@ -60,33 +60,6 @@ pub trait Sink: Sync {
     }
 }
 
-/// The sinks of `output.formats` (names as [`crate::params::output::FORMATS`] has them), in
-/// the order given; unknown names were refused when the parameters were read.
-/// `atlas` is the cut-out atlas the build wrote beside the textures, for the GLB tiles.
-pub fn sinks(
-    output: &crate::params::OutputParams,
-    atlas: Option<&super::atlas::Atlas>,
-) -> Vec<Box<dyn Sink>> {
-    let mut out: Vec<Box<dyn Sink>> = Vec::new();
-    for f in &output.formats {
-        let s: Box<dyn Sink> = match f.as_str() {
-            "obj" => Box::new(super::obj::ObjSink {
-                by_kind: output.obj_objects == "kind",
-            }),
-            "glb" => Box::new(super::gltf::GlbSink {
-                meshopt: output.glb_compression == "meshopt",
-                atlas: atlas.cloned(),
-                shared: Default::default(),
-            }),
-            _ => continue,
-        };
-        if !out.iter().any(|o| o.format() == s.format()) {
-            out.push(s);
-        }
-    }
-    out
-}
-
 /// The tile centre the local formats take positions around: the grid square's centre for a
 /// grid id, else the middle of the tile's content (`bounds`, output frame millimetres:
 /// min then max), both relative to the dataset origin and rounded to whole millimetres.

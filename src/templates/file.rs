@@ -297,7 +297,7 @@ pub fn parse(file: &str, text: &str) -> Result<Source, String> {
         m.into_iter()
             .map(|(k, v)| {
                 let s = cx.src(v);
-                match super::template::value_problem(s.value) {
+                match value_problem(s.value) {
                     Some(why) => Err(format!("{}: `{k}` = {} {why}", s.loc, s.value)),
                     None => Ok((k, s)),
                 }
@@ -461,6 +461,24 @@ pub fn merge(base: &Source, child: &Source) -> Source {
         materials: over(&base.materials, &child.materials),
         checks: base.checks.iter().chain(&child.checks).cloned().collect(),
         parts,
+    }
+}
+
+/// The largest size of a number a user gives a template (a parameter's default or the
+/// parameter file's value, `--set`, a feature's attribute): metres, degrees and counts of a
+/// building are far below it; 1e7 made a house 10,000 km tall.
+pub const MAX_VALUE: f64 = 1000.0;
+/// Why `v` cannot be a value a user gives a template, or `None`.
+pub fn value_problem(v: f64) -> Option<String> {
+    if !v.is_finite() {
+        Some("is not a number".into())
+    } else if v.abs() > MAX_VALUE {
+        Some(format!(
+            "is larger than a building's numbers may be (at most {MAX_VALUE} in size): give \
+             it in metres, degrees or a count"
+        ))
+    } else {
+        None
     }
 }
 

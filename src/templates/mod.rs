@@ -308,7 +308,7 @@ impl Catalog {
                             t.param_names().join(", ")
                         ))
                         })?;
-                    if let Some(why) = template::value_problem(*v) {
+                    if let Some(why) = file::value_problem(*v) {
                         return Err(TemplateError::Invalid(format!(
                             "parameter file: [{where_}template.{name}] `{k}` = {v} {why}"
                         )));

@@ -7,7 +7,7 @@ use std::ops::Range;
 use geo_types::Coord;
 
 use super::expr::{compile, Expr, Lot};
-use super::file::{Loc, OutlineSource, PartSource, Source, Src, Text};
+use super::file::{value_problem, Loc, OutlineSource, PartSource, Source, Src, Text};
 use crate::materials;
 
 /// What a template models; `type_mix` may name only machiya.
@@ -736,30 +736,12 @@ fn roof(p: &PartSource, scalar: &Names, all: &Names, loc: &Loc) -> Result<Option
     }))
 }
 
-/// The largest size of a number a user gives a template (a parameter's default or the
-/// parameter file's value, `--set`, a feature's attribute): metres, degrees and counts of a
-/// building are far below it; 1e7 made a house 10,000 km tall.
-pub const MAX_VALUE: f64 = 1000.0;
 /// The largest size of a derived value (areas and products of metres stay well below it).
 pub const MAX_DERIVED: f64 = 1e6;
 
-/// Why `v` cannot be a value a user gives a template, or `None`.
-pub fn value_problem(v: f64) -> Option<String> {
-    if !v.is_finite() {
-        Some("is not a number".into())
-    } else if v.abs() > MAX_VALUE {
-        Some(format!(
-            "is larger than a building's numbers may be (at most {MAX_VALUE} in size): give \
-             it in metres, degrees or a count"
-        ))
-    } else {
-        None
-    }
-}
-
 impl Template {
     /// Every scalar slot for one feature: the inputs, the params (defaults, then `overrides`),
-    /// the attributes (defaults, then the feature's own, each within [`MAX_VALUE`]), then
+    /// the attributes (defaults, then the feature's own, each within [`super::file::MAX_VALUE`]), then
     /// the derived values. A derived value that is not a finite number, or is larger than
     /// [`MAX_DERIVED`], is an error naming it.
     pub fn evaluate(

@@ -20,10 +20,10 @@ use std::collections::BTreeMap;
 
 use serde_json::{json, Value};
 
-use super::buffer::Buffer;
 use super::{Primitive, Slot};
 use crate::generate::crowd::Crowd;
 use crate::model::WalkKey;
+use crate::output::glb::buffer::Buffer;
 
 /// The largest distance (metres) between a walker and where its kept keys put it.
 pub const TOLERANCE: f64 = 0.02;

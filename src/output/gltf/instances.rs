@@ -11,9 +11,9 @@
 
 use serde_json::{json, Value};
 
-use super::buffer::Buffer;
 use super::models::Model;
 use crate::generate::planted::Instanced;
+use crate::output::glb::buffer::Buffer;
 
 /// The mesh and the node of each variant, appended to `meshes` and `nodes` (the node's mesh
 /// is its index there). `models` are the variants' shared models, in the order of `groups`

@@ -14,19 +14,19 @@
 //! build, cached by a browser across tiles, loadable from any static server.
 
 mod animation;
-pub mod buffer;
 mod instances;
-pub mod metadata;
 pub mod models;
 pub mod quantize;
 
 use serde_json::{json, Value};
 
 use crate::generate::mesh::Mesh;
+use crate::model::object::ObjectKind;
 use crate::output::atlas::{self, Atlas};
 use crate::output::features::Feature;
+use crate::output::glb::buffer::Buffer;
+use crate::output::glb::{add_images, declare_extensions, linear, metadata};
 use crate::output::palette::{mime_type, Palette};
-use buffer::Buffer;
 
 /// One primitive being assembled: interleaving is left to the accessors (one view each).
 #[derive(Default)]
@@ -257,15 +257,6 @@ fn snap(v: f64, steps: f64) -> f32 {
     ((v * steps).round() / steps) as f32
 }
 
-/// sRGB to linear, for `baseColorFactor` (glTF factors are linear).
-pub fn linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// The GLB bytes of one tile. `shift` (millimetres, output frame) is the tile centre the
 /// positions are taken around; `features` has one entry per mesh. Grown trees come
 /// instanced when the tile has `instanced` variants (their copies in `trees_grown` are left
@@ -276,21 +267,18 @@ pub fn tile_glb(
     meshopt: bool,
     atlas: Option<&Atlas>,
     models: &[&models::Model],
-) -> buffer::Glb {
+) -> crate::output::glb::buffer::Glb {
     let (meshes, features, shift, palette) =
         (tile.meshes, tile.features, tile.centre, tile.palette);
     let instanced = !tile.instanced.is_empty();
     // Walkers come animated: their standing copies are left out, their figures carry the
     // copies' row.
-    let walking = tile.crowd.and_then(|_| {
-        meshes
-            .iter()
-            .position(|m| m.name == crate::generate::billboards::WALKING)
-    });
+    let walking =
+        (tile.crowd).and_then(|_| (meshes.iter()).position(|m| m.kind == ObjectKind::Walkers));
     // Node per kind, in order of first appearance; primitive per material, by material id.
     let mut kinds: Vec<(&str, std::collections::BTreeMap<u16, Primitive>)> = Vec::new();
     for (i, (mesh, f)) in meshes.iter().zip(features).enumerate() {
-        if (instanced && mesh.name == "trees_grown") || walking == Some(i) {
+        if (instanced && mesh.kind == ObjectKind::GrownTrees) || walking == Some(i) {
             continue;
         }
         let k = match kinds.iter().position(|(k, _)| *k == f.kind) {
@@ -433,7 +421,7 @@ pub fn tile_glb(
         }
     }
     add_images(&mut doc, images, textures);
-    buffer::glb(&doc, buf.bin)
+    crate::output::glb::buffer::glb(&doc, buf.bin)
 }
 
 /// A primitive's accessors written to `buf` (positions, normals, uvs, its objects' feature
@@ -491,36 +479,6 @@ fn material_index(used: &mut Vec<u16>, material: u16) -> usize {
             used.len() - 1
         }
     }
-}
-
-/// The images and textures of a tile (leaf or parent), with the one sampler they share
-/// (linear, mipmapped, repeating); nothing when there are none.
-pub fn add_images(doc: &mut Value, images: Vec<Value>, textures: Vec<Value>) {
-    if !images.is_empty() {
-        doc["images"] = json!(images);
-        doc["textures"] = json!(textures);
-        doc["samplers"] =
-            json!([{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]);
-    }
-}
-
-/// `extensionsUsed` and `extensionsRequired` of a tile (a leaf or a parent): the metadata
-/// extensions, `KHR_mesh_quantization` (byte normals, short positions: not core glTF, so a
-/// client must know it to read them) and, when a view of `buf` was compressed,
-/// `EXT_meshopt_compression` (those views have no data but what the decoder makes).
-pub fn declare_extensions(doc: &mut Value, buf: &Buffer) {
-    let mut used = vec![
-        "EXT_mesh_features",
-        "EXT_structural_metadata",
-        "KHR_mesh_quantization",
-    ];
-    let mut required = vec!["KHR_mesh_quantization"];
-    if buf.compressed() {
-        used.push("EXT_meshopt_compression");
-        required.push("EXT_meshopt_compression");
-    }
-    doc["extensionsUsed"] = json!(used);
-    doc["extensionsRequired"] = json!(required);
 }
 
 /// The materials `used` (library ids, in first-use order; [`atlas::MATERIAL`] the cut-out

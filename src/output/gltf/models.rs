@@ -17,30 +17,11 @@ use std::sync::{Arc, Mutex};
 
 use serde_json::{json, Value};
 
-use super::buffer::Buffer;
 use super::quantize::Grid;
 use super::{Primitive, Slot};
 use crate::generate::mesh::Mesh;
+use crate::output::glb::{self, buffer::Buffer, MODELS_DIR};
 use crate::output::report::ManifestFile;
-
-/// Where the shared models are written, relative to the output directory (beside
-/// `tiles/textures/`, so a tile reaches them without `..`).
-pub const DIR: &str = "tiles/models";
-
-/// The URI of the model named `name`, relative to `tiles/` (a variant's name is
-/// `<species>_<k>`, the species' name checked to be letters, digits and `_`).
-fn uri_of(name: &str) -> String {
-    format!("models/{name}.bin")
-}
-
-/// Whether `uri` is one [`uri_of`] makes: `models/<name>.bin`, the name of letters, digits,
-/// `_` and `.` but no `..`. Readers of our own tiles take no other external buffer.
-pub fn is_shared_uri(uri: &str) -> bool {
-    let name = uri.strip_prefix("models/").unwrap_or("");
-    name.ends_with(".bin")
-        && (name.chars()).all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.')
-        && !name.contains("..")
-}
 
 /// One model encoded as a buffer of its own.
 pub struct Model {
@@ -91,7 +72,7 @@ pub fn encode(model: &Mesh, atlas: Option<&crate::output::atlas::Atlas>, meshopt
         primitives.push((material, prim));
     }
     Model {
-        uri: uri_of(&model.name),
+        uri: glb::uri_of(&model.name),
         step: grid.step,
         bin: buf.bin,
         views: buf.views,
@@ -198,7 +179,7 @@ impl Shared {
                 format!("{}: {e}", out.join(encoded.path()).display()),
             )
         };
-        std::fs::create_dir_all(out.join(DIR)).map_err(named)?;
+        std::fs::create_dir_all(out.join(MODELS_DIR)).map_err(named)?;
         let file =
             crate::output::write_listed(out, encoded.path(), &[&encoded.bin]).map_err(named)?;
         let w = Arc::new(Written {
@@ -228,22 +209,6 @@ mod tests {
         m.face(1, [(a, t), (b, t), (c, t)].into_iter().collect());
         m.face(2, [(a, t), (c, t), (d, t)].into_iter().collect());
         m.finish()
-    }
-
-    #[test]
-    fn only_the_uris_of_shared_models_are_taken() {
-        assert!(is_shared_uri(&uri_of("matsu_3")));
-        for bad in [
-            "../matsu_3.bin",
-            "models/../matsu_3.bin",
-            "models/a/b.bin",
-            "models/matsu_3.png",
-            "https://example.org/models/matsu_3.bin",
-            "/models/matsu_3.bin",
-            "models/.bin.",
-        ] {
-            assert!(!is_shared_uri(bad), "{bad}");
-        }
     }
 
     #[test]

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use rusqlite::{Connection, OpenFlags};
 
-use super::layers::{opt, t};
+use super::rows::{optional, text_or_null};
 use super::styles::{self, Look, Shape};
 use super::{int, text, GeoPackage, GeomKind, GpkgError, Srs, Value};
 
@@ -65,9 +65,9 @@ const LOT_COLUMNS: [super::Column; 11] = [
 impl LotRow {
     fn values(&self) -> [Value; 4] {
         [
-            opt(self.mtype.as_deref()),
-            opt(self.kura.as_deref()),
-            opt(self.status.as_deref()),
+            optional(self.mtype.as_deref()),
+            optional(self.kura.as_deref()),
+            optional(self.status.as_deref()),
             self.trees.map_or(Value::Null, Value::Integer),
         ]
     }
@@ -294,9 +294,9 @@ pub fn write_diff(
         count += 1;
         let first = y.or(x).expect("an id of either build");
         let mut row = vec![
-            t(id),
+            text_or_null(id),
             first.record.map_or(Value::Null, Value::Integer),
-            t(&differs),
+            text_or_null(&differs),
         ];
         let none = [Value::Null, Value::Null, Value::Null, Value::Null];
         let (vx, vy) = (
@@ -328,7 +328,7 @@ pub fn write_diff(
     ] {
         for id in ids {
             let geom = ta.get(id).or_else(|| tb.get(id)).cloned().flatten();
-            w.add_blob(geom.as_deref(), &[t(id), t(what)])?;
+            w.add_blob(geom.as_deref(), &[text_or_null(id), text_or_null(what)])?;
         }
     }
     w.end()?;

@@ -5,7 +5,10 @@ use std::collections::HashMap;
 
 use geo_types::{Coord, Geometry, LineString, Polygon};
 
-use super::layers::{kura_words, n, opt, planned, polygon_of, r, source, t, Index, PlanSources};
+use super::rows::{
+    count, house_layer, kura_words, optional, planned_houses, polygon_of, real_or_null,
+    text_or_null, Index, PlanSources,
+};
 use super::styles::{self, Look, Shape};
 use super::{int, real, text, GeoPackage, GeomKind, GpkgError, Value};
 use crate::geom::frame::Frame;
@@ -38,8 +41,8 @@ pub(super) fn mark_generated(
         .filter(|(_, l)| by_key.contains_key(&("lots", l.id.as_str())))
         .map(|(i, l)| (l.id.as_str(), i as i64 + 1))
         .collect();
-    for (i, h) in planned(s.plan).enumerate() {
-        let Some(found) = by_key.get(&(source(h), h.id.as_str())) else {
+    for (i, h) in planned_houses(s.plan).enumerate() {
+        let Some(found) = by_key.get(&(house_layer(h), h.id.as_str())) else {
             continue;
         };
         let lot = match h.is_footprint() {
@@ -47,14 +50,8 @@ pub(super) fn mark_generated(
             true => None,
         };
         for k in found {
-            // "its kura: ...", "its fence: ...", "its <hall>: ...": a part of the lot; the
-            // house stands.
-            mark(
-                g,
-                (lot, i as i64 + 1),
-                &k.reason,
-                k.reason.starts_with("its "),
-            )?;
+            // A part of the lot (its kura, fence or a hall): the house stands.
+            mark(g, (lot, i as i64 + 1), &k.reason, k.is_part())?;
         }
     }
     Ok(())
@@ -126,21 +123,21 @@ pub(super) fn houses(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Resu
          frontage its template fills, a footprint building its outline) and its template",
         Some(style),
     )?;
-    for h in planned(s.plan) {
-        let skip = index.skip_of(source(h), &h.id, h.record);
+    for h in planned_houses(s.plan) {
+        let skip = index.skip_of(house_layer(h), &h.id, h.record);
         w.add(
             Some(&footprint(h, (s.band)(h))),
             &[
-                t(&h.id),
-                n(h.record),
-                t(source(h)),
-                t(&h.mtype),
-                n(h.type_given as usize),
-                opt(h.district.as_deref()),
-                h.footprint_height().map_or(Value::Null, r),
-                t(&h.tile),
-                n(skip.is_none() as usize),
-                opt(skip.map(|k| k.reason.as_str())),
+                text_or_null(&h.id),
+                count(h.record),
+                text_or_null(house_layer(h)),
+                text_or_null(&h.mtype),
+                count(h.type_given as usize),
+                optional(h.district.as_deref()),
+                h.footprint_height().map_or(Value::Null, real_or_null),
+                text_or_null(&h.tile),
+                count(skip.is_none() as usize),
+                optional(skip.map(|k| k.reason.as_str())),
             ],
         )?;
     }
@@ -210,7 +207,7 @@ pub(super) fn kura(g: &mut GeoPackage, s: &PlanSources) -> Result<(), GpkgError>
         "The kura (storehouse) plots of section 4.2: placed, or refused for a collision",
         Some(style),
     )?;
-    for h in planned(s.plan) {
+    for h in planned_houses(s.plan) {
         let Some(rect) = h.kura.rect() else {
             continue;
         };
@@ -219,13 +216,13 @@ pub(super) fn kura(g: &mut GeoPackage, s: &PlanSources) -> Result<(), GpkgError>
         w.add(
             Some(&polygon_of(frame.quad(rect).to_vec())),
             &[
-                t(&h.id),
-                n(h.record),
-                t(status),
-                t(why),
-                r(rect[2] - rect[0]),
-                r(rect[3] - rect[1]),
-                t(&h.tile),
+                text_or_null(&h.id),
+                count(h.record),
+                text_or_null(status),
+                text_or_null(why),
+                real_or_null(rect[2] - rect[0]),
+                real_or_null(rect[3] - rect[1]),
+                text_or_null(&h.tile),
             ],
         )?;
     }

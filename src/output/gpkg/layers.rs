@@ -6,29 +6,18 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use geo_types::{Coord, Geometry, LineString, Polygon};
-use rstar::RTree;
 
 use super::styles::{self, Look, Shape};
 use super::{int, real, text, GeoPackage, GeomKind, GpkgError, Srs, Value};
-use crate::geom::segment::Segment;
-use crate::model::{Dataset, KuraDecision, Lot, Plan, PlannedHouse, Skipped};
+use crate::model::{Dataset, Plan, PlannedHouse, Skipped};
 use crate::output::report::Manifest;
 use crate::params::Params;
 
+use super::rows::{
+    count, house_layer, kura_words, optional, planned_houses, real_or_null, shapes_of,
+    text_or_null, Index, PlanSources,
+};
 use super::{houses, places};
-
-/// What `plan.gpkg` is made from: the input read, the analysis and the parameters.
-pub struct PlanSources<'a> {
-    /// The input as read.
-    pub data: &'a Dataset,
-    /// The analysis.
-    pub plan: &'a Plan,
-    /// The build's parameters.
-    pub params: &'a Params,
-    /// The band behind its frontage a machiya's body fills (`analyse::house::house_band`:
-    /// its template decides it); `None` for a footprint building.
-    pub band: &'a (dyn Fn(&PlannedHouse) -> Option<(f64, f64)> + Sync),
-}
 
 /// A `plan.gpkg` being written: the layers analysis alone decides are written by
 /// [`PlanWriter::start`] while the tiles are made; the ones that need the tiles' manifest
@@ -101,114 +90,6 @@ pub fn srs_of(data: &Dataset, params: &Params) -> Srs {
     Srs::of_build(&params.crs, data.crs_wkt.as_deref(), &data.crs, reprojected)
 }
 
-/// Lookups every layer needs: lots by id, skips by layer and id, the streets' segments.
-pub(super) struct Index<'a> {
-    /// Lots read, by id.
-    pub lots: HashMap<&'a str, &'a Lot>,
-    /// The skips of each (layer, id), in report order.
-    skips: HashMap<(&'a str, &'a str), Vec<&'a Skipped>>,
-    /// Features a landmark displaced: (kind, id) -> landmark.
-    pub displaced: HashMap<(&'a str, &'a str), &'a str>,
-    /// Every street's segments, the street's index in `value`.
-    streets: RTree<Segment>,
-}
-
-impl<'a> Index<'a> {
-    /// The lots by id alone: where a skipped record without an outline of its own is drawn.
-    fn lots_of(data: &'a Dataset) -> Index<'a> {
-        Index {
-            lots: data.lots.iter().map(|l| (l.id.as_str(), l)).collect(),
-            skips: HashMap::new(),
-            displaced: HashMap::new(),
-            streets: RTree::new(),
-        }
-    }
-
-    /// Every lookup, with `skipped`: the skips analysis knows of (generation's are marked
-    /// afterwards).
-    fn of(s: &'a PlanSources, skipped: impl Iterator<Item = &'a Skipped>) -> Index<'a> {
-        let (data, plan) = (s.data, s.plan);
-        let mut index = Index::lots_of(data);
-        for k in skipped {
-            index
-                .skips
-                .entry((k.layer.as_str(), k.id.as_str()))
-                .or_default()
-                .push(k);
-        }
-        for d in &plan.landmark_report.displaced {
-            index
-                .displaced
-                .entry((d.kind.as_str(), d.id.as_str()))
-                .or_insert(d.landmark.as_str());
-        }
-        let segments = data.streets.iter().enumerate().flat_map(|(i, st)| {
-            st.line.0.windows(2).map(move |w| Segment {
-                a: [w[0].x, w[0].y],
-                b: [w[1].x, w[1].y],
-                value: i as f64,
-            })
-        });
-        index.streets = RTree::bulk_load(segments.collect());
-        index
-    }
-
-    /// The first skip of a feature: its layer, its id and its record (a skip of a repeated
-    /// id names another record than the feature built under that id).
-    pub fn skip_of(&self, layer: &str, id: &str, record: usize) -> Option<&'a Skipped> {
-        self.skips
-            .get(&(layer, id))?
-            .iter()
-            .find(|k| k.record.is_none_or(|r| r == record))
-            .copied()
-    }
-
-    /// The id of the street nearest a point.
-    fn street_at(&self, p: Coord<f64>, data: &'a Dataset) -> Option<&'a str> {
-        let nearest = self.streets.nearest_neighbor(&[p.x, p.y])?;
-        data.streets
-            .get(nearest.value as usize)
-            .map(|s| s.id.as_str())
-    }
-}
-
-/// A string value, or NULL when empty.
-pub(super) fn t(s: &str) -> Value {
-    match s {
-        "" => Value::Null,
-        s => Value::Text(s.to_string()),
-    }
-}
-
-/// An optional string value.
-pub(super) fn opt(s: Option<&str>) -> Value {
-    s.map_or(Value::Null, t)
-}
-
-/// An integer value.
-pub(super) fn n(v: usize) -> Value {
-    Value::Integer(v as i64)
-}
-
-/// A real value, NULL unless finite.
-pub(super) fn r(v: f64) -> Value {
-    if v.is_finite() {
-        Value::Real(v)
-    } else {
-        Value::Null
-    }
-}
-
-/// A ring of map points as a polygon.
-pub(super) fn polygon_of(points: Vec<Coord<f64>>) -> Geometry<f64> {
-    Geometry::Polygon(Polygon::new(LineString::from(points), Vec::new()))
-}
-
-/// Every planned house, lot by lot, in the plan's order.
-pub(super) fn planned(plan: &Plan) -> impl Iterator<Item = &PlannedHouse> {
-    plan.houses.values().flatten()
-}
-
 /// The index of the outline's exterior edge from `a` to `b` (from 0).
 fn edge_index(outline: &Polygon<f64>, a: Coord<f64>, b: Coord<f64>) -> Option<usize> {
     let same = |p: Coord<f64>, q: Coord<f64>| (p.x - q.x).abs() < 1e-6 && (p.y - q.y).abs() < 1e-6;
@@ -217,24 +98,6 @@ fn edge_index(outline: &Polygon<f64>, a: Coord<f64>, b: Coord<f64>) -> Option<us
         .0
         .windows(2)
         .position(|w| same(w[0], a) && same(w[1], b))
-}
-
-/// What section 4.2 decided for a machiya's kura, in words: (decision, why).
-pub(super) fn kura_words(k: &KuraDecision, avoid: bool) -> (&'static str, &'static str) {
-    match k {
-        KuraDecision::NotCandidate => (
-            "not a candidate",
-            "frontage narrower than kura.min_frontage or lot shallower than kura.depth_ratio \
-             times it",
-        ),
-        KuraDecision::NoRoom => ("refused", "no room behind the house"),
-        KuraDecision::Collides(_) if avoid => (
-            "refused",
-            "its plot overlaps another machiya's (kura.collision = true)",
-        ),
-        KuraDecision::Collides(_) => ("placed", "its plot overlaps another machiya's"),
-        KuraDecision::Clear(_) => ("placed", ""),
-    }
 }
 
 const LOT_COLUMNS: [super::Column; 15] = [
@@ -259,7 +122,7 @@ const LOT_COLUMNS: [super::Column; 15] = [
 /// it had one).
 fn lots(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgError> {
     let avoid = s.params.kura.collision;
-    let houses: HashMap<&str, &PlannedHouse> = planned(s.plan)
+    let houses: HashMap<&str, &PlannedHouse> = planned_houses(s.plan)
         .filter(|h| !h.is_footprint())
         .map(|h| (h.id.as_str(), h))
         .collect();
@@ -290,16 +153,16 @@ fn lots(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgEr
         };
         let (edge, street, fallback) = match house {
             Some(h) => (
-                edge_index(&lot.outline, h.frontage.a, h.frontage.b).map_or(Value::Null, n),
-                opt(index.street_at(mid(h.frontage.a, h.frontage.b), s.data)),
-                n(h.frontage.fallback as usize),
+                edge_index(&lot.outline, h.frontage.a, h.frontage.b).map_or(Value::Null, count),
+                optional(index.street_at(mid(h.frontage.a, h.frontage.b), s.data)),
+                count(h.frontage.fallback as usize),
             ),
             None => (Value::Null, Value::Null, Value::Null),
         };
         let (kura, kura_reason) = match house {
             Some(h) => {
                 let (k, why) = kura_words(&h.kura, avoid);
-                (t(k), t(why))
+                (text_or_null(k), text_or_null(why))
             }
             None => (Value::Null, Value::Null),
         };
@@ -311,21 +174,21 @@ fn lots(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgEr
         w.add(
             Some(&Geometry::Polygon(lot.outline.clone())),
             &[
-                t(&lot.id),
-                n(lot.record),
-                t(lot.lot_use.name()),
-                opt(lot.district.as_deref()),
-                opt(mtype),
-                opt(source),
+                text_or_null(&lot.id),
+                count(lot.record),
+                text_or_null(lot.lot_use.name()),
+                optional(lot.district.as_deref()),
+                optional(mtype),
+                optional(source),
                 edge,
                 street,
                 fallback,
                 kura,
                 kura_reason,
-                n(trees.get(lot.id.as_str()).copied().unwrap_or(0)),
-                opt(house.map(|h| h.tile.as_str())),
-                t(status),
-                t(&reason),
+                count(trees.get(lot.id.as_str()).copied().unwrap_or(0)),
+                optional(house.map(|h| h.tile.as_str())),
+                text_or_null(status),
+                text_or_null(&reason),
             ],
         )?;
     }
@@ -344,24 +207,16 @@ fn lots(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), GpkgEr
             continue;
         }
         let shape = shapes.get(&(k.layer.as_str(), k.record, k.id.as_str()));
-        let mut row = vec![t(&k.id), k.record.map_or(Value::Null, n)];
+        let mut row = vec![text_or_null(&k.id), k.record.map_or(Value::Null, count)];
         row.extend(std::iter::repeat_n(Value::Null, LOT_COLUMNS.len() - 4));
-        row.push(t("skipped"));
-        row.push(t(&k.reason));
+        row.push(text_or_null("skipped"));
+        row.push(text_or_null(&k.reason));
         w.add(
             shape.map(|p| Geometry::Polygon((*p).clone())).as_ref(),
             &row,
         )?;
     }
     w.end()
-}
-
-/// The outlines reading kept of skipped records, by (layer, record, id).
-pub(super) fn shapes_of(data: &Dataset) -> HashMap<(&str, Option<usize>, &str), &Polygon<f64>> {
-    data.skipped_shapes
-        .iter()
-        .map(|k| ((k.layer.as_str(), Some(k.record), k.id.as_str()), &k.shape))
-        .collect()
 }
 
 fn mid(a: Coord<f64>, b: Coord<f64>) -> Coord<f64> {
@@ -413,27 +268,20 @@ fn frontages(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Result<(), G
             Look::of(crate::output::plan::FRONTAGE).sized(0.6),
         )),
     )?;
-    for h in planned(s.plan) {
+    for h in planned_houses(s.plan) {
         let f = h.frontage;
         w.add(
             Some(&Geometry::LineString(LineString::from(vec![f.a, f.b]))),
             &[
-                t(&h.id),
-                n(h.record),
-                t(source(h)),
-                edge_index(&h.outline, f.a, f.b).map_or(Value::Null, n),
-                opt(index.street_at(mid(f.a, f.b), s.data)),
-                r(f.width()),
-                n(f.fallback as usize),
+                text_or_null(&h.id),
+                count(h.record),
+                text_or_null(house_layer(h)),
+                edge_index(&h.outline, f.a, f.b).map_or(Value::Null, count),
+                optional(index.street_at(mid(f.a, f.b), s.data)),
+                real_or_null(f.width()),
+                count(f.fallback as usize),
             ],
         )?;
     }
     w.end()
-}
-
-pub(super) fn source(h: &PlannedHouse) -> &'static str {
-    match h.is_footprint() {
-        true => "footprints",
-        false => "lots",
-    }
 }

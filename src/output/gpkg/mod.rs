@@ -17,6 +17,7 @@ mod houses;
 mod layer;
 mod layers;
 mod places;
+mod rows;
 mod rtree;
 mod styles;
 
@@ -26,7 +27,8 @@ use rusqlite::{params, Connection};
 
 pub use diff::{write_diff, DiffError};
 pub use layer::LayerWriter;
-pub use layers::{write_plan, write_problems, PlanSources, PlanWriter};
+pub use layers::{write_plan, write_problems, PlanWriter};
+pub use rows::PlanSources;
 pub use rusqlite::types::Value;
 
 /// The date every `last_change` and style `update_time` carries: a build's file never

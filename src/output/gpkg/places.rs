@@ -5,7 +5,9 @@ use std::collections::HashMap;
 
 use geo_types::{Geometry, LineString, Point};
 
-use super::layers::{n, opt, polygon_of, r, shapes_of, t, Index, PlanSources};
+use super::rows::{
+    count, optional, polygon_of, real_or_null, shapes_of, text_or_null, Index, PlanSources,
+};
 use super::styles::{self, Look, Shape};
 use super::{int, real, text, GeoPackage, GeomKind, GpkgError, Value};
 use crate::model::{BillboardKind, Dataset, FenceKind, Skipped};
@@ -47,14 +49,14 @@ pub(super) fn fences(g: &mut GeoPackage, s: &PlanSources) -> Result<(), GpkgErro
             w.add(
                 Some(&Geometry::LineString(LineString::from(vec![f.a, f.b]))),
                 &[
-                    t(&f.id),
-                    n(f.record),
-                    t(&f.layer),
-                    t(&f.template),
-                    n(f.edge),
-                    r((f.b.x - f.a.x).hypot(f.b.y - f.a.y)),
-                    opt(f.district.as_deref()),
-                    t(&f.tile),
+                    text_or_null(&f.id),
+                    count(f.record),
+                    text_or_null(&f.layer),
+                    text_or_null(&f.template),
+                    count(f.edge),
+                    real_or_null((f.b.x - f.a.x).hypot(f.b.y - f.a.y)),
+                    optional(f.district.as_deref()),
+                    text_or_null(&f.tile),
                 ],
             )?;
         }
@@ -112,16 +114,16 @@ pub(super) fn halls(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Resul
         w.add(
             geom.as_ref(),
             &[
-                t(&stat.lot),
-                lot.map_or(Value::Null, |l| n(l.record)),
-                t(&stat.lot_use),
-                t(&stat.template),
-                n(stat.placed as usize),
-                t(&stat.reason),
-                r(stat.size[0]),
-                r(stat.size[1]),
-                opt(lot.and_then(|l| l.district.as_deref())),
-                opt(hall.map(|h| h.tile.as_str())),
+                text_or_null(&stat.lot),
+                lot.map_or(Value::Null, |l| count(l.record)),
+                text_or_null(&stat.lot_use),
+                text_or_null(&stat.template),
+                count(stat.placed as usize),
+                text_or_null(&stat.reason),
+                real_or_null(stat.size[0]),
+                real_or_null(stat.size[1]),
+                optional(lot.and_then(|l| l.district.as_deref())),
+                optional(hall.map(|h| h.tile.as_str())),
             ],
         )?;
     }
@@ -180,25 +182,25 @@ pub(super) fn gardens(g: &mut GeoPackage, s: &PlanSources, index: &Index) -> Res
             (None, None) => None,
         };
         let mut row = vec![
-            t(&stat.lot),
-            opt(stat.area.as_deref()),
-            n(stat.placed as usize),
-            t(&stat.reason),
-            r(stat.size[0]),
-            r(stat.size[1]),
-            n(stat.stones),
+            text_or_null(&stat.lot),
+            optional(stat.area.as_deref()),
+            count(stat.placed as usize),
+            text_or_null(&stat.reason),
+            real_or_null(stat.size[0]),
+            real_or_null(stat.size[1]),
+            count(stat.stones),
             if stat.placed {
-                r(stat.fitness)
+                real_or_null(stat.fitness)
             } else {
                 Value::Null
             },
         ];
-        row.extend(
-            rules
-                .iter()
-                .map(|rule| stat.scores.get(*rule).map_or(Value::Null, |v| r(*v))),
-        );
-        row.push(opt(garden.map(|g| g.tile.as_str())));
+        row.extend(rules.iter().map(|rule| {
+            stat.scores
+                .get(*rule)
+                .map_or(Value::Null, |v| real_or_null(*v))
+        }));
+        row.push(optional(garden.map(|g| g.tile.as_str())));
         w.add(geom.as_ref(), &row)?;
     }
     w.end()
@@ -252,16 +254,16 @@ pub(super) fn billboards(g: &mut GeoPackage, s: &PlanSources) -> Result<(), Gpkg
             w.add(
                 Some(&Geometry::Point(Point(b.at))),
                 &[
-                    t(&b.id),
-                    opt(tree.map(|f| f.species.as_str())),
-                    opt(tree.and_then(|f| f.lot.as_deref())),
-                    r(b.height),
-                    tree.map_or(Value::Null, |f| r(f.crown)),
-                    opt(form),
-                    t(&b.texture),
-                    r(b.facing.to_degrees()),
-                    opt(b.district.as_deref()),
-                    t(&b.tile),
+                    text_or_null(&b.id),
+                    optional(tree.map(|f| f.species.as_str())),
+                    optional(tree.and_then(|f| f.lot.as_deref())),
+                    real_or_null(b.height),
+                    tree.map_or(Value::Null, |f| real_or_null(f.crown)),
+                    optional(form),
+                    text_or_null(&b.texture),
+                    real_or_null(b.facing.to_degrees()),
+                    optional(b.district.as_deref()),
+                    text_or_null(&b.tile),
                 ],
             )?;
         }
@@ -298,16 +300,18 @@ pub(super) fn landmarks(g: &mut GeoPackage, s: &PlanSources) -> Result<(), GpkgE
         w.add(
             Some(&Geometry::Polygon(l.footprint.clone())),
             &[
-                t(&l.id),
-                n(l.record),
-                t(&l.model.file),
-                r(l.rotation.to_degrees()),
-                r(l.scale),
-                t(&displaced
-                    .get(l.id.as_str())
-                    .map(|v| v.join("; "))
-                    .unwrap_or_default()),
-                t(&l.tile),
+                text_or_null(&l.id),
+                count(l.record),
+                text_or_null(&l.model.file),
+                real_or_null(l.rotation.to_degrees()),
+                real_or_null(l.scale),
+                text_or_null(
+                    &displaced
+                        .get(l.id.as_str())
+                        .map(|v| v.join("; "))
+                        .unwrap_or_default(),
+                ),
+                text_or_null(&l.tile),
             ],
         )?;
     }
@@ -362,13 +366,13 @@ pub(super) fn tiles(
         w.add(
             geom.as_ref(),
             &[
-                t(&tile.id),
+                text_or_null(&tile.id),
                 bytes(&tile.obj),
                 bytes(&tile.mtl),
                 bytes(&tile.glb),
-                n(tile.stats.machiya),
-                n(tile.stats.footprints),
-                n(tile.stats.kura),
+                count(tile.stats.machiya),
+                count(tile.stats.footprints),
+                count(tile.stats.kura),
             ],
         )?;
     }
@@ -423,11 +427,11 @@ fn records(
         w.add(
             where_skipped(k, &shapes, index).as_ref(),
             &[
-                t(&k.layer),
-                t(&k.file),
-                k.record.map_or(Value::Null, n),
-                t(&k.id),
-                t(&k.reason),
+                text_or_null(&k.layer),
+                text_or_null(&k.file),
+                k.record.map_or(Value::Null, count),
+                text_or_null(&k.id),
+                text_or_null(&k.reason),
             ],
         )?;
     }
@@ -486,11 +490,11 @@ pub(super) fn problems(
         w.add(
             None,
             &[
-                opt(class.as_str()),
-                opt(warning.layer.as_deref()),
-                opt(warning.file.as_deref()),
-                opt(warning.key.as_deref()),
-                t(&warning.message),
+                optional(class.as_str()),
+                optional(warning.layer.as_deref()),
+                optional(warning.file.as_deref()),
+                optional(warning.key.as_deref()),
+                text_or_null(&warning.message),
             ],
         )?;
     }

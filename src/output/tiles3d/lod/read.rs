@@ -15,7 +15,7 @@ use serde_json::Value;
 
 use super::{Content, Cutout, Part, TextureColours};
 use crate::output::features::Feature;
-use crate::output::gltf::metadata;
+use crate::output::glb::metadata;
 use crate::output::tiles3d::globe::Affine;
 
 /// The kinds a parent leaves out: people are the size of the error of the first level.
@@ -57,7 +57,7 @@ impl Sources {
     /// once. A URI that is not one (another directory, a scheme, `..`) is refused: a leaf
     /// read back names only what the build wrote.
     fn model(&self, uri: &str, shown: &str) -> Result<Arc<Vec<u8>>, String> {
-        if !crate::output::gltf::models::is_shared_uri(uri) {
+        if !crate::output::glb::is_shared_uri(uri) {
             return Err(format!(
                 "{shown}: its buffer `{uri}` is not a shared model of this build \
                  (models/<name>.bin): build the tiles again"
@@ -336,7 +336,7 @@ pub fn bounds<'a>(points: impl IntoIterator<Item = &'a [f64; 3]>) -> ([f64; 3], 
 }
 
 /// The rows of the GLB's property table, as the writer laid them out
-/// ([`crate::output::gltf::metadata`]); a column the table leaves out is empty in every row.
+/// ([`crate::output::glb::metadata`]); a column the table leaves out is empty in every row.
 /// The table's `count` must be no more than its `name` column holds rows: a count of 1e10
 /// in a few bytes was allocated before it was believed (issue 57).
 fn features(
@@ -461,7 +461,7 @@ pub fn texture_colours(out: &Path) -> TextureColours {
         for p in img.pixels() {
             let a = p[3] as f64 / 255.0;
             for k in 0..3 {
-                sum[k] += a * crate::output::gltf::linear(p[k] as f32 / 255.0) as f64;
+                sum[k] += a * crate::output::glb::linear(p[k] as f32 / 255.0) as f64;
             }
             weight += a;
         }

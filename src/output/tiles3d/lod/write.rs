@@ -11,8 +11,8 @@ use std::collections::{BTreeMap, HashMap};
 use serde_json::{json, Value};
 
 use super::{Content, Part};
-use crate::output::gltf::buffer::{self, Buffer};
-use crate::output::gltf::metadata;
+use crate::output::glb::buffer::{self, Buffer};
+use crate::output::glb::metadata;
 
 /// The GLB of `content` named `name`, compressed with meshopt when `meshopt`.
 pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> buffer::Glb {
@@ -95,7 +95,7 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
     });
     if !kinds.is_empty() {
         let metadata = metadata::structural_metadata(&content.features, &mut buf);
-        crate::output::gltf::declare_extensions(&mut doc, &buf);
+        crate::output::glb::declare_extensions(&mut doc, &buf);
         doc["extensions"] = json!({"EXT_structural_metadata": metadata});
         doc["scenes"][0]["nodes"] = json!((0..kinds.len()).collect::<Vec<_>>());
         let (mut nodes, mut meshes) = (Vec::new(), Vec::new());
@@ -116,7 +116,7 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
         doc["buffers"] = buf.buffers_json();
         doc["bufferViews"] = json!(buf.views);
         doc["accessors"] = json!(buf.accessors);
-        crate::output::gltf::add_images(&mut doc, images, textures);
+        crate::output::glb::add_images(&mut doc, images, textures);
     }
     buffer::glb(&doc, buf.bin)
 }
