@@ -127,6 +127,9 @@ pub struct BuildOptions {
     pub selection: Selection,
     /// Replace an output directory built from other parameters or input.
     pub force: bool,
+    /// The analysis cache's directory (`cache::dir_from` the environment, at the command
+    /// line); `None`: no cache.
+    pub cache: Option<PathBuf>,
 }
 
 /// Wall time of each stage.
@@ -377,7 +380,8 @@ fn run(
     // reading the input and analysing it.
     let cache = match opts.selection {
         Selection::Shard { .. } => None,
-        _ => cache::file_for(&opts.out).and_then(|file| Some((file, cache::key(opts)?))),
+        _ => (opts.cache.as_deref())
+            .and_then(|dir| Some((cache::file_for(dir, &opts.out), cache::key(opts)?))),
     };
     let t = Instant::now();
     let cached = match (&opts.selection, &cache) {

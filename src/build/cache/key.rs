@@ -241,6 +241,7 @@ mod tests {
             plan_image: false,
             selection: crate::build::Selection::All,
             force: false,
+            cache: None,
         }
     }
 

@@ -45,19 +45,26 @@ pub enum CacheUse {
     Analysed,
 }
 
-/// Where this output directory's cache file is, if caching is on.
-pub fn file_for(out: &Path) -> Option<PathBuf> {
-    let dir = match std::env::var_os("EDO_CITY_CACHE") {
-        Some(v) if v.is_empty() || v == "off" => return None,
-        Some(v) => PathBuf::from(v),
-        None => match std::env::var_os("XDG_CACHE_HOME").filter(|v| !v.is_empty()) {
-            Some(x) => PathBuf::from(x).join("edo-city"),
-            None => PathBuf::from(std::env::var_os("HOME")?).join(".cache/edo-city"),
+/// The cache directory the environment names (`var` looks a variable up): `EDO_CITY_CACHE`
+/// (`off` or empty: none), else `$XDG_CACHE_HOME/edo-city`, else `~/.cache/edo-city`. The
+/// command line reads it once and passes it in [`super::BuildOptions::cache`]: the library
+/// reads no environment of its own.
+pub fn dir_from(var: impl Fn(&str) -> Option<std::ffi::OsString>) -> Option<PathBuf> {
+    match var("EDO_CITY_CACHE") {
+        Some(v) if v.is_empty() || v == "off" => None,
+        Some(v) => Some(PathBuf::from(v)),
+        None => match var("XDG_CACHE_HOME").filter(|v| !v.is_empty()) {
+            Some(x) => Some(PathBuf::from(x).join("edo-city")),
+            None => Some(PathBuf::from(var("HOME")?).join(".cache/edo-city")),
         },
-    };
+    }
+}
+
+/// Where the cache file of output directory `out` is in the cache directory `dir`.
+pub fn file_for(dir: &Path, out: &Path) -> PathBuf {
     let out = super::absolute(out);
     let name = crate::output::sha256_hex(out.as_os_str().as_encoded_bytes());
-    Some(dir.join(format!("{}.plan", &name[..24])))
+    dir.join(format!("{}.plan", &name[..24]))
 }
 
 /// The input and plan cached for `out` under `key`, or `None` (no file, another key,
@@ -192,6 +199,26 @@ fn evict_beyond(dir: &Path, keep: usize, keep_bytes: u64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_directory_is_the_one_the_environment_names() {
+        let env = |pairs: &'static [(&'static str, &'static str)]| {
+            move |k: &str| {
+                (pairs.iter())
+                    .find(|(n, _)| *n == k)
+                    .map(|(_, v)| std::ffi::OsString::from(v))
+            }
+        };
+        assert_eq!(dir_from(env(&[("EDO_CITY_CACHE", "off"), ("HOME", "/h")])), None);
+        assert_eq!(dir_from(env(&[("EDO_CITY_CACHE", "")])), None);
+        let given = dir_from(env(&[("EDO_CITY_CACHE", "/c"), ("HOME", "/h")]));
+        assert_eq!(given, Some(PathBuf::from("/c")));
+        let xdg = dir_from(env(&[("XDG_CACHE_HOME", "/x"), ("HOME", "/h")]));
+        assert_eq!(xdg, Some(PathBuf::from("/x/edo-city")));
+        let home = dir_from(env(&[("XDG_CACHE_HOME", ""), ("HOME", "/h")]));
+        assert_eq!(home, Some(PathBuf::from("/h/.cache/edo-city")));
+        assert_eq!(dir_from(env(&[])), None, "no home: no cache");
+    }
     use geo::polygon;
 
     #[test]
