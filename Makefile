@@ -2,7 +2,7 @@
 
 CARGO ?= cargo
 
-.PHONY: run test test-cluster test-future lint bench crowd-fd real textures fixtures clean pictures bad-input viewer-deps gis-deps blender-deps
+.PHONY: run test test-cluster test-future lint bench crowd-fd real real-cut textures fixtures clean pictures bad-input viewer-deps gis-deps blender-deps
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
@@ -50,6 +50,14 @@ real:
 	$(BIN) build $(REAL)/osaka_plateau --params params/examples/osaka-lonlat.toml --out out/real/osaka-lonlat
 	$(BIN) build $(REAL)/kyoto_plateau_related --params params/examples/kyoto.toml --out out/real/kyoto
 	$(BIN) build $(REAL)/swellendam_osm --params params/examples/swellendam.toml --out out/real/swellendam
+
+## Cut fixtures/real from the full sets of $(REAL) (pyshp in target/cut-venv): the real data
+## the tests read in a clone with nothing beside it (fixtures/real/README.md).
+real-cut:
+	python3 -m venv target/cut-venv
+	target/cut-venv/bin/pip install --quiet pyshp==3.1.9
+	rm -rf fixtures/real/*/
+	target/cut-venv/bin/python scripts/cut_real.py $(REAL) fixtures/real
 
 ## Whole-Kyoto scale: 30,052 synthetic lots, three builds, per-stage timings.
 bench:
