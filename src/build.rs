@@ -27,6 +27,7 @@ use crate::templates::{Catalog, Kind, TemplateError};
 pub mod cache;
 mod check;
 mod city;
+pub mod merge;
 mod names;
 mod plan_files;
 pub mod shards;

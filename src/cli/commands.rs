@@ -245,7 +245,7 @@ pub fn plan_command(args: PlanArgs) -> Result<()> {
 /// `edo-city merge`.
 pub fn merge_command(args: MergeArgs) -> Result<()> {
     let MergeArgs { dirs, no_plan } = args;
-    let report = shards::merge(&dirs, !no_plan)?;
+    let report = edo_city::build::merge::merge(&dirs, !no_plan)?;
     say!(
         "merged into {}: {} tiles, {} machiya, {} footprints, {} skipped",
         dirs[0].display(),
