@@ -24,6 +24,7 @@ pub use dataset::*;
 pub use landmark::{LandmarkRecord, LandmarkReport, Model, PlannedLandmark};
 pub use plan::*;
 pub use precinct::{GardenStat, GroundHeight, HallStat, PlannedGarden, PlannedGround, PlannedHall};
+/// A tile id `<col>_<row>` on the fixed grid.
 pub use tile::TileId;
 pub use warning::{Warning, WarningClass};
 

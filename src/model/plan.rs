@@ -44,8 +44,6 @@ impl Frontage {
     }
 }
 
-/// A tile id `<col>_<row>` on the fixed grid.
-
 /// What a planned house stands for.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum HouseSource {
