@@ -58,6 +58,7 @@ pub fn build_one(
     let first = mesh.faces.len();
     if let Err(e) = instantiate(t, &slots, &site, frame, mesh) {
         mesh.faces.truncate(first);
+        mesh.parts.retain(|p| (p.first_face as usize) < first);
         return Err(e);
     }
     if let Some(slot) = t.material_slot("picture") {

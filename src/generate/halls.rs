@@ -52,5 +52,12 @@ pub fn build(
     let owner = Owner::of(OwnerLayer::Lots, &h.lot);
     let mut mesh = Mesh::object(h.object_name(), ObjectKind::Hall, owner);
     instantiate(t, &slots, &site, frame, &mut mesh)?;
+    mesh.building = Some(super::instance::building_facts(
+        t,
+        &slots,
+        &site,
+        &[],
+        h.ground,
+    ));
     Ok(mesh.finish())
 }

@@ -68,6 +68,32 @@ impl Site {
     }
 }
 
+/// What a city model says of a building built from `t` with `slots` on `site`: its storeys
+/// (the feature's own `storeys` attribute when it has one, else the template's expression),
+/// its roof type, and the ground it stands on.
+pub fn building_facts(
+    t: &Template,
+    slots: &[f64],
+    site: &Site,
+    attrs: &[(String, f64)],
+    ground: f64,
+) -> super::mesh::BuildingFacts {
+    let given = attrs
+        .iter()
+        .find(|(k, _)| k.eq_ignore_ascii_case("storeys"))
+        .map(|(_, v)| *v);
+    let storeys = given
+        .or_else(|| t.storeys.as_ref().map(|e| e.eval(slots, site)))
+        .filter(|s| s.is_finite() && *s >= 1.0 && *s <= 200.0)
+        .map(|s| s.round() as u32);
+    super::mesh::BuildingFacts {
+        storeys,
+        roof_type: t.roof_type.clone(),
+        ground,
+        template: t.name.clone(),
+    }
+}
+
 /// Builds every part of `t` whose `when` holds into `mesh`. `slots` come from
 /// [`Template::evaluate`] for this site.
 pub fn instantiate(
@@ -94,6 +120,11 @@ pub fn instantiate(
         }
         // Parts share the mesh's vertices; each part's own faces must close on themselves.
         let first_face = mesh.faces.len();
+        mesh.parts.push(super::mesh::MeshPart {
+            name: part.name.clone(),
+            first_face: first_face as u32,
+            installation: part.installation,
+        });
         let closed = match &part.shape {
             Shape::Prism(p) => {
                 let cx = PartCx {

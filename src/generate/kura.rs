@@ -66,5 +66,12 @@ pub fn build(
     let kind = crate::model::object::ObjectKind::Kura;
     let mut mesh = Mesh::object(format!("kura_{}", m.id), kind, m.owner());
     instantiate(t, &slots, &site, frame, &mut mesh)?;
+    mesh.building = Some(super::instance::building_facts(
+        t,
+        &slots,
+        &site,
+        &[],
+        m.ground,
+    ));
     Ok(mesh.finish())
 }

@@ -6,7 +6,7 @@
 //! its site (the lot in the frontage frame) and its inputs.
 
 use super::clip::{area, dedup, LocalPoly, LocalRing};
-use super::instance::{instantiate, Local, Site};
+use super::instance::{building_facts, instantiate, Local, Site};
 use super::mesh::{Frame, Mesh};
 use crate::model::PlannedHouse;
 use crate::params::MachiyaParams;
@@ -103,6 +103,7 @@ pub fn build(
     )?;
     let mut mesh = Mesh::object(m.object_name(), m.object_kind(), m.owner());
     instantiate(t, &slots, &site, frame, &mut mesh)?;
+    mesh.building = Some(building_facts(t, &slots, &site, &m.attrs, m.ground));
     if mesh.faces.is_empty() {
         return Err(format!("template {} gives no faces on this lot", t.name));
     }

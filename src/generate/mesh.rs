@@ -91,6 +91,10 @@ pub struct Mesh {
     pub kind: ObjectKind,
     /// Whose it is (its lot, footprint, fence line, garden area or landmark).
     pub owner: Owner,
+    /// Its template's parts as built, each from its first face to the next one's.
+    pub parts: Vec<MeshPart>,
+    /// What a city model says of a building (houses, kura, halls).
+    pub building: Option<BuildingFacts>,
     /// Output frame, millimetres: x east, y up, z south, relative to the dataset origin.
     pub positions: Vec<[i64; 3]>,
     /// Texture coordinates in units of 1/10000.
@@ -99,6 +103,31 @@ pub struct Mesh {
     pub faces: Vec<Face>,
     pos_index: IndexTable,
     uv_index: IndexTable,
+}
+
+/// One part of a template as built into a mesh: its faces run from `first_face` to the next
+/// part's first face (or the mesh's end).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshPart {
+    /// The part's name in its template.
+    pub name: String,
+    /// Its first face.
+    pub first_face: u32,
+    /// Whether a city model holds it as an installation (the template says so).
+    pub installation: bool,
+}
+
+/// What a city model says of a building, from its template and its feature.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BuildingFacts {
+    /// Storeys above ground (the data's, else the template's), when known.
+    pub storeys: Option<u32>,
+    /// The roof's form (the template's `roof_type`), when it says.
+    pub roof_type: Option<String>,
+    /// The ground it stands on, metres.
+    pub ground: f64,
+    /// The template it was built from.
+    pub template: String,
 }
 
 /// Converts map coordinates (east, north, height; metres) to the output frame.

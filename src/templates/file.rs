@@ -30,6 +30,8 @@ struct RawTemplate {
     #[serde(default, rename = "abstract")]
     is_abstract: bool,
     height: Option<Spanned<NumOrText>>,
+    storeys: Option<Spanned<NumOrText>>,
+    roof_type: Option<String>,
     #[serde(default)]
     params: BTreeMap<String, Spanned<f64>>,
     #[serde(default)]
@@ -79,6 +81,8 @@ struct RawPart {
     front_material: Option<Spanned<String>>,
     front_base: Option<Spanned<NumOrText>>,
     front_height: Option<Spanned<NumOrText>>,
+    #[serde(default)]
+    installation: bool,
     // Explicit vertices and faces.
     #[serde(default)]
     vertices: Vec<Spanned<Vec<Spanned<NumOrText>>>>,
@@ -147,6 +151,10 @@ pub struct Source {
     pub is_abstract: bool,
     /// The height the model declares (tests hold the mesh to it).
     pub height: Option<Text>,
+    /// Its storeys above ground, for a city model (`storeys`).
+    pub storeys: Option<Text>,
+    /// Its roof's form, for a city model (`roof_type`: gable, hip, hip-and-gable, ...).
+    pub roof_type: Option<String>,
     /// Parameters with their defaults (a parameter file may set them).
     pub params: Vec<(String, Src<f64>)>,
     /// Attributes with their defaults (a lot's field of the same name sets them).
@@ -212,6 +220,9 @@ pub struct PartSource {
     pub faces: Vec<FaceSource>,
     /// Whether the part must be a closed shell.
     pub closed: Option<bool>,
+    /// Whether a city model holds it as an installation of the building (a pent roof, a
+    /// board facade, a gate, a porch), not as the building's own body.
+    pub installation: bool,
 }
 
 /// A prism's outline as written.
@@ -380,6 +391,7 @@ pub fn parse(file: &str, text: &str) -> Result<Source, String> {
                 })
                 .collect(),
             closed: p.closed,
+            installation: p.installation,
         })
         .collect();
     Ok(Source {
@@ -392,6 +404,8 @@ pub fn parse(file: &str, text: &str) -> Result<Source, String> {
         extends: raw.extends.map(|e| cx.src(e)),
         is_abstract: raw.is_abstract,
         height: cx.opt(raw.height),
+        storeys: cx.opt(raw.storeys),
+        roof_type: raw.roof_type,
         params: nums(raw.params)?,
         attributes: nums(raw.attributes)?,
         derived: raw
@@ -455,6 +469,8 @@ pub fn merge(base: &Source, child: &Source) -> Source {
         extends: None,
         is_abstract: child.is_abstract,
         height: child.height.clone().or_else(|| base.height.clone()),
+        storeys: child.storeys.clone().or_else(|| base.storeys.clone()),
+        roof_type: child.roof_type.clone().or_else(|| base.roof_type.clone()),
         params: over(&base.params, &child.params),
         attributes: over(&base.attributes, &child.attributes),
         derived: over(&base.derived, &child.derived),

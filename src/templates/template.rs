@@ -211,6 +211,10 @@ pub struct Template {
     pub checks: Vec<(Expr, String)>,
     /// The height the model declares (checked by tests against the mesh).
     pub height: Option<(Expr, Loc)>,
+    /// Its storeys above ground (`storeys`), for a city model.
+    pub storeys: Option<Expr>,
+    /// Its roof's form (`roof_type`), for a city model.
+    pub roof_type: Option<String>,
     /// Its parts, in file order.
     pub parts: Vec<Part>,
     /// The `[materials]` slots and the library material each names: a billboard's drawn
@@ -239,6 +243,8 @@ pub struct Part {
     pub when: Option<Expr>,
     /// A prism or explicit faces.
     pub shape: Shape,
+    /// Whether a city model holds it as an installation of the building.
+    pub installation: bool,
 }
 
 /// What a part is made of.
@@ -399,6 +405,10 @@ pub fn compile_template(s: &Source) -> Result<Template, String> {
         Some(t) => Some((scalar_names.compile(t)?, t.loc.clone())),
         None => None,
     };
+    let storeys = match &s.storeys {
+        Some(t) => Some(scalar_names.compile(t)?),
+        None => None,
+    };
     let material_slots = material_slots(s, kind, &here)?;
     let checks = s
         .checks
@@ -433,6 +443,8 @@ pub fn compile_template(s: &Source) -> Result<Template, String> {
         v_slot: u + 1,
         checks,
         height,
+        storeys,
+        roof_type: s.roof_type.clone(),
         parts,
         names,
         material_slots,
@@ -690,6 +702,7 @@ fn compile_part(p: &PartSource, scalar: &Names, all: &Names, slots: Slots) -> Re
         loc,
         when: scalar.opt(&p.when)?,
         shape,
+        installation: p.installation,
     })
 }
 
