@@ -47,6 +47,7 @@ pub fn check(
                 mtl: None,
                 glb: None,
                 crowds: None,
+                cityjson: None,
                 models: Vec::new(),
                 bounds: None,
                 centre: [0.0; 2],

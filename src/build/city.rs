@@ -70,6 +70,7 @@ impl<'a> CityWriter<'a> {
                 &tiles_dir,
                 &opts.out.join(output::TEXTURE_DIR),
                 &opts.out.join(output::glb::MODELS_DIR),
+                &opts.out.join(output::cityjson::TEMPLATES_DIR),
                 &crowds_dir,
             ] {
                 output::atomic::remove_leftover_temporaries(dir);
@@ -88,7 +89,7 @@ impl<'a> CityWriter<'a> {
             catalog,
             library,
             tiles_dir,
-            sinks: output::sinks(&params.output, library.atlas),
+            sinks: output::sinks(&params.output, library.atlas, &report::params_id(params)),
             files: super::layer_files(&opts.input, params),
             textures,
             species,
@@ -302,6 +303,7 @@ fn entry(id: &str, extent: Option<([i64; 3], [i64; 3])>, centre: [i64; 3]) -> re
         mtl: None,
         glb: None,
         crowds: None,
+        cityjson: None,
         models: Vec::new(),
         bounds: extent.map(|(lo, hi)| {
             // Output frame (x east, y up, z south) to east, north, up.

@@ -290,7 +290,9 @@ pub fn remove_stale_tiles(out: &Path, manifest: &Manifest) {
         .flat_map(|t| t.files().map(|f| f.path.clone()).collect::<Vec<_>>())
         .chain(old.files.iter().map(|f| f.path.clone()));
     for path in old_files {
-        let ours = path.starts_with("tiles/") || path.starts_with(crate::output::crowds::DIR);
+        let ours = path.starts_with("tiles/")
+            || path.starts_with(crate::output::crowds::DIR)
+            || path == crate::output::cityjson::FILE;
         let safe = ours && crate::output::listed::relative(&path).is_ok();
         if safe && !current.contains(path.as_str()) {
             let _ = std::fs::remove_file(out.join(&path));
@@ -298,6 +300,7 @@ pub fn remove_stale_tiles(out: &Path, manifest: &Manifest) {
     }
     let _ = std::fs::remove_dir(out.join(crate::output::tiles3d::LOD_DIR));
     let _ = std::fs::remove_dir(out.join(crate::output::glb::MODELS_DIR));
+    let _ = std::fs::remove_dir(out.join(crate::output::cityjson::TEMPLATES_DIR));
     let _ = std::fs::remove_dir(out.join(crate::output::crowds::DIR));
 }
 
@@ -329,7 +332,7 @@ pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildEr
         ..manifest.params.output.clone()
     };
     // The whole-build steps draw no tile: no atlas needed.
-    for sink in crate::output::sinks(&output, None) {
+    for sink in crate::output::sinks(&output, None, &report::params_id(&manifest.params)) {
         let files = sink
             .finish(out, manifest, &mut warnings)
             .map_err(|e| write_err(out, e))?;

@@ -62,6 +62,21 @@ impl Crs {
         })
     }
 
+    /// The EPSG code whose definition bears the name `name` (a WKT's `PROJCS["<name>"`, as
+    /// a `.prj` without AUTHORITY gives it), from the built-in list of codes.
+    ///
+    /// ```
+    /// let code = edo_city::geom::crs::Crs::epsg_named("JGD2011 / Japan Plane Rectangular CS VI");
+    /// assert_eq!(code, Some(6674));
+    /// assert_eq!(edo_city::geom::crs::Crs::epsg_named("My own grid"), None);
+    /// ```
+    pub fn epsg_named(name: &str) -> Option<u16> {
+        let head = format!("PROJCS[\"{name}\",");
+        (1024..=u16::MAX).find(|&code| {
+            crs_definitions::from_code(code).is_some_and(|d| d.wkt.starts_with(&head))
+        })
+    }
+
     /// The UTM zone (WGS84) holding a longitude/latitude in degrees.
     pub fn utm_for(lon: f64, lat: f64) -> Crs {
         let zone = (((lon + 180.0) / 6.0).floor() as i32).clamp(0, 59) + 1;

@@ -31,12 +31,19 @@ pub struct Feature {
     pub kura: bool,
     /// The layer file (relative to the input directory) the object came from.
     pub source: String,
+    /// The owner's record in its layer file, when it is a lot or footprint.
+    pub record: Option<usize>,
+    /// For a house: the street its frontage faces (the nearest street's id), else empty.
+    pub street: String,
 }
 
 /// The lookup from names to lots and houses, built once per build.
 pub struct Directory<'a> {
     lots: HashMap<&'a str, &'a crate::model::Lot>,
     houses: HashMap<&'a str, &'a crate::model::PlannedHouse>,
+    /// Every street's segments, the street's index in `value`: the street a frontage faces.
+    streets: rstar::RTree<crate::geom::segment::Segment>,
+    street_ids: Vec<&'a str>,
     params: &'a Params,
     /// Whether people and trees came from point layers (else they were drawn: no source).
     given: [bool; 2],
@@ -55,7 +62,31 @@ impl<'a> Directory<'a> {
                 .collect(),
             params,
             given: [data.people.is_some(), data.trees.is_some()],
+            streets: rstar::RTree::bulk_load(
+                (data.streets.iter().enumerate())
+                    .flat_map(|(i, st)| {
+                        st.line
+                            .0
+                            .windows(2)
+                            .map(move |w| crate::geom::segment::Segment {
+                                a: [w[0].x, w[0].y],
+                                b: [w[1].x, w[1].y],
+                                value: i as f64,
+                            })
+                    })
+                    .collect(),
+            ),
+            street_ids: data.streets.iter().map(|s| s.id.as_str()).collect(),
         }
+    }
+
+    /// The id of the street nearest the middle of a house's frontage.
+    fn street_of(&self, house: &crate::model::PlannedHouse) -> String {
+        let (a, b) = (house.frontage.a, house.frontage.b);
+        let mid = [(a.x + b.x) / 2.0, (a.y + b.y) / 2.0];
+        (self.streets.nearest_neighbor(&mid))
+            .and_then(|s| self.street_ids.get(s.value as usize))
+            .map_or(String::new(), |id| id.to_string())
     }
 
     /// One feature per mesh, in the meshes' order.
@@ -124,8 +155,13 @@ impl<'a> Directory<'a> {
         if let Some(house) = self.houses.get(id) {
             f.mtype = house.mtype.clone();
             f.district = house.district.clone().unwrap_or_default();
+            f.record = Some(house.record);
+            if m.kind.is_building() {
+                f.street = self.street_of(house);
+            }
         }
         if let Some(lot) = self.lots.get(id) {
+            f.record = f.record.or(Some(lot.record));
             f.lot_use = lot.lot_use.name().to_string();
             if f.district.is_empty() {
                 f.district = lot.district.clone().unwrap_or_default();

@@ -9,6 +9,7 @@ pub mod accounting;
 pub mod atlas;
 pub mod atomic;
 pub mod chart;
+pub mod cityjson;
 pub mod crowds;
 pub mod cutout;
 pub mod features;
@@ -71,9 +72,11 @@ pub fn write_listed(out: &Path, path: String, parts: &[&[u8]]) -> std::io::Resul
 /// The registry is the folder's front door: the trait sits in `sink.rs` with nothing of the
 /// formats, each format imports the trait, and only this names the formats (issue 58: the
 /// registry beside the trait made the two import each other).
+/// `hypothesis` is the parameters' fingerprint ([`report::params_id`]) the city model names.
 pub fn sinks(
     output: &crate::params::OutputParams,
     atlas: Option<&atlas::Atlas>,
+    hypothesis: &str,
 ) -> Vec<Box<dyn sink::Sink>> {
     let mut out: Vec<Box<dyn sink::Sink>> = Vec::new();
     for f in &output.formats {
@@ -86,6 +89,7 @@ pub fn sinks(
                 atlas: atlas.cloned(),
                 shared: Default::default(),
             }),
+            "cityjson" => Box::new(cityjson::CityJsonSink::new(hypothesis.to_string())),
             _ => continue,
         };
         if !out.iter().any(|o| o.format() == s.format()) {

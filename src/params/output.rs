@@ -4,8 +4,9 @@
 use serde::{Deserialize, Serialize};
 
 /// The formats a build can write, as `--format` and `output.formats` spell them: two of
-/// tiles, and `gpkg`, the build's decisions as GIS layers (`plan.gpkg`).
-pub const FORMATS: &[&str] = &["obj", "glb", "gpkg"];
+/// tiles, `gpkg`, the build's decisions as GIS layers (`plan.gpkg`), and `cityjson`, the
+/// city as a CityJSON 2.0 model (`city.city.jsonl`).
+pub const FORMATS: &[&str] = &["obj", "glb", "gpkg", "cityjson"];
 
 /// The output's settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -66,9 +67,10 @@ pub fn check_formats(formats: &[String]) -> Result<(), String> {
             "unknown format `{f}`: the formats are {}",
             FORMATS.join(", ")
         )),
-        None if formats.iter().all(|f| f == "gpkg") => {
-            Err("name a tile format (obj or glb) beside gpkg: plan.gpkg describes the tiles".into())
-        }
+        None if formats.iter().all(|f| f == "gpkg") => Err(
+            "name a tile format (obj, glb or cityjson) beside gpkg: plan.gpkg describes the tiles"
+                .into(),
+        ),
         None => Ok(()),
     }
 }

@@ -1,6 +1,7 @@
 //! Helpers shared by the end-to-end tests: run the real binary, re-read what it wrote.
 #![allow(dead_code)]
 
+pub mod cityjson;
 pub mod corpus;
 mod corpus_ledger;
 pub mod designer;

@@ -66,6 +66,14 @@ pub fn input_id(absolute: &std::path::Path) -> String {
     hex[..16].to_string()
 }
 
+/// The fingerprint of a build's parameters as they are published (paths outside the input
+/// by their fingerprints): the hypothesis a city model names, the same for a full build,
+/// its shards and its merge, on any machine.
+pub fn params_id(params: &Params) -> String {
+    let bytes = serde_json::to_vec(&published_params(params)).expect("parameters serialise");
+    crate::output::sha256_hex(&bytes)[..16].to_string()
+}
+
 /// What stands in a published manifest for a parameter's path outside the input.
 pub const UNPUBLISHED: &str = "(not published) ";
 
@@ -209,8 +217,13 @@ pub struct ManifestTile {
     /// Its walkers' clips, `crowds/<id>.csv` (`people.motion = "boids"`, any format).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crowds: Option<ManifestFile>,
-    /// The shared models its GLB draws (`tiles/models/<species>_<k>.bin`, grown trees'
-    /// variants): other tiles list the same files.
+    /// Its CityJSON features, `tiles/<id>.city.jsonl` (format `cityjson`): the lines
+    /// `city.city.jsonl` is made of.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cityjson: Option<ManifestFile>,
+    /// The shared files its files draw: the GLB's grown trees' variants
+    /// (`tiles/models/<species>_<k>.bin`) and CityJSON's geometry templates of them
+    /// (`tiles/templates/<species>_<k>.json`); other tiles list the same files.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub models: Vec<ManifestFile>,
     /// The extent of its content, metres relative to the origin: `[east_min, north_min,
@@ -234,9 +247,15 @@ impl ManifestTile {
 
     /// The files of the tile alone (not the shared models).
     fn own_files(&self) -> impl Iterator<Item = &ManifestFile> {
-        [&self.obj, &self.mtl, &self.glb, &self.crowds]
-            .into_iter()
-            .flatten()
+        [
+            &self.obj,
+            &self.mtl,
+            &self.glb,
+            &self.crowds,
+            &self.cityjson,
+        ]
+        .into_iter()
+        .flatten()
     }
 
     /// Files a sink wrote, each put in its slot by its extension.
@@ -246,7 +265,9 @@ impl ManifestTile {
                 Some("obj") => &mut self.obj,
                 Some("mtl") => &mut self.mtl,
                 Some("csv") => &mut self.crowds,
-                Some("bin") => {
+                Some("jsonl") => &mut self.cityjson,
+                // Shared: a GLB's variant models, CityJSON's geometry templates.
+                Some("bin" | "json") => {
                     self.models.push(f);
                     continue;
                 }

@@ -429,6 +429,9 @@ fn features(
             lot_use: take("use", i),
             source: take("source", i),
             kura: kura.get(i / 8).is_some_and(|b| b >> (i % 8) & 1 == 1),
+            // Not in a GLB's table.
+            record: None,
+            street: String::new(),
         })
         .collect())
 }

@@ -1,0 +1,290 @@
+//! The city as a CityJSON 2.0 model (issue 60): `--format ...,cityjson` writes
+//! `city.city.jsonl`, which CityJSON's official validator (cjval) passes with no error and no
+//! warning, which holds every building the report counts once with its lot, the walls,
+//! gates, ground, streets and gardens, the grown trees as instances of one template per
+//! variant; the same bytes for any thread count, `--tiles`, and shards merged.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use common::cityjson::{objects, read, validate};
+use common::{build_ok, fixture, read_json};
+use serde_json::Value;
+
+const FORMATS: &str = "obj,glb,gpkg,cityjson";
+
+fn assert_valid(path: &Path) -> usize {
+    let v = validate(path);
+    assert!(v.errors.is_empty(), "{}", v.errors.join("\n"));
+    assert!(v.warnings.is_empty(), "{}", v.warnings.join("\n"));
+    v.features
+}
+
+/// The types of a model's city objects, counted.
+fn types(features: &[Value]) -> BTreeMap<String, usize> {
+    let mut out = BTreeMap::new();
+    for (_, o) in objects(features) {
+        *out.entry(o["type"].as_str().unwrap().to_string())
+            .or_default() += 1;
+    }
+    out
+}
+
+#[test]
+fn the_example_town_is_a_valid_city_model_holding_every_building_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let report = build_ok(
+        &fixture("kyoto-small"),
+        &out,
+        &["--quiet", "--format", FORMATS],
+    );
+    let file = out.join("city.city.jsonl");
+    let n = assert_valid(&file);
+    let (header, features) = read(&file);
+    assert_eq!(features.len(), n);
+    assert_eq!(
+        (header["type"].as_str(), header["version"].as_str()),
+        (Some("CityJSON"), Some("2.0"))
+    );
+    assert_eq!(
+        header["transform"]["scale"],
+        serde_json::json!([0.001, 0.001, 0.001])
+    );
+    // The fixture's .prj names JGD2011 zone VI without an AUTHORITY: found by its name.
+    assert_eq!(
+        header["metadata"]["referenceSystem"],
+        "https://www.opengis.net/def/crs/EPSG/0/6674"
+    );
+    let hypothesis = header["metadata"]["identifier"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        hypothesis.starts_with("edo-city/") && hypothesis.ends_with("/seed-1"),
+        "{hypothesis}"
+    );
+
+    // Every building the report counts, once, with its lot.
+    let c = &report["counts"];
+    let halls = (report["halls"].as_array().into_iter().flatten())
+        .filter(|h| h["placed"] == true)
+        .count() as u64;
+    let built = c["machiya"].as_u64().unwrap()
+        + c["footprints"].as_u64().unwrap()
+        + c["kura"].as_u64().unwrap()
+        + halls;
+    let all = objects(&features);
+    let buildings: Vec<&(String, Value)> = all
+        .iter()
+        .filter(|(_, o)| o["type"] == "Building")
+        .collect();
+    assert_eq!(buildings.len() as u64, built, "{c}");
+    let mut ids: Vec<&String> = buildings.iter().map(|(id, _)| id).collect();
+    ids.sort();
+    ids.dedup();
+    assert_eq!(ids.len(), buildings.len(), "each once");
+    for (id, b) in &buildings {
+        let a = &b["attributes"];
+        assert!(a["lot"].is_string(), "{id}: {a}");
+        assert!(a["record"].is_u64(), "{id}: {a}");
+        assert!(a["measuredHeight"].as_f64().unwrap() > 2.0, "{id}: {a}");
+        assert!(a["storeysAboveGround"].as_u64().unwrap() >= 1, "{id}: {a}");
+        assert!(a["roofType"].is_string(), "{id}: {a}");
+        let lods: Vec<&str> = (b["geometry"].as_array().unwrap().iter())
+            .map(|g| g["lod"].as_str().unwrap())
+            .collect();
+        assert_eq!(lods, ["1", "2"], "{id}: an LoD1 block and the LoD2 model");
+    }
+    // A machiya: a closed body (a Solid) with roofs, walls and its ground, its pent roof an
+    // installation; its street named.
+    let (id, house) = buildings
+        .iter()
+        .find(|(id, _)| id.starts_with("machiya_"))
+        .unwrap();
+    let lod2 = &house["geometry"][1];
+    assert_eq!(lod2["type"], "Solid", "{id}");
+    let surfaces: Vec<&str> = (lod2["semantics"]["surfaces"].as_array().unwrap().iter())
+        .map(|s| s["type"].as_str().unwrap())
+        .collect();
+    for s in ["RoofSurface", "WallSurface", "GroundSurface"] {
+        assert!(surfaces.contains(&s), "{id}: {surfaces:?}");
+    }
+    assert!(house["attributes"]["street"].is_string(), "{id}");
+    let children = house["children"].as_array().unwrap();
+    let hisashi = format!("{id}-hisashi");
+    assert!(
+        children.iter().any(|c| c == hisashi.as_str()),
+        "{children:?}"
+    );
+    let (_, inst) = all.iter().find(|(k, _)| *k == hisashi).unwrap();
+    assert_eq!(inst["type"], "BuildingInstallation");
+    assert_eq!(inst["parents"][0], id.as_str());
+
+    // Walls and gates, ground, streets, the temple's rock garden; no people.
+    let t = types(&features);
+    for ty in ["CityFurniture", "LandUse", "Road", "PlantCover"] {
+        assert!(t.contains_key(ty), "{t:?}");
+    }
+    let walls = (all.iter())
+        .filter(|(_, o)| o["attributes"]["function"] == "wall")
+        .count();
+    assert!(walls > 0, "{t:?}");
+    assert!(!all.iter().any(|(id, _)| id.starts_with("people")));
+    // Every building of the file is listed in the manifest's tiles as a fragment.
+    let m = read_json(&out.join("manifest.json"));
+    assert!(m["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|f| f["path"] == "city.city.jsonl"));
+}
+
+#[test]
+fn grown_trees_are_instances_of_one_template_per_variant() {
+    let dir = tempfile::tempdir().unwrap();
+    let town = dir.path().join("town");
+    common::edo_city()
+        .args([
+            "synth",
+            town.to_str().unwrap(),
+            "--lots",
+            "300",
+            "--seed",
+            "5",
+        ])
+        .assert()
+        .success();
+    let params = dir.path().join("trees.toml");
+    std::fs::write(&params, "[trees]\nstyle = \"lsystem\"\nper_ha = 200.0\n").unwrap();
+    let out = dir.path().join("out");
+    let p = params.to_str().unwrap();
+    build_ok(
+        &town,
+        &out,
+        &["--quiet", "--params", p, "--format", FORMATS],
+    );
+    let file = out.join("city.city.jsonl");
+    assert_valid(&file);
+    let (header, features) = read(&file);
+    let templates = header["geometry-templates"]["templates"]
+        .as_array()
+        .unwrap();
+    assert!(templates.len() > 1, "{}", templates.len());
+    let trees: Vec<Value> = (objects(&features).into_iter())
+        .filter(|(_, o)| o["type"] == "SolitaryVegetationObject")
+        .map(|(_, o)| o)
+        .filter(|o| o["geometry"][0]["type"] == "GeometryInstance")
+        .collect();
+    assert!(trees.len() > 10, "{}", trees.len());
+    let mut used = std::collections::BTreeSet::new();
+    for t in &trees {
+        let k = t["geometry"][0]["template"].as_u64().unwrap() as usize;
+        assert!(k < templates.len());
+        used.insert(k);
+        assert!(t["attributes"]["species"].is_string());
+    }
+    assert_eq!(used.len(), templates.len(), "every template drawn");
+}
+
+/// Builds `town` into `out` with `extra` flags, the model's formats and parameters `p`.
+fn build(town: &Path, out: &Path, p: &str, extra: &[&str]) {
+    let mut args = vec!["--quiet", "--params", p, "--format", FORMATS];
+    args.extend(extra);
+    common::run_ok(town, out, &args);
+}
+
+#[test]
+fn the_model_is_the_same_bytes_for_any_thread_count_single_tiles_and_merged_shards() {
+    let dir = tempfile::tempdir().unwrap();
+    let town = dir.path().join("town");
+    common::edo_city()
+        .args([
+            "synth",
+            town.to_str().unwrap(),
+            "--lots",
+            "300",
+            "--seed",
+            "5",
+        ])
+        .assert()
+        .success();
+    let params = dir.path().join("trees.toml");
+    std::fs::write(&params, "[trees]\nstyle = \"lsystem\"\nper_ha = 200.0\n").unwrap();
+    let p = params.to_str().unwrap();
+    let (one, two) = (dir.path().join("j1"), dir.path().join("j2"));
+    build(&town, &one, p, &["-j", "1"]);
+    build(&town, &two, p, &["-j", "2"]);
+    let model = |d: &Path| std::fs::read(d.join("city.city.jsonl")).unwrap();
+    assert_eq!(model(&one), model(&two));
+    // One tile again, its fragment and a template gone: the same file.
+    let m = read_json(&two.join("manifest.json"));
+    let tile = &m["tiles"][0];
+    std::fs::remove_file(two.join(tile["cityjson"]["path"].as_str().unwrap())).unwrap();
+    if let Some(t) = (tile["models"].as_array().into_iter().flatten())
+        .find(|f| f["path"].as_str().unwrap().starts_with("tiles/templates/"))
+    {
+        std::fs::remove_file(two.join(t["path"].as_str().unwrap())).unwrap();
+    }
+    build(&town, &two, p, &["--tiles", tile["id"].as_str().unwrap()]);
+    assert_eq!(model(&one), model(&two));
+    // Shards in two directories, merged.
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    build(&town, &a, p, &["--shard", "1/2"]);
+    build(&town, &b, p, &["--shard", "2/2"]);
+    common::edo_city()
+        .arg("merge")
+        .arg(&a)
+        .arg(&b)
+        .assert()
+        .success();
+    assert_eq!(model(&one), model(&a));
+}
+
+/// The real sets (their cut in a clone without ../shared) validate too.
+#[test]
+fn real_towns_are_valid_city_models() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (set, example) in [
+        ("chino_plateau_devpermit", "chino"),
+        ("osaka_plateau", "osaka"),
+    ] {
+        let full = repo.join("../shared/data/real").join(set);
+        let dir = match full.is_dir() {
+            true => full,
+            false => repo.join("fixtures/real").join(set),
+        };
+        let work = tempfile::tempdir().unwrap();
+        let params = repo.join("params/examples").join(format!("{example}.toml"));
+        let out = work.path().join("out");
+        let report = build_ok(
+            &dir,
+            &out,
+            &[
+                "--quiet",
+                "--params",
+                params.to_str().unwrap(),
+                "--format",
+                "obj,cityjson",
+            ],
+        );
+        let file = out.join("city.city.jsonl");
+        assert_valid(&file);
+        let (_, features) = read(&file);
+        let buildings = types(&features).get("Building").copied().unwrap_or(0) as u64;
+        let c = &report["counts"];
+        let landmarks = report["landmarks"]["placed"]
+            .as_array()
+            .map_or(0, |p| p.len()) as u64;
+        assert_eq!(
+            buildings,
+            c["machiya"].as_u64().unwrap()
+                + c["footprints"].as_u64().unwrap()
+                + c["kura"].as_u64().unwrap()
+                + landmarks,
+            "{set}: {c}"
+        );
+    }
+}
