@@ -209,7 +209,10 @@ mod tests {
                     .map(|(_, v)| std::ffi::OsString::from(v))
             }
         };
-        assert_eq!(dir_from(env(&[("EDO_CITY_CACHE", "off"), ("HOME", "/h")])), None);
+        assert_eq!(
+            dir_from(env(&[("EDO_CITY_CACHE", "off"), ("HOME", "/h")])),
+            None
+        );
         assert_eq!(dir_from(env(&[("EDO_CITY_CACHE", "")])), None);
         let given = dir_from(env(&[("EDO_CITY_CACHE", "/c"), ("HOME", "/h")]));
         assert_eq!(given, Some(PathBuf::from("/c")));
