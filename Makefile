@@ -2,16 +2,16 @@
 
 CARGO ?= cargo
 
-.PHONY: run test test-cluster test-future lint bench crowd-fd real real-cut textures fixtures clean pictures bad-input viewer-deps gis-deps blender-deps
+.PHONY: cityjson-deps run test test-cluster test-future lint bench crowd-fd real real-cut textures fixtures clean pictures bad-input viewer-deps gis-deps blender-deps
 
 ## Build the tool and the city of the bundled example data into out/.
 run:
 	$(CARGO) run --release -- build fixtures/kyoto-small --out out
 
 ## Unit, property, end-to-end and doc tests; the glTF validator and the browser test need
-## the viewer's npm packages, the GeoPackage tests GDAL, the crowd's clip Blender (each
-## installed first when missing).
-test: viewer-deps gis-deps blender-deps
+## the viewer's npm packages, the GeoPackage tests GDAL, the crowd's clip Blender, the city
+## model's test cjio (each installed first when missing).
+test: viewer-deps gis-deps blender-deps cityjson-deps
 	$(CARGO) test --all-targets
 	$(CARGO) test --doc
 
@@ -19,6 +19,10 @@ test: viewer-deps gis-deps blender-deps
 ## exactly as viewer/package-lock.json pins them, and Debian's chromium for the browser test.
 viewer-deps:
 	bash scripts/viewer-deps.sh
+
+## cjio (PyPI) in target/cjio-venv, with which tests/cityjson.rs reads the city model.
+cityjson-deps:
+	bash scripts/cityjson-deps.sh
 
 ## Debian's blender, whose glTF importer tests/crowd_clip.rs runs on the walkers' clip.
 blender-deps:

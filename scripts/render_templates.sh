@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Renders every shipped template alone into docs/templates/<name>.png, and a street of the
 # example city with its people into docs/people.png (run `make pictures`).
-# Needs f3d and xvfb-run (Debian: apt install f3d xvfb); the pictures are committed.
+# Needs f3d and xvfb-run (Debian: apt install f3d xvfb) and Blender (make blender-deps);
+# the pictures are committed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${CARGO_TARGET_DIR:-target}/release/edo-city
@@ -39,3 +40,10 @@ xvfb-run -a f3d "$work/city/tiles/1108_760.obj" --output docs/people.png \
     --resolution 960,600 --camera-position=131,3,-185 --camera-focal-point=133,1.5,-205 \
     --camera-view-up=0,1,0 --grid=0 --bg-color=0.7,0.8,0.9 >/dev/null 2>&1
 echo docs/people.png
+
+# The example city as a CityJSON model, coloured by what the model says each surface is
+# (docs/cityjson.md); Blender in the background (make blender-deps).
+"$bin" build fixtures/kyoto-small --out "$work/model" --no-plan --format cityjson >/dev/null
+blender -b --python scripts/cityjson_picture.py -- "$work/model/city.city.jsonl" \
+    "$PWD/docs/pictures/cityjson.png" >/dev/null 2>&1
+echo docs/pictures/cityjson.png

@@ -133,13 +133,37 @@ fn the_example_town_is_a_valid_city_model_holding_every_building_once() {
         .count();
     assert!(walls > 0, "{t:?}");
     assert!(!all.iter().any(|(id, _)| id.starts_with("people")));
-    // Every building of the file is listed in the manifest's tiles as a fragment.
     let m = read_json(&out.join("manifest.json"));
-    assert!(m["files"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .any(|f| f["path"] == "city.city.jsonl"));
+    let listed = m["files"].as_array().unwrap();
+    assert!(listed.iter().any(|f| f["path"] == "city.city.jsonl"));
+
+    // cjio, a client of the format, reads it: its info gives the buildings the report counts
+    // and the CRS.
+    let info = cjio_info(&file);
+    assert!(info.contains(&format!("Building ({built})")), "{info}");
+    assert!(info.contains("EPSG = 6674"), "{info}");
+    assert!(info.contains("CityJSON version = 2.0"), "{info}");
+}
+
+/// `cjio stdin info` of a CityJSONSeq (cjio in target/cjio-venv: `make cityjson-deps`).
+fn cjio_info(file: &Path) -> String {
+    let target = std::env::var("CARGO_TARGET_DIR").map_or_else(
+        |_| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"),
+        std::path::PathBuf::from,
+    );
+    let cjio = target.join("cjio-venv/bin/cjio");
+    assert!(
+        cjio.exists(),
+        "{} is missing: run `make cityjson-deps`",
+        cjio.display()
+    );
+    let o = std::process::Command::new(cjio)
+        .args(["stdin", "info"])
+        .stdin(std::fs::File::open(file).unwrap())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
 #[test]

@@ -6,18 +6,18 @@
 //! from the output frame (x east, y up, z south) to east, north, up. The header's
 //! `transform` (scale 0.001, translate the origin) makes them map metres again, exactly.
 
-use std::collections::HashMap;
-
 use geo::ConvexHull;
-use serde_json::{json, Value};
+
+use super::text;
 
 use crate::generate::mesh::{Face, Mesh};
 
-/// The vertices of one feature, each once.
+/// The vertices of one feature, each once (hashed with foldhash: the std map's SipHash was
+/// a twentieth of a model's time).
 #[derive(Default)]
 pub struct Vertices {
     list: Vec<[i64; 3]>,
-    index: HashMap<[i64; 3], u32>,
+    index: std::collections::HashMap<[i64; 3], u32, foldhash::fast::FixedState>,
 }
 
 impl Vertices {
@@ -30,9 +30,16 @@ impl Vertices {
         })
     }
 
-    /// The list, as CityJSON writes it.
-    pub fn json(&self) -> Value {
-        json!(self.list)
+    /// Writes the list, as CityJSON has it: `[[x,y,z],...]`.
+    pub fn write(&self, out: &mut String) {
+        out.push('[');
+        for (i, v) in self.list.iter().enumerate() {
+            if i > 0 {
+                out.push(',');
+            }
+            text::vertex(out, *v);
+        }
+        out.push(']');
     }
 }
 
@@ -142,20 +149,20 @@ pub fn classify(points: &[[i64; 3]], ground: i64, top: i64) -> Semantic {
     }
 }
 
-/// A geometry object of `lod` from `surfaces`: a `Solid` of one shell when `solid`, else a
-/// `MultiSurface`; with its semantics and its materials (`materials` numbers them locally:
-/// the library id of each local index).
+/// Writes a geometry object of `lod` from `surfaces`: a `Solid` of one shell when `solid`,
+/// else a `MultiSurface`; with its semantics (when `with_semantics`) and its materials
+/// (`materials` numbers them locally: the library id of each local index).
 pub fn geometry(
+    out: &mut String,
     surfaces: &[Surface],
     lod: &str,
     solid: bool,
     materials: &mut Vec<u16>,
     with_semantics: bool,
-) -> Value {
+) {
     let mut kinds: Vec<Semantic> = surfaces.iter().map(|s| s.semantic).collect();
     kinds.sort_unstable();
     kinds.dedup();
-    let boundaries: Vec<Value> = surfaces.iter().map(|s| json!([s.ring])).collect();
     let sem: Vec<usize> = (surfaces.iter())
         .map(|s| kinds.binary_search(&s.semantic).unwrap_or(0))
         .collect();
@@ -168,32 +175,71 @@ pub fn geometry(
             }
         })
         .collect();
-    let (ty, boundaries, sem, mat) = match solid {
-        true => ("Solid", json!([boundaries]), json!([sem]), json!([mat])),
-        false => ("MultiSurface", json!(boundaries), json!(sem), json!(mat)),
-    };
-    let mut g = json!({
-        "type": ty,
-        "lod": lod,
-        "boundaries": boundaries,
-        "material": {"visual": {"values": mat}},
-    });
-    if with_semantics {
-        g["semantics"] = json!({
-            "surfaces": kinds.iter().map(|k| json!({"type": k.name()})).collect::<Vec<_>>(),
-            "values": sem,
-        });
+    // A solid's arrays are one level deeper: its one shell.
+    let (open, close) = if solid { ("[", "]") } else { ("", "") };
+    out.push('{');
+    text::key(out, "boundaries");
+    out.push_str(open);
+    out.push('[');
+    for (i, s) in surfaces.iter().enumerate() {
+        if i > 0 {
+            out.push(',');
+        }
+        out.push('[');
+        text::ints(out, &s.ring);
+        out.push(']');
     }
-    g
+    out.push(']');
+    out.push_str(close);
+    out.push(',');
+    text::key(out, "lod");
+    text::string(out, lod);
+    out.push(',');
+    text::key(out, "material");
+    out.push_str("{\"visual\":{\"values\":");
+    out.push_str(open);
+    text::ints(out, &mat);
+    out.push_str(close);
+    out.push_str("}}");
+    if with_semantics {
+        out.push(',');
+        text::key(out, "semantics");
+        out.push('{');
+        text::key(out, "surfaces");
+        out.push('[');
+        for (i, k) in kinds.iter().enumerate() {
+            if i > 0 {
+                out.push(',');
+            }
+            out.push_str("{\"type\":\"");
+            out.push_str(k.name());
+            out.push_str("\"}");
+        }
+        out.push_str("],");
+        text::key(out, "values");
+        out.push_str(open);
+        text::ints(out, &sem);
+        out.push_str(close);
+        out.push('}');
+    }
+    out.push(',');
+    text::key(out, "type");
+    text::string(out, if solid { "Solid" } else { "MultiSurface" });
+    out.push('}');
 }
 
-/// The LoD1 block of a building: the convex hull of its vertices seen from above, from its
-/// lowest to its highest point, as a Solid (walls, roof, ground with their semantics).
-pub fn block(points: &[[i64; 3]], vertices: &mut Vertices) -> Option<Value> {
-    let z0 = points.iter().map(|p| p[2]).min()?;
-    let z1 = points.iter().map(|p| p[2]).max()?;
+/// Writes the LoD1 block of a building: the convex hull of its vertices seen from above,
+/// from its lowest to its highest point, as a Solid (walls, roof, ground with their
+/// semantics); false when there is none (a flat or empty building).
+pub fn block(out: &mut String, points: &[[i64; 3]], vertices: &mut Vertices) -> bool {
+    let (Some(z0), Some(z1)) = (
+        points.iter().map(|p| p[2]).min(),
+        points.iter().map(|p| p[2]).max(),
+    ) else {
+        return false;
+    };
     if z1 <= z0 {
-        return None;
+        return false;
     }
     let cloud: geo_types::MultiPoint<f64> = points
         .iter()
@@ -211,7 +257,7 @@ pub fn block(points: &[[i64; 3]], vertices: &mut Vertices) -> Option<Value> {
     ring.pop();
     ring.dedup();
     if ring.len() < 3 {
-        return None;
+        return false;
     }
     let low: Vec<u32> = ring
         .iter()
@@ -221,27 +267,31 @@ pub fn block(points: &[[i64; 3]], vertices: &mut Vertices) -> Option<Value> {
         .iter()
         .map(|p| vertices.add([p[0], p[1], z1]))
         .collect();
-    let mut shell = Vec::new();
-    let mut sem = Vec::new();
     // The ground faces down: its ring clockwise seen from above.
-    shell.push(json!([low.iter().rev().copied().collect::<Vec<_>>()]));
-    sem.push(2);
-    shell.push(json!([high.clone()]));
-    sem.push(0);
+    let ground: Vec<u32> = low.iter().rev().copied().collect();
+    let mut shell = vec![ground, high.clone()];
+    let mut sem = vec![2u8, 0];
     for i in 0..ring.len() {
         let j = (i + 1) % ring.len();
-        shell.push(json!([[low[i], low[j], high[j], high[i]]]));
+        shell.push(vec![low[i], low[j], high[j], high[i]]);
         sem.push(1);
     }
-    Some(json!({
-        "type": "Solid",
-        "lod": "1",
-        "boundaries": [shell],
-        "semantics": {
-            "surfaces": [{"type": "RoofSurface"}, {"type": "WallSurface"}, {"type": "GroundSurface"}],
-            "values": [sem],
-        },
-    }))
+    out.push_str("{\"boundaries\":[[");
+    for (i, r) in shell.iter().enumerate() {
+        if i > 0 {
+            out.push(',');
+        }
+        out.push('[');
+        text::ints(out, r);
+        out.push(']');
+    }
+    out.push_str(
+        "]],\"lod\":\"1\",\"semantics\":{\"surfaces\":[{\"type\":\"RoofSurface\"},\
+                  {\"type\":\"WallSurface\"},{\"type\":\"GroundSurface\"}],\"values\":[",
+    );
+    text::ints(out, &sem);
+    out.push_str("]},\"type\":\"Solid\"}");
+    true
 }
 
 #[cfg(test)]
@@ -284,7 +334,9 @@ mod tests {
             [2000, 1000, 1000],
         ];
         let mut v = Vertices::default();
-        let g = block(&pts, &mut v).unwrap();
+        let mut text = String::new();
+        assert!(block(&mut text, &pts, &mut v));
+        let g: serde_json::Value = serde_json::from_str(&text).unwrap();
         let shell = g["boundaries"][0].as_array().unwrap();
         assert_eq!(shell.len(), 2 + 4, "ground, roof and four walls");
         assert_eq!(v.list.len(), 8);

@@ -26,6 +26,7 @@ use super::sink::{Sink, TileContent, TileFiles};
 
 mod geometry;
 mod objects;
+mod text;
 
 /// The model's file, in the output directory.
 pub const FILE: &str = "city.city.jsonl";
@@ -56,18 +57,14 @@ impl Sink for CityJsonSink {
             palette: tile.palette,
         };
         let mut text = String::new();
-        let mut line = |v: Value| {
-            text.push_str(&v.to_string());
-            text.push('\n');
-        };
         let instanced = !tile.instanced.is_empty();
         for (mesh, f) in tile.meshes.iter().zip(tile.features) {
             // Grown trees come one by one, from their variant's template.
             if instanced && mesh.kind == crate::model::object::ObjectKind::GrownTrees {
                 continue;
             }
-            if let Some(v) = objects::feature(mesh, f, &cx) {
-                line(v);
+            if objects::feature(&mut text, mesh, f, &cx) {
+                text.push('\n');
             }
         }
         let mut files = Vec::new();
@@ -76,13 +73,9 @@ impl Sink for CityJsonSink {
             let template = self.template(out, &g.model)?;
             for tree in &g.trees {
                 let f = rows.next().cloned().unwrap_or_default();
-                line(tree_feature(
-                    tree,
-                    &g.model.name,
-                    &f,
-                    tile.origin,
-                    &self.hypothesis,
-                ));
+                let v = tree_feature(tree, &g.model.name, &f, tile.origin, &self.hypothesis);
+                text.push_str(&v.to_string());
+                text.push('\n');
             }
             if let Some(t) = template {
                 if !files.contains(&t) {
@@ -147,9 +140,11 @@ fn template_json(model: &crate::generate::mesh::Mesh) -> Value {
     let mut vertices = geometry::Vertices::default();
     let s = geometry::surfaces(model, &model.faces, 0, &mut vertices);
     let boundaries: Vec<Value> = s.iter().map(|s| json!([s.ring])).collect();
+    let mut points = String::new();
+    vertices.write(&mut points);
     json!({
         "geometry": {"type": "MultiSurface", "lod": "2", "boundaries": boundaries},
-        "vertices": vertices.json(),
+        "vertices": serde_json::from_str::<Value>(&points).expect("vertices are JSON"),
     })
 }
 

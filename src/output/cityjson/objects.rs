@@ -1,13 +1,16 @@
-//! Each object of a tile as a CityJSONFeature: houses, kura, halls and landmarks as
+//! Each object of a tile as a CityJSONFeature line: houses, kura, halls and landmarks as
 //! `Building`s (an LoD1 block and the LoD2 model with semantic surfaces; the parts the
 //! template calls installations as `BuildingInstallation` children), walls and gates as
 //! `CityFurniture`, rock gardens as `PlantCover` with their stones as `CityFurniture`, trees
 //! as `SolitaryVegetationObject`s, the ground as `LandUse`, the streets as `Road`, a DEM's
 //! terrain as `TINRelief`. People are left out: a city model holds what stands.
 
+use std::collections::BTreeMap;
+
 use serde_json::{json, Map, Value};
 
-use super::geometry::{block, geometry, surfaces, Surface, Vertices};
+use super::geometry::{block, east_north_up, geometry, surfaces, Surface, Vertices};
+use super::text;
 use crate::generate::mesh::{open_edges_of, Mesh};
 use crate::model::object::ObjectKind;
 use crate::output::features::Feature;
@@ -23,14 +26,15 @@ pub struct Context<'a> {
     pub palette: Palette<'a>,
 }
 
-/// The CityJSONFeature of one object, or `None` for what a city model leaves out.
-pub fn feature(mesh: &Mesh, f: &Feature, cx: &Context) -> Option<Value> {
+/// Writes the CityJSONFeature line of one object into `out` (without its newline); false
+/// for what a city model leaves out.
+pub fn feature(out: &mut String, mesh: &Mesh, f: &Feature, cx: &Context) -> bool {
     if mesh.faces.is_empty() {
-        return None;
+        return false;
     }
     match mesh.kind {
-        k if k.is_building() => Some(building(mesh, f, cx)),
-        ObjectKind::People | ObjectKind::Walkers | ObjectKind::Other => None,
+        k if k.is_building() => building(out, mesh, f, cx),
+        ObjectKind::People | ObjectKind::Walkers | ObjectKind::Other => return false,
         kind => {
             let (ty, function) = match kind {
                 ObjectKind::Fence => ("CityFurniture", Some("wall")),
@@ -42,15 +46,16 @@ pub fn feature(mesh: &Mesh, f: &Feature, cx: &Context) -> Option<Value> {
                 ObjectKind::Streets => ("Road", None),
                 _ => ("TINRelief", None),
             };
-            Some(other(mesh, f, cx, ty, function))
+            other(out, mesh, f, cx, ty, function);
         }
     }
+    true
 }
 
 /// A building: its body (the parts its template does not call installations) as LoD2, a
 /// `Solid` when it is one closed part, else a `MultiSurface`; its LoD1 block; each
 /// installation a child.
-fn building(mesh: &Mesh, f: &Feature, cx: &Context) -> Value {
+fn building(out: &mut String, mesh: &Mesh, f: &Feature, cx: &Context) {
     let facts = mesh.building.clone().unwrap_or_default();
     let ground = (facts.ground * 1000.0).round() as i64;
     let mut vertices = Vertices::default();
@@ -63,7 +68,7 @@ fn building(mesh: &Mesh, f: &Feature, cx: &Context) -> Value {
         let faces = &mesh.faces[start..end];
         points.extend(
             (faces.iter().flat_map(|fc| fc.corners.iter()))
-                .map(|&(p, _)| super::geometry::east_north_up(mesh.positions[p as usize])),
+                .map(|&(p, _)| east_north_up(mesh.positions[p as usize])),
         );
         body_surfaces.extend(surfaces(mesh, faces, ground, &mut vertices));
     }
@@ -71,20 +76,29 @@ fn building(mesh: &Mesh, f: &Feature, cx: &Context) -> Value {
         [(start, end, _)] => open_edges_of(&mesh.faces[*start..*end]).is_empty(),
         _ => false,
     };
-    let id = mesh.name.clone();
-    let mut geometries = Vec::new();
-    if let Some(lod1) = block(&points, &mut vertices) {
-        geometries.push(lod1);
+    let id = mesh.name.as_str();
+    // The building's own object: its geometries first (they number the vertices).
+    let mut geometries = String::from("[");
+    if block(&mut geometries, &points, &mut vertices) && !body_surfaces.is_empty() {
+        geometries.push(',');
     }
     if !body_surfaces.is_empty() {
-        geometries.push(geometry(&body_surfaces, "2", closed, &mut materials, true));
+        geometry(
+            &mut geometries,
+            &body_surfaces,
+            "2",
+            closed,
+            &mut materials,
+            true,
+        );
     }
+    geometries.push(']');
     let top = points.iter().map(|p| p[2]).max().unwrap_or(ground);
     let mut attributes = base_attributes(f, cx);
     let mut put = |k: &str, v: Value| {
         attributes.insert(k.to_string(), v);
     };
-    put("measuredHeight", json!(round_mm(top - ground)));
+    put("measuredHeight", json!((top - ground) as f64 / 1000.0));
     if let Some(n) = facts.storeys {
         put("storeysAboveGround", json!(n));
     }
@@ -97,7 +111,8 @@ fn building(mesh: &Mesh, f: &Feature, cx: &Context) -> Value {
     if !f.street.is_empty() {
         put("street", json!(f.street));
     }
-    let mut objects = Map::new();
+    // Its installations, each a child.
+    let mut objects: BTreeMap<String, String> = BTreeMap::new();
     let mut children = Vec::new();
     for &(start, end, _) in parts.iter().filter(|p| p.2) {
         let name = part_name(mesh, start);
@@ -106,31 +121,38 @@ fn building(mesh: &Mesh, f: &Feature, cx: &Context) -> Value {
             continue;
         }
         let child = format!("{id}-{name}");
-        objects.insert(
-            child.clone(),
-            json!({
-                "type": "BuildingInstallation",
-                "parents": [id],
-                "attributes": {"part": name},
-                "geometry": [geometry(&s, "2", false, &mut materials, true)],
-            }),
-        );
+        let mut o = String::from("{\"attributes\":");
+        o.push_str(&json!({ "part": name }).to_string());
+        o.push_str(",\"geometry\":[");
+        geometry(&mut o, &s, "2", false, &mut materials, true);
+        o.push_str("],\"parents\":");
+        o.push_str(&json!([id]).to_string());
+        o.push_str(",\"type\":\"BuildingInstallation\"}");
+        objects.insert(child.clone(), o);
         children.push(child);
     }
-    let mut me = json!({
-        "type": "Building",
-        "attributes": attributes,
-        "geometry": geometries,
-    });
+    let mut me = String::from("{\"attributes\":");
+    me.push_str(&Value::Object(attributes).to_string());
     if !children.is_empty() {
-        me["children"] = json!(children);
+        me.push_str(",\"children\":");
+        me.push_str(&json!(children).to_string());
     }
-    objects.insert(id.clone(), me);
-    wrap(id, objects, &vertices, &materials, cx)
+    me.push_str(",\"geometry\":");
+    me.push_str(&geometries);
+    me.push_str(",\"type\":\"Building\"}");
+    objects.insert(id.to_string(), me);
+    wrap(out, id, &objects, &vertices, &materials, cx);
 }
 
 /// An object that is not a building: one geometry of all its faces, without semantics.
-fn other(mesh: &Mesh, f: &Feature, cx: &Context, ty: &str, function: Option<&str>) -> Value {
+fn other(
+    out: &mut String,
+    mesh: &Mesh,
+    f: &Feature,
+    cx: &Context,
+    ty: &str,
+    function: Option<&str>,
+) {
     let mut vertices = Vertices::default();
     let mut materials = Vec::new();
     let s = surfaces(mesh, &mesh.faces, 0, &mut vertices);
@@ -139,21 +161,32 @@ fn other(mesh: &Mesh, f: &Feature, cx: &Context, ty: &str, function: Option<&str
     if let Some(function) = function {
         attributes.insert("function".into(), json!(function));
     }
-    let g = match ty {
-        // A relief is a composite surface of its triangles.
-        "TINRelief" => {
-            let mut g = geometry(&s, "1", false, &mut materials, false);
-            g["type"] = json!("CompositeSurface");
-            g
-        }
-        _ => geometry(&s, "2", false, &mut materials, false),
-    };
-    let mut objects = Map::new();
-    objects.insert(
-        id.clone(),
-        json!({"type": ty, "attributes": attributes, "geometry": [g]}),
+    let mut g = String::new();
+    // A relief is a composite surface of its triangles.
+    let relief = ty == "TINRelief";
+    geometry(
+        &mut g,
+        &s,
+        if relief { "1" } else { "2" },
+        false,
+        &mut materials,
+        false,
     );
-    wrap(id, objects, &vertices, &materials, cx)
+    if relief {
+        g = g.replace(
+            "\"type\":\"MultiSurface\"}",
+            "\"type\":\"CompositeSurface\"}",
+        );
+    }
+    let mut o = String::from("{\"attributes\":");
+    o.push_str(&Value::Object(attributes).to_string());
+    o.push_str(",\"geometry\":[");
+    o.push_str(&g);
+    o.push_str("],\"type\":");
+    text::string(&mut o, ty);
+    o.push('}');
+    let objects: BTreeMap<String, String> = [(id.clone(), o)].into_iter().collect();
+    wrap(out, &id, &objects, &vertices, &materials, cx);
 }
 
 /// The attributes every object carries: its kind, lot and record, lot use, district, the
@@ -180,34 +213,45 @@ fn base_attributes(f: &Feature, cx: &Context) -> Map<String, Value> {
     a
 }
 
-/// A feature line's object: its city objects, its own vertices and the materials its
-/// geometries number (their names and colours).
-pub fn wrap(
-    id: String,
-    objects: Map<String, Value>,
+/// Writes a feature line: its city objects (each's JSON text, by id), its own vertices and
+/// the materials its geometries number (their names and colours). Keys in serde_json's
+/// order.
+fn wrap(
+    out: &mut String,
+    id: &str,
+    objects: &BTreeMap<String, String>,
     vertices: &Vertices,
     materials: &[u16],
     cx: &Context,
-) -> Value {
-    let mut v = json!({
-        "type": "CityJSONFeature",
-        "id": id,
-        "CityObjects": objects,
-        "vertices": vertices.json(),
-    });
+) {
+    out.push_str("{\"CityObjects\":{");
+    for (i, (k, o)) in objects.iter().enumerate() {
+        if i > 0 {
+            out.push(',');
+        }
+        text::string(out, k);
+        out.push(':');
+        out.push_str(o);
+    }
+    out.push('}');
     if !materials.is_empty() {
         let list: Vec<Value> = (materials.iter())
             .map(|&m| {
                 let e = cx.palette.get(m);
                 json!({
-                    "name": e.name,
                     "diffuseColor": e.kd.map(|c| round_colour(c as f64)),
+                    "name": e.name,
                 })
             })
             .collect();
-        v["appearance"] = json!({"materials": list});
+        out.push_str(",\"appearance\":");
+        out.push_str(&json!({ "materials": list }).to_string());
     }
-    v
+    out.push_str(",\"id\":");
+    text::string(out, id);
+    out.push_str(",\"type\":\"CityJSONFeature\",\"vertices\":");
+    vertices.write(out);
+    out.push('}');
 }
 
 /// Each part's faces as (first, end, installation); a mesh without parts (a landmark's
@@ -236,11 +280,6 @@ fn part_name(mesh: &Mesh, start: usize) -> &str {
     (mesh.parts.iter())
         .find(|p| p.first_face as usize == start)
         .map_or("part", |p| p.name.as_str())
-}
-
-/// Millimetres as metres, to the millimetre.
-fn round_mm(mm: i64) -> f64 {
-    mm as f64 / 1000.0
 }
 
 /// A colour channel to three decimals (the library's colours are given so).
