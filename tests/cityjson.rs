@@ -213,6 +213,75 @@ fn grown_trees_are_instances_of_one_template_per_variant() {
     assert_eq!(used.len(), templates.len(), "every template drawn");
 }
 
+/// `[output] cityjson_textures = true`: textured surfaces name the library's images (files
+/// the build wrote) with a coordinate for each corner; the model stays valid; without it, no
+/// texture is named.
+#[test]
+fn textures_are_named_when_asked_and_valid() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = dir.path().join("textures.toml");
+    std::fs::write(&params, "[output]\ncityjson_textures = true\n").unwrap();
+    let out = dir.path().join("out");
+    let p = params.to_str().unwrap();
+    let args = ["--quiet", "--params", p, "--format", "cityjson"];
+    build_ok(&fixture("kyoto-small"), &out, &args);
+    let file = out.join("city.city.jsonl");
+    assert_valid(&file);
+    let (_, features) = read(&file);
+    let mut textured = 0;
+    for f in &features {
+        let Some(images) = f["appearance"]["textures"].as_array() else {
+            continue;
+        };
+        let uvs = f["appearance"]["vertices-texture"].as_array().unwrap();
+        for t in images {
+            let image = t["image"].as_str().unwrap();
+            assert!(image.starts_with("tiles/textures/"), "{image}");
+            assert!(out.join(image).is_file(), "{image} is written");
+        }
+        for (_, o) in f["CityObjects"].as_object().unwrap() {
+            for g in o["geometry"].as_array().into_iter().flatten() {
+                let Some(values) = g["texture"]["visual"]["values"].as_array() else {
+                    continue;
+                };
+                // A solid's surfaces are one shell deeper.
+                let surfaces = match g["type"].as_str() {
+                    Some("Solid") => values[0].as_array().unwrap(),
+                    _ => values,
+                };
+                let rings = match g["type"].as_str() {
+                    Some("Solid") => g["boundaries"][0].as_array().unwrap(),
+                    _ => g["boundaries"].as_array().unwrap(),
+                };
+                assert_eq!(surfaces.len(), rings.len());
+                for (s, r) in surfaces.iter().zip(rings) {
+                    let ring = s[0].as_array().unwrap();
+                    if ring[0].is_null() {
+                        continue;
+                    }
+                    textured += 1;
+                    assert!((ring[0].as_u64().unwrap() as usize) < images.len());
+                    assert_eq!(ring.len() - 1, r[0].as_array().unwrap().len());
+                    assert!(ring[1..]
+                        .iter()
+                        .all(|k| (k.as_u64().unwrap() as usize) < uvs.len()));
+                }
+            }
+        }
+    }
+    assert!(textured > 1000, "{textured} textured surfaces");
+    // The same town without it: colours only (and the same as before the key existed).
+    let plain = dir.path().join("plain");
+    build_ok(
+        &fixture("kyoto-small"),
+        &plain,
+        &["--quiet", "--format", "cityjson"],
+    );
+    let text = std::fs::read_to_string(plain.join("city.city.jsonl")).unwrap();
+    assert!(!text.contains("\"texture\""));
+    assert!(text.contains("\"diffuseColor\""));
+}
+
 /// Builds `town` into `out` with `extra` flags, the model's formats and parameters `p`.
 fn build(town: &Path, out: &Path, p: &str, extra: &[&str]) {
     let mut args = vec!["--quiet", "--params", p, "--format", FORMATS];

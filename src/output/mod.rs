@@ -89,7 +89,10 @@ pub fn sinks(
                 atlas: atlas.cloned(),
                 shared: Default::default(),
             }),
-            "cityjson" => Box::new(cityjson::CityJsonSink::new(hypothesis.to_string())),
+            "cityjson" => Box::new(cityjson::CityJsonSink::new(
+                hypothesis.to_string(),
+                output.cityjson_textures,
+            )),
             _ => continue,
         };
         if !out.iter().any(|o| o.format() == s.format()) {

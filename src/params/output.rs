@@ -25,6 +25,12 @@ pub struct OutputParams {
     /// without a decoder, such as Blender's importer and the Khronos validator).
     #[serde(default = "meshopt")]
     pub glb_compression: String,
+    /// The city model's surfaces name their textures (the library's PNGs in
+    /// `tiles/textures/`, with each corner's texture coordinates), for clients that draw
+    /// CityJSON textures; off, surfaces carry their materials' colours only. Left out of a
+    /// published manifest when off, so builds without it keep their fingerprint.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub cityjson_textures: bool,
 }
 
 fn each() -> String {
@@ -101,5 +107,6 @@ pub(super) mod partial {
         formats: Option<Vec<String>>,
         obj_objects: Option<String>,
         glb_compression: Option<String>,
+        cityjson_textures: Option<bool>,
     }
 }

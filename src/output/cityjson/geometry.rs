@@ -8,6 +8,7 @@
 
 use geo::ConvexHull;
 
+use super::appearance::Appearance;
 use super::text;
 
 use crate::generate::mesh::{Face, Mesh};
@@ -81,6 +82,8 @@ impl Semantic {
 pub struct Surface {
     /// The exterior ring, counter-clockwise seen from outside.
     pub ring: Vec<u32>,
+    /// The texture coordinate of each corner of the ring (indices into the mesh's).
+    pub uvs: Vec<u32>,
     /// What it is, for a building.
     pub semantic: Semantic,
     /// Its material.
@@ -102,11 +105,14 @@ pub fn surfaces(mesh: &Mesh, faces: &[Face], ground: i64, vertices: &mut Vertice
         let points: Vec<[i64; 3]> = (f.corners.iter())
             .map(|&(p, _)| east_north_up(mesh.positions[p as usize]))
             .collect();
-        let mut ring: Vec<u32> = points.iter().map(|&p| vertices.add(p)).collect();
-        ring.dedup();
-        if ring.len() > 1 && ring.first() == ring.last() {
-            ring.pop();
+        let mut corners: Vec<(u32, u32)> = (points.iter().zip(&f.corners))
+            .map(|(&p, &(_, t))| (vertices.add(p), t))
+            .collect();
+        corners.dedup_by_key(|c| c.0);
+        if corners.len() > 1 && corners.first().map(|c| c.0) == corners.last().map(|c| c.0) {
+            corners.pop();
         }
+        let (ring, uvs): (Vec<u32>, Vec<u32>) = corners.into_iter().unzip();
         let mut distinct = ring.clone();
         distinct.sort_unstable();
         distinct.dedup();
@@ -115,6 +121,7 @@ pub fn surfaces(mesh: &Mesh, faces: &[Face], ground: i64, vertices: &mut Vertice
         }
         out.push(Surface {
             ring,
+            uvs,
             semantic: classify(&points, ground, top),
             material: f.material,
         });
@@ -149,15 +156,16 @@ pub fn classify(points: &[[i64; 3]], ground: i64, top: i64) -> Semantic {
     }
 }
 
-/// Writes a geometry object of `lod` from `surfaces`: a `Solid` of one shell when `solid`,
-/// else a `MultiSurface`; with its semantics (when `with_semantics`) and its materials
-/// (`materials` numbers them locally: the library id of each local index).
+/// Writes a geometry object of `lod` from `surfaces` of `mesh`: a `Solid` of one shell when
+/// `solid`, else a `MultiSurface`; with its semantics (when `with_semantics`), its materials
+/// and, when the appearance has them, its textures (`appearance` numbers both locally).
 pub fn geometry(
     out: &mut String,
+    mesh: &Mesh,
     surfaces: &[Surface],
     lod: &str,
     solid: bool,
-    materials: &mut Vec<u16>,
+    appearance: &mut Appearance,
     with_semantics: bool,
 ) {
     let mut kinds: Vec<Semantic> = surfaces.iter().map(|s| s.semantic).collect();
@@ -167,13 +175,7 @@ pub fn geometry(
         .map(|s| kinds.binary_search(&s.semantic).unwrap_or(0))
         .collect();
     let mat: Vec<usize> = (surfaces.iter())
-        .map(|s| match materials.iter().position(|&m| m == s.material) {
-            Some(k) => k,
-            None => {
-                materials.push(s.material);
-                materials.len() - 1
-            }
-        })
+        .map(|s| appearance.material(s.material))
         .collect();
     // A solid's arrays are one level deeper: its one shell.
     let (open, close) = if solid { ("[", "]") } else { ("", "") };
@@ -221,6 +223,22 @@ pub fn geometry(
         text::ints(out, &sem);
         out.push_str(close);
         out.push('}');
+    }
+    if appearance.has_textures() {
+        out.push(',');
+        text::key(out, "texture");
+        out.push_str("{\"visual\":{\"values\":");
+        out.push_str(open);
+        out.push('[');
+        for (i, s) in surfaces.iter().enumerate() {
+            if i > 0 {
+                out.push(',');
+            }
+            appearance.write_texture_ring(out, s.material, &mesh.uvs, &s.uvs);
+        }
+        out.push(']');
+        out.push_str(close);
+        out.push_str("}}");
     }
     out.push(',');
     text::key(out, "type");

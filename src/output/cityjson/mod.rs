@@ -24,6 +24,7 @@ use super::features::Feature;
 use super::report::{Manifest, ManifestFile};
 use super::sink::{Sink, TileContent, TileFiles};
 
+mod appearance;
 mod geometry;
 mod objects;
 mod text;
@@ -41,6 +42,8 @@ const MAX_TEMPLATE_BYTES: u64 = 256 << 20;
 pub struct CityJsonSink {
     /// The build's hypothesis (its parameters' fingerprint), an attribute of every object.
     pub hypothesis: String,
+    /// Surfaces name their textures (`[output] cityjson_textures`).
+    pub textures: bool,
     /// Templates written by this run: each once, whatever tile plants it first.
     pub shared: Mutex<BTreeMap<String, ManifestFile>>,
 }
@@ -55,6 +58,7 @@ impl Sink for CityJsonSink {
             tile: tile.id,
             hypothesis: &self.hypothesis,
             palette: tile.palette,
+            textures: self.textures,
         };
         let mut text = String::new();
         let instanced = !tile.instanced.is_empty();
@@ -102,10 +106,12 @@ impl Sink for CityJsonSink {
 }
 
 impl CityJsonSink {
-    /// The sink of a build whose parameters have the fingerprint `hypothesis`.
-    pub fn new(hypothesis: String) -> Self {
+    /// The sink of a build whose parameters have the fingerprint `hypothesis`; `textures`
+    /// when surfaces name their textures.
+    pub fn new(hypothesis: String, textures: bool) -> Self {
         CityJsonSink {
             hypothesis,
+            textures,
             shared: Mutex::default(),
         }
     }

@@ -9,6 +9,7 @@ use std::collections::BTreeMap;
 
 use serde_json::{json, Map, Value};
 
+use super::appearance::Appearance;
 use super::geometry::{block, east_north_up, geometry, surfaces, Surface, Vertices};
 use super::text;
 use crate::generate::mesh::{open_edges_of, Mesh};
@@ -22,8 +23,10 @@ pub struct Context<'a> {
     pub tile: &'a str,
     /// The build's hypothesis: its parameters' fingerprint.
     pub hypothesis: &'a str,
-    /// The materials' names and colours.
+    /// The materials' names, colours and textures.
     pub palette: Palette<'a>,
+    /// Whether surfaces name their textures (`[output] cityjson_textures`).
+    pub textures: bool,
 }
 
 /// Writes the CityJSONFeature line of one object into `out` (without its newline); false
@@ -59,7 +62,7 @@ fn building(out: &mut String, mesh: &Mesh, f: &Feature, cx: &Context) {
     let facts = mesh.building.clone().unwrap_or_default();
     let ground = (facts.ground * 1000.0).round() as i64;
     let mut vertices = Vertices::default();
-    let mut materials = Vec::new();
+    let mut appearance = Appearance::new(cx.palette, cx.textures);
     let parts = part_ranges(mesh);
     let body: Vec<_> = parts.iter().filter(|p| !p.2).collect();
     let mut body_surfaces: Vec<Surface> = Vec::new();
@@ -85,10 +88,11 @@ fn building(out: &mut String, mesh: &Mesh, f: &Feature, cx: &Context) {
     if !body_surfaces.is_empty() {
         geometry(
             &mut geometries,
+            mesh,
             &body_surfaces,
             "2",
             closed,
-            &mut materials,
+            &mut appearance,
             true,
         );
     }
@@ -124,7 +128,7 @@ fn building(out: &mut String, mesh: &Mesh, f: &Feature, cx: &Context) {
         let mut o = String::from("{\"attributes\":");
         o.push_str(&json!({ "part": name }).to_string());
         o.push_str(",\"geometry\":[");
-        geometry(&mut o, &s, "2", false, &mut materials, true);
+        geometry(&mut o, mesh, &s, "2", false, &mut appearance, true);
         o.push_str("],\"parents\":");
         o.push_str(&json!([id]).to_string());
         o.push_str(",\"type\":\"BuildingInstallation\"}");
@@ -141,7 +145,7 @@ fn building(out: &mut String, mesh: &Mesh, f: &Feature, cx: &Context) {
     me.push_str(&geometries);
     me.push_str(",\"type\":\"Building\"}");
     objects.insert(id.to_string(), me);
-    wrap(out, id, &objects, &vertices, &materials, cx);
+    wrap(out, id, &objects, &vertices, &appearance);
 }
 
 /// An object that is not a building: one geometry of all its faces, without semantics.
@@ -154,7 +158,7 @@ fn other(
     function: Option<&str>,
 ) {
     let mut vertices = Vertices::default();
-    let mut materials = Vec::new();
+    let mut appearance = Appearance::new(cx.palette, cx.textures);
     let s = surfaces(mesh, &mesh.faces, 0, &mut vertices);
     let id = format!("{}-{}", mesh.name, cx.tile);
     let mut attributes = base_attributes(f, cx);
@@ -166,10 +170,11 @@ fn other(
     let relief = ty == "TINRelief";
     geometry(
         &mut g,
+        mesh,
         &s,
         if relief { "1" } else { "2" },
         false,
-        &mut materials,
+        &mut appearance,
         false,
     );
     if relief {
@@ -186,7 +191,7 @@ fn other(
     text::string(&mut o, ty);
     o.push('}');
     let objects: BTreeMap<String, String> = [(id.clone(), o)].into_iter().collect();
-    wrap(out, &id, &objects, &vertices, &materials, cx);
+    wrap(out, &id, &objects, &vertices, &appearance);
 }
 
 /// The attributes every object carries: its kind, lot and record, lot use, district, the
@@ -214,15 +219,13 @@ fn base_attributes(f: &Feature, cx: &Context) -> Map<String, Value> {
 }
 
 /// Writes a feature line: its city objects (each's JSON text, by id), its own vertices and
-/// the materials its geometries number (their names and colours). Keys in serde_json's
-/// order.
+/// the appearance its geometries number. Keys in serde_json's order.
 fn wrap(
     out: &mut String,
     id: &str,
     objects: &BTreeMap<String, String>,
     vertices: &Vertices,
-    materials: &[u16],
-    cx: &Context,
+    appearance: &Appearance,
 ) {
     out.push_str("{\"CityObjects\":{");
     for (i, (k, o)) in objects.iter().enumerate() {
@@ -234,18 +237,9 @@ fn wrap(
         out.push_str(o);
     }
     out.push('}');
-    if !materials.is_empty() {
-        let list: Vec<Value> = (materials.iter())
-            .map(|&m| {
-                let e = cx.palette.get(m);
-                json!({
-                    "diffuseColor": e.kd.map(|c| round_colour(c as f64)),
-                    "name": e.name,
-                })
-            })
-            .collect();
+    if !appearance.is_empty() {
         out.push_str(",\"appearance\":");
-        out.push_str(&json!({ "materials": list }).to_string());
+        appearance.write(out);
     }
     out.push_str(",\"id\":");
     text::string(out, id);
@@ -280,9 +274,4 @@ fn part_name(mesh: &Mesh, start: usize) -> &str {
     (mesh.parts.iter())
         .find(|p| p.first_face as usize == start)
         .map_or("part", |p| p.name.as_str())
-}
-
-/// A colour channel to three decimals (the library's colours are given so).
-fn round_colour(c: f64) -> f64 {
-    (c.clamp(0.0, 1.0) * 1000.0).round() / 1000.0
 }
