@@ -12,10 +12,4 @@ fi
 cargo fmt --version >/dev/null
 cargo clippy --version >/dev/null
 
-# shellcheck source=scripts/apt-install.sh
-. "$(dirname "$0")/apt-install.sh"
-if ! command -v faketime >/dev/null 2>&1; then
-  apt_install faketime
-fi
-command -v faketime >/dev/null
-
+bash "$(dirname "$0")/faketime-deps.sh"

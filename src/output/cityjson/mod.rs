@@ -244,21 +244,33 @@ fn write_model(out: &Path, manifest: &Manifest) -> std::io::Result<ManifestFile>
         let mut h = Sha256::new();
         let mut bytes = 0u64;
         let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-        let mut put = |s: &str| -> std::io::Result<()> {
-            h.update(s.as_bytes());
+        let mut put = |s: &[u8]| -> std::io::Result<()> {
+            h.update(s);
             bytes += s.len() as u64;
-            w.write_all(s.as_bytes())
+            w.write_all(s)
         };
-        put(&header.to_string())?;
-        put("\n")?;
+        put(header.to_string().as_bytes())?;
+        put(b"\n")?;
+        let mut line = Vec::new();
+        let key = memchr::memmem::Finder::new(TEMPLATE_KEY);
         for t in &manifest.tiles {
             let Some(f) = &t.cityjson else { continue };
             let real = super::listed::locate(out, &f.path).map_err(std::io::Error::other)?;
             let (file, _) = crate::bounded::open(&real).map_err(std::io::Error::other)?;
-            for line in std::io::BufReader::new(file).lines() {
-                let line = line?;
-                put(&number_template(&line, &index))?;
-                put("\n")?;
+            let mut r = std::io::BufReader::with_capacity(1 << 20, file);
+            loop {
+                line.clear();
+                if r.read_until(b'\n', &mut line)? == 0 {
+                    break;
+                }
+                if line.last() != Some(&b'\n') {
+                    line.push(b'\n');
+                }
+                match key.find(&line) {
+                    // Only a grown tree's line names a template.
+                    Some(at) => put(&number_template(&line, at, &index))?,
+                    None => put(&line)?,
+                }
             }
         }
         w.into_inner().map_err(|e| e.into_error())?;
@@ -280,19 +292,26 @@ fn write_model(out: &Path, manifest: &Manifest) -> std::io::Result<ManifestFile>
     }
 }
 
-/// `line` with a tree's `"template":"<name>"` made `"template":<index>`.
-fn number_template(line: &str, index: &BTreeMap<&str, usize>) -> String {
-    const KEY: &str = "\"template\":\"";
-    let Some(at) = line.find(KEY) else {
-        return line.to_string();
+/// What a grown tree's line names its template by.
+const TEMPLATE_KEY: &[u8] = b"\"template\":\"";
+
+/// `line` with a tree's `"template":"<name>"` (found at `at`) made `"template":<index>`;
+/// unchanged when the name is not a template of the build.
+fn number_template(line: &[u8], at: usize, index: &BTreeMap<&str, usize>) -> Vec<u8> {
+    let rest = &line[at + TEMPLATE_KEY.len()..];
+    let Some(end) = rest.iter().position(|&b| b == b'"') else {
+        return line.to_vec();
     };
-    let rest = &line[at + KEY.len()..];
-    let Some(end) = rest.find('"') else {
-        return line.to_string();
-    };
-    match index.get(&rest[..end]) {
-        Some(i) => format!("{}\"template\":{i}{}", &line[..at], &rest[end + 1..]),
-        None => line.to_string(),
+    let name = std::str::from_utf8(&rest[..end]).unwrap_or("");
+    match index.get(name) {
+        Some(i) => {
+            let mut out = Vec::with_capacity(line.len());
+            out.extend_from_slice(&line[..at]);
+            out.extend_from_slice(format!("\"template\":{i}").as_bytes());
+            out.extend_from_slice(&rest[end + 1..]);
+            out
+        }
+        None => line.to_vec(),
     }
 }
 
@@ -399,12 +418,14 @@ mod tests {
     #[test]
     fn a_trees_template_is_numbered_by_its_name() {
         let index: BTreeMap<&str, usize> = [("matsu_1", 0), ("sakura_3", 1)].into_iter().collect();
-        let line = r#"{"a":{"template":"sakura_3","boundaries":[0]}}"#;
+        let line = br#"{"a":{"template":"sakura_3","boundaries":[0]}}"#;
+        let at = memchr::memmem::find(line, TEMPLATE_KEY).unwrap();
         assert_eq!(
-            number_template(line, &index),
-            r#"{"a":{"template":1,"boundaries":[0]}}"#
+            number_template(line, at, &index),
+            br#"{"a":{"template":1,"boundaries":[0]}}"#
         );
-        assert_eq!(number_template("{}", &index), "{}");
+        let other = br#"{"template":"kusu_0"}"#;
+        assert_eq!(number_template(other, 1, &index), other);
         assert_eq!(species_of("shidare_zakura_4"), "shidare_zakura");
     }
 }
