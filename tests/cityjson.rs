@@ -32,6 +32,40 @@ fn types(features: &[Value]) -> BTreeMap<String, usize> {
     out
 }
 
+/// The validator of these tests finds what cjval finds: a feature's index past its own
+/// vertices, a surface not closed, an unknown semantic type, a city object twice.
+#[test]
+fn the_validator_finds_broken_features() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = r#"{"type":"CityJSON","version":"2.0","transform":{"scale":[0.001,0.001,0.001],"translate":[0,0,0]},"CityObjects":{},"vertices":[]}"#;
+    let good = |id: &str, last: u32| {
+        format!(
+            r#"{{"type":"CityJSONFeature","id":"{id}","CityObjects":{{"{id}":{{"type":"CityFurniture","geometry":[{{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,{last}]]]}}]}}}},"vertices":[[0,0,0],[1000,0,0],[0,1000,0]]}}"#
+        )
+    };
+    let file = dir.path().join("m.city.jsonl");
+    let write = |lines: &[String]| {
+        std::fs::write(&file, format!("{header}\n{}\n", lines.join("\n"))).unwrap();
+        validate(&file)
+    };
+    let ok = write(&[good("a", 2), good("b", 2)]);
+    assert!(
+        ok.errors.is_empty() && ok.warnings.is_empty(),
+        "{:?}",
+        ok.errors
+    );
+    assert_eq!(ok.features, 2);
+    // Index 3 of a feature with three vertices: the next feature's first vertex once the
+    // two are one document, yet wrong.
+    assert!(!write(&[good("a", 3), good("b", 2)]).errors.is_empty());
+    assert!(!write(&[good("a", 2), good("a", 2)]).errors.is_empty());
+    let unknown = good("c", 2).replace("CityFurniture", "Teahouse");
+    assert!(!write(&[good("a", 2), unknown]).errors.is_empty());
+    let twice = good("d", 2).replace("[1000,0,0]", "[0,0,0]");
+    let v = write(&[twice]);
+    assert!(!v.errors.is_empty() || !v.warnings.is_empty());
+}
+
 #[test]
 fn the_example_town_is_a_valid_city_model_holding_every_building_once() {
     let dir = tempfile::tempdir().unwrap();
