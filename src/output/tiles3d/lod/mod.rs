@@ -22,6 +22,7 @@
 mod hidden;
 pub mod massing;
 pub mod read;
+mod simplify;
 pub mod write;
 
 use std::collections::BTreeMap;
@@ -166,7 +167,7 @@ pub fn coarsen(children: Vec<Content>, level: u32, target: f64) -> Content {
             level_error = level_error.max(m.flat_error);
         }
     }
-    let (solid, e) = simplify(rest, target);
+    let (solid, e) = simplify::simplify(rest, target);
     out.solid = solid;
     level_error = level_error.max(e);
     for cut in out.cutouts.values_mut() {
@@ -276,59 +277,6 @@ fn split_buildings(solid: Part, features: &[Feature]) -> (Vec<Mass>, Part) {
         .filter_map(|(id, tris)| massing::mass(*id, tris))
         .collect();
     (masses, rest)
-}
-
-/// `part` welded (equal position, colour and row) and simplified by meshoptimizer to
-/// `target` metres, small disconnected parts pruned; with the error meshoptimizer measured.
-fn simplify(part: Part, target: f64) -> (Part, f64) {
-    if part.indices.is_empty() {
-        return (part, 0.0);
-    }
-    let centre = part.positions[0];
-    let mut welded = Part::default();
-    let mut index: std::collections::HashMap<([i64; 3], [u8; 4], u32), u32> =
-        std::collections::HashMap::new();
-    let remap: Vec<u32> = (0..part.positions.len())
-        .map(|v| {
-            let p = part.positions[v];
-            let key = (
-                p.map(|x| (x * 1000.0).round() as i64),
-                part.colours[v],
-                part.ids[v],
-            );
-            *index.entry(key).or_insert_with(|| {
-                welded.positions.push(p);
-                welded.colours.push(part.colours[v]);
-                welded.ids.push(part.ids[v]);
-                (welded.positions.len() - 1) as u32
-            })
-        })
-        .collect();
-    let indices: Vec<u32> = part.indices.iter().map(|&i| remap[i as usize]).collect();
-    let local: Vec<f32> = welded
-        .positions
-        .iter()
-        .flat_map(|p| [0, 1, 2].map(|k| (p[k] - centre[k]) as f32))
-        .collect();
-    let bytes = meshopt::utilities::typed_to_bytes(&local);
-    let adapter =
-        meshopt::VertexDataAdapter::new(bytes, 12, 0).expect("a whole number of vertices");
-    let mut error = 0.0f32;
-    let kept = meshopt::simplify(
-        &indices,
-        &adapter,
-        0,
-        target as f32,
-        meshopt::SimplifyOptions::ErrorAbsolute | meshopt::SimplifyOptions::Prune,
-        Some(&mut error),
-    );
-    // Only the vertices still used.
-    let mut out = Part::default();
-    let mut seen = vec![u32::MAX; welded.positions.len()];
-    for &v in &kept {
-        out.keep(&welded, v, &mut seen);
-    }
-    (out, error as f64)
 }
 
 /// The connected parts of a triangle list over `n` vertices (vertices joined by a triangle),
