@@ -200,23 +200,20 @@ fn cjio_info(file: &Path) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
+/// A 300-lot synth town in `dir/town` and parameters that grow its trees from their
+/// grammars, dense enough for every variant to be planted.
+fn grown_tree_town(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    let town = dir.join("town");
+    common::synth(&town, 300, 5);
+    let params = dir.join("trees.toml");
+    std::fs::write(&params, "[trees]\nstyle = \"lsystem\"\nper_ha = 200.0\n").unwrap();
+    (town, params)
+}
+
 #[test]
 fn grown_trees_are_instances_of_one_template_per_variant() {
     let dir = tempfile::tempdir().unwrap();
-    let town = dir.path().join("town");
-    common::edo_city()
-        .args([
-            "synth",
-            town.to_str().unwrap(),
-            "--lots",
-            "300",
-            "--seed",
-            "5",
-        ])
-        .assert()
-        .success();
-    let params = dir.path().join("trees.toml");
-    std::fs::write(&params, "[trees]\nstyle = \"lsystem\"\nper_ha = 200.0\n").unwrap();
+    let (town, params) = grown_tree_town(dir.path());
     let out = dir.path().join("out");
     let p = params.to_str().unwrap();
     build_ok(
@@ -326,20 +323,7 @@ fn build(town: &Path, out: &Path, p: &str, extra: &[&str]) {
 #[test]
 fn the_model_is_the_same_bytes_for_any_thread_count_single_tiles_and_merged_shards() {
     let dir = tempfile::tempdir().unwrap();
-    let town = dir.path().join("town");
-    common::edo_city()
-        .args([
-            "synth",
-            town.to_str().unwrap(),
-            "--lots",
-            "300",
-            "--seed",
-            "5",
-        ])
-        .assert()
-        .success();
-    let params = dir.path().join("trees.toml");
-    std::fs::write(&params, "[trees]\nstyle = \"lsystem\"\nper_ha = 200.0\n").unwrap();
+    let (town, params) = grown_tree_town(dir.path());
     let p = params.to_str().unwrap();
     let (one, two) = (dir.path().join("j1"), dir.path().join("j2"));
     build(&town, &one, p, &["-j", "1"]);
