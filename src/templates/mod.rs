@@ -8,6 +8,7 @@
 //! describes the format. A user adds a type by dropping a file into a directory given with
 //! `--templates` (or `machiya.templates`) and naming it in `type_mix`.
 
+mod compile;
 pub(crate) mod dir;
 pub mod expr;
 pub mod file;
@@ -224,7 +225,7 @@ impl Catalog {
         let mut cat = Catalog::default();
         for name in sources.keys() {
             let merged = resolve_extends(&sources, name)?;
-            let t = template::compile_template(&merged).map_err(TemplateError::Invalid)?;
+            let t = compile::compile_template(&merged).map_err(TemplateError::Invalid)?;
             if t.kind == Kind::Machiya && !t.is_abstract {
                 for spelling in [&t.name, &t.kanji].into_iter().chain(&t.aliases) {
                     if spelling.is_empty() {
