@@ -5,14 +5,17 @@
 //! frontage the paper's Fig.4 chose for each house as a thick red edge (a red line away from
 //! the street is a wrong frontage); the tile grid with ids; a legend and a scale bar.
 
+mod furniture;
+mod paint;
+
 use std::collections::{BTreeMap, HashSet};
 
-use geo_types::{Coord, Polygon};
-use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
+use geo_types::Coord;
+use tiny_skia::{Color, Pixmap};
 
-use super::text::{draw_text, text_width};
-use crate::model::tile::parse_tile_id;
 use crate::model::{Dataset, Plan};
+use furniture::{draw_legend, draw_scale_bar, draw_tile_grid, Shown};
+use paint::{crisp, paint, thin, wide, Batch, Draw, OUTLINE};
 
 /// Longest side of the image in pixels.
 pub const MAX_SIDE: f64 = 2400.0;
@@ -122,179 +125,6 @@ pub fn type_colours(plan: &Plan) -> BTreeMap<String, [u8; 3]> {
         .collect()
 }
 
-fn paint(rgb: [u8; 3], a: u8) -> Paint<'static> {
-    let mut p = Paint::default();
-    p.set_color_rgba8(rgb[0], rgb[1], rgb[2], a);
-    p
-}
-
-fn line_path(view: &View, pts: &[Coord<f64>]) -> Option<tiny_skia::Path> {
-    let mut pb = PathBuilder::new();
-    push_line(&mut pb, view, pts);
-    pb.finish()
-}
-
-/// An open polyline.
-fn push_line(pb: &mut PathBuilder, view: &View, pts: &[Coord<f64>]) {
-    for (i, c) in pts.iter().enumerate() {
-        let (x, y) = view.pixel(c);
-        if i == 0 {
-            pb.move_to(x, y)
-        } else {
-            pb.line_to(x, y)
-        }
-    }
-}
-
-/// A closed ring through `pts`, in their order.
-fn push_closed<'a>(
-    pb: &mut PathBuilder,
-    view: &View,
-    mut pts: impl Iterator<Item = &'a Coord<f64>>,
-) {
-    if let Some(first) = pts.next() {
-        let (x, y) = view.pixel(first);
-        pb.move_to(x, y);
-        for c in pts {
-            let (x, y) = view.pixel(c);
-            pb.line_to(x, y);
-        }
-        pb.close();
-    }
-}
-
-/// What a [`Batch`] does with each of its paths.
-enum Draw {
-    /// Fills it (nonzero rule).
-    Fill(Paint<'static>),
-    /// Strokes it.
-    Stroke(Paint<'static>, Stroke),
-    /// Fills it, then outlines it with a hairline of the second paint. The fill is meant
-    /// [`crisp`]: the outline smooths its edges, and anti-aliasing the fills of 30,000 lots
-    /// took as long as everything else in the plan.
-    FillOutlined(Paint<'static>, Paint<'static>),
-}
-
-impl Draw {
-    fn path(&self, pm: &mut Pixmap, path: &tiny_skia::Path) {
-        let id = Transform::identity();
-        match self {
-            Draw::Fill(paint) => pm.fill_path(path, paint, FillRule::Winding, id, None),
-            Draw::Stroke(paint, stroke) => pm.stroke_path(path, paint, stroke, id, None),
-            Draw::FillOutlined(fill, outline) => {
-                pm.fill_path(path, fill, FillRule::Winding, id, None);
-                pm.stroke_path(path, outline, &thin(), id, None);
-            }
-        }
-    }
-}
-
-/// Shapes of one paint gathered into few paths, each drawn by one call. tiny-skia's cost is
-/// per call and per span of pixels, and side by side lots of one colour share their spans:
-/// a path per lot made the plan a third of a 30,052-lot build's CPU. A path holds at most
-/// [`Batch::SHAPES`] shapes and is drawn as soon as it is full, because tiny-skia builds
-/// every edge of a path before it draws, and a million lots' paths held at once would be
-/// hundreds of megabytes.
-struct Batch {
-    draw: Draw,
-    open: PathBuilder,
-    shapes: usize,
-}
-
-impl Batch {
-    /// Shapes per path.
-    const SHAPES: usize = 1024;
-
-    fn new(draw: Draw) -> Batch {
-        Batch {
-            draw,
-            open: PathBuilder::new(),
-            shapes: 0,
-        }
-    }
-
-    /// A polygon's rings, the exterior counter-clockwise on screen and the holes clockwise,
-    /// so the nonzero rule fills the union of overlapping polygons and keeps their holes
-    /// (even-odd would punch a hole where two lots of the data overlap).
-    fn polygon(&mut self, pm: &mut Pixmap, view: &View, poly: &Polygon<f64>) {
-        self.push_ring(view, &poly.exterior().0, true);
-        for hole in poly.interiors() {
-            self.push_ring(view, &hole.0, false);
-        }
-        self.shape_done(pm);
-    }
-
-    /// A closed ring (a shape of its own), counter-clockwise on screen.
-    fn ring(&mut self, pm: &mut Pixmap, view: &View, pts: &[Coord<f64>]) {
-        self.push_ring(view, pts, true);
-        self.shape_done(pm);
-    }
-
-    /// A closed ring, turned to `outer`'s orientation. The turn is read from the map
-    /// coordinates (north up: clockwise there is counter-clockwise on screen), so no copy of
-    /// the ring is made.
-    fn push_ring(&mut self, view: &View, pts: &[Coord<f64>], outer: bool) {
-        let twice_area: f64 = pts
-            .iter()
-            .zip(pts.iter().cycle().skip(1))
-            .map(|(a, b)| a.x * b.y - b.x * a.y)
-            .sum();
-        if (twice_area < 0.0) == outer {
-            push_closed(&mut self.open, view, pts.iter().rev());
-        } else {
-            push_closed(&mut self.open, view, pts.iter());
-        }
-    }
-
-    /// An open polyline.
-    fn line(&mut self, pm: &mut Pixmap, view: &View, pts: &[Coord<f64>]) {
-        push_line(&mut self.open, view, pts);
-        self.shape_done(pm);
-    }
-
-    fn circle(&mut self, pm: &mut Pixmap, x: f32, y: f32, r: f32) {
-        self.open.push_circle(x, y, r);
-        self.shape_done(pm);
-    }
-
-    fn shape_done(&mut self, pm: &mut Pixmap) {
-        self.shapes += 1;
-        if self.shapes.is_multiple_of(Self::SHAPES) {
-            self.draw_open(pm);
-        }
-    }
-
-    fn draw_open(&mut self, pm: &mut Pixmap) {
-        if let Some(path) = std::mem::take(&mut self.open).finish() {
-            self.draw.path(pm, &path);
-        }
-    }
-
-    /// Draws what is left; whether anything was added.
-    fn finish(mut self, pm: &mut Pixmap) -> bool {
-        self.draw_open(pm);
-        self.shapes > 0
-    }
-}
-
-/// Outlines of lots, houses and blocks.
-const OUTLINE: [u8; 3] = [90, 80, 70];
-
-/// A stroke `width` pixels wide.
-fn wide(width: f32) -> Stroke {
-    Stroke {
-        width,
-        ..Stroke::default()
-    }
-}
-
-/// The paint without anti-aliasing: for shapes whose edges are outlined anyway, and small
-/// squares that stay squares.
-fn crisp(mut paint: Paint<'static>) -> Paint<'static> {
-    paint.anti_alias = false;
-    paint
-}
-
 /// Draws the plan; `None` when there is nothing to draw. `tile_grid` = (size, origin).
 /// `kura`: `None` when kura are off, else whether collisions are avoided (then the refused
 /// kura are outlined in red).
@@ -335,15 +165,6 @@ pub fn draw_plan(
     };
     draw_legend(&mut pm, &colours, &shown);
     encode_png(&pm)
-}
-
-/// A hairline: one pixel wide at any scale, drawn by tiny-skia's line rasteriser instead of
-/// being stroked into a polygon (a third of the plan's time when every outline was one).
-fn thin() -> Stroke {
-    Stroke {
-        width: 0.0,
-        ..Stroke::default()
-    }
 }
 
 /// Street bands as wide as the streets, and block outlines.
@@ -531,151 +352,10 @@ pub fn encode_png(pm: &Pixmap) -> Option<Vec<u8>> {
     Some(buf)
 }
 
-fn draw_tile_grid(pm: &mut Pixmap, view: &View, plan: &Plan, (size, origin): (f64, [f64; 2])) {
-    let tile_px = size * view.scale;
-    let dash = Stroke {
-        width: 1.0,
-        dash: tiny_skia::StrokeDash::new(vec![6.0, 4.0], 0.0),
-        ..Stroke::default()
-    };
-    for id in &plan.tiles {
-        let Some((c, r)) = parse_tile_id(id) else {
-            continue;
-        };
-        let (x0, y0) = (origin[0] + c as f64 * size, origin[1] + r as f64 * size);
-        let corners = [
-            Coord { x: x0, y: y0 },
-            Coord {
-                x: x0 + size,
-                y: y0,
-            },
-            Coord {
-                x: x0 + size,
-                y: y0 + size,
-            },
-            Coord {
-                x: x0,
-                y: y0 + size,
-            },
-            Coord { x: x0, y: y0 },
-        ];
-        if let Some(path) = line_path(view, &corners) {
-            pm.stroke_path(
-                &path,
-                &paint([90, 90, 160], 200),
-                &dash,
-                Transform::identity(),
-                None,
-            );
-        }
-        let scale = if tile_px > 400.0 { 2 } else { 1 };
-        if tile_px > f64::from(text_width(id, scale) + 8) {
-            // The tile's top-left corner, kept inside the image when the tile is cut off.
-            let (x, y) = view.pixel(&corners[3]);
-            let (x, y) = (x.max(0.0) + 4.0, y.max(0.0) + 4.0);
-            draw_text(pm, x, y, id, scale, [70, 70, 150]);
-        }
-    }
-}
-
-fn draw_scale_bar(pm: &mut Pixmap, view: &View) {
-    let target = (pm.width() as f64 / 5.0) / view.scale;
-    let steps = [
-        1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0,
-    ];
-    // The longest round length that fits a fifth of the width.
-    let metres = steps
-        .iter()
-        .rev()
-        .copied()
-        .find(|s| *s <= target)
-        .unwrap_or(1.0);
-    let len = (metres * view.scale) as f32;
-    let (x, y) = (20.0, pm.height() as f32 - 30.0);
-    for (i, colour) in [[30, 30, 30], [250, 250, 250], [30, 30, 30], [250, 250, 250]]
-        .iter()
-        .enumerate()
-    {
-        if let Some(r) = Rect::from_xywh(x + i as f32 * len / 4.0, y, len / 4.0, 8.0) {
-            pm.fill_rect(r, &paint(*colour, 255), Transform::identity(), None);
-        }
-    }
-    if let Some(r) = Rect::from_xywh(x, y, len, 8.0) {
-        let path = PathBuilder::from_rect(r);
-        pm.stroke_path(
-            &path,
-            &paint([30, 30, 30], 255),
-            &Stroke::default(),
-            Transform::identity(),
-            None,
-        );
-    }
-    draw_text(pm, x, y - 20.0, &format!("{metres} m"), 2, [30, 30, 30]);
-}
-
-/// Which rows the legend has (only what the plan shows).
-struct Shown {
-    footprints: bool,
-    /// 0 (kura off), 1 (kura) or 2 (kura and refused kura).
-    kura_rows: usize,
-    fences: bool,
-    halls: bool,
-    landmarks: bool,
-    billboards: bool,
-}
-
-fn draw_legend(pm: &mut Pixmap, colours: &BTreeMap<String, [u8; 3]>, shown: &Shown) {
-    let mut rows: Vec<(String, [u8; 3])> = colours.iter().map(|(t, c)| (t.clone(), *c)).collect();
-    if shown.footprints {
-        rows.push(("footprint".into(), FOOTPRINT));
-    }
-    for (name, colour) in [
-        ("kura", KURA),
-        ("kura refused (plots collide)", KURA_REFUSED),
-    ]
-    .into_iter()
-    .take(shown.kura_rows)
-    {
-        rows.push((name.into(), colour));
-    }
-    if shown.fences {
-        rows.push(("wall".into(), FENCE));
-        rows.push(("gate".into(), GATE));
-    }
-    if shown.halls {
-        rows.push(("hall".into(), HALL));
-    }
-    if shown.landmarks {
-        rows.push(("landmark".into(), LANDMARK));
-        rows.push(("lot of a landmark".into(), LANDMARK_LOT));
-    }
-    if shown.billboards {
-        rows.push(("tree".into(), TREE));
-        rows.push(("person".into(), PERSON));
-    }
-    rows.push(("other use".into(), OTHER_USE));
-    rows.push(("skipped".into(), SKIPPED));
-    rows.push(("frontage".into(), FRONTAGE));
-    let width = rows.iter().map(|r| text_width(&r.0, 2)).max().unwrap_or(0) as f32 + 60.0;
-    let height = rows.len() as f32 * 24.0 + 16.0;
-    // Top right: tile ids sit at the top left of their tiles.
-    let x0 = (pm.width() as f32 - width - 10.0).max(0.0);
-    if let Some(r) = Rect::from_xywh(x0, 10.0, width, height) {
-        pm.fill_rect(r, &paint([255, 255, 255], 230), Transform::identity(), None);
-    }
-    for (i, (name, colour)) in rows.iter().enumerate() {
-        let y = 18.0 + i as f32 * 24.0;
-        if let Some(r) = Rect::from_xywh(x0 + 8.0, y, 28.0, 16.0) {
-            pm.fill_rect(r, &paint(*colour, 255), Transform::identity(), None);
-        }
-        draw_text(pm, x0 + 44.0, y, name, 2, [30, 30, 30]);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use geo_types::{coord, LineString};
+    use geo_types::{coord, LineString, Polygon};
 
     fn square(x: f64, y: f64, side: f64, clockwise: bool) -> LineString<f64> {
         let mut pts = vec![
