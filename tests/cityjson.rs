@@ -302,11 +302,21 @@ fn textures_are_named_when_asked_and_valid() {
     }
     assert!(textured > 1000, "{textured} textured surfaces");
     // The same town without it: colours only (and the same as before the key existed).
+    // (Its summary says where the model is.)
     let plain = dir.path().join("plain");
-    build_ok(
-        &fixture("kyoto-small"),
-        &plain,
-        &["--quiet", "--format", "cityjson"],
+    let o = common::edo_city()
+        .arg("build")
+        .arg(fixture("kyoto-small"))
+        .arg("--out")
+        .arg(&plain)
+        .args(["--format", "cityjson"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        said.contains("in 3D GIS: ") && said.contains("city.city.jsonl"),
+        "{said}"
     );
     let text = std::fs::read_to_string(plain.join("city.city.jsonl")).unwrap();
     assert!(!text.contains("\"texture\""));

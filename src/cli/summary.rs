@@ -223,6 +223,13 @@ pub fn print_summary(opts: &BuildOptions, o: &BuildOutcome) -> std::io::Result<(
     if gpkg.is_file() && opts.selection == edo_city::build::Selection::All {
         say!("  in QGIS: {} (docs/gpkg.md)", gpkg.display());
     }
+    let model = opts.out.join(edo_city::output::cityjson::FILE);
+    if model.is_file() && opts.selection == edo_city::build::Selection::All {
+        say!(
+            "  in 3D GIS: {} (CityJSON 2.0, docs/cityjson.md)",
+            model.display()
+        );
+    }
     Ok(())
 }
 
