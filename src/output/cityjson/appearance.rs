@@ -107,54 +107,30 @@ impl<'a> Appearance<'a> {
     pub fn write(&self, out: &mut String) {
         out.push('{');
         text::key(out, "materials");
-        out.push('[');
-        for (i, &m) in self.materials.iter().enumerate() {
-            if i > 0 {
-                out.push(',');
-            }
+        text::array(out, &self.materials, |out, &m| {
             let e = self.palette.get(m);
             out.push('{');
             text::key(out, "diffuseColor");
-            out.push('[');
-            for (j, c) in e.kd.iter().enumerate() {
-                if j > 0 {
-                    out.push(',');
-                }
-                out.push_str(&serde_json::to_string(&round_colour(*c as f64)).unwrap_or_default());
-            }
-            out.push_str("],");
+            text::array(out, e.kd, |out, c| {
+                out.push_str(&serde_json::to_string(&round_colour(c as f64)).unwrap_or_default())
+            });
+            out.push(',');
             text::key(out, "name");
             text::string(out, e.name);
             out.push('}');
-        }
-        out.push(']');
+        });
         if let Some(t) = self.textures.as_ref().filter(|t| !t.files.is_empty()) {
             out.push(',');
             text::key(out, "textures");
-            out.push('[');
-            for (i, f) in t.files.iter().enumerate() {
-                if i > 0 {
-                    out.push(',');
-                }
+            text::array(out, &t.files, |out, f| {
                 out.push('{');
                 text::key(out, "image");
                 text::string(out, &format!("{}/{f}", crate::output::TEXTURE_DIR));
                 out.push_str(",\"type\":\"PNG\",\"wrapMode\":\"wrap\"}");
-            }
-            out.push_str("],");
+            });
+            out.push(',');
             text::key(out, "vertices-texture");
-            out.push('[');
-            for (i, uv) in t.uvs.iter().enumerate() {
-                if i > 0 {
-                    out.push(',');
-                }
-                out.push('[');
-                fixed4(out, uv[0]);
-                out.push(',');
-                fixed4(out, uv[1]);
-                out.push(']');
-            }
-            out.push(']');
+            text::array(out, &t.uvs, |out, uv| text::array(out, *uv, fixed4));
         }
         out.push('}');
     }

@@ -33,14 +33,7 @@ impl Vertices {
 
     /// Writes the list, as CityJSON has it: `[[x,y,z],...]`.
     pub fn write(&self, out: &mut String) {
-        out.push('[');
-        for (i, v) in self.list.iter().enumerate() {
-            if i > 0 {
-                out.push(',');
-            }
-            text::vertex(out, *v);
-        }
-        out.push(']');
+        text::array(out, &self.list, |out, v| text::vertex(out, *v));
     }
 }
 
@@ -182,16 +175,9 @@ pub fn geometry(
     out.push('{');
     text::key(out, "boundaries");
     out.push_str(open);
-    out.push('[');
-    for (i, s) in surfaces.iter().enumerate() {
-        if i > 0 {
-            out.push(',');
-        }
-        out.push('[');
-        text::ints(out, &s.ring);
-        out.push(']');
-    }
-    out.push(']');
+    text::array(out, surfaces, |out, s| {
+        text::array(out, [&s.ring], |out, r| text::ints(out, r))
+    });
     out.push_str(close);
     out.push(',');
     text::key(out, "lod");
@@ -208,16 +194,12 @@ pub fn geometry(
         text::key(out, "semantics");
         out.push('{');
         text::key(out, "surfaces");
-        out.push('[');
-        for (i, k) in kinds.iter().enumerate() {
-            if i > 0 {
-                out.push(',');
-            }
+        text::array(out, &kinds, |out, k| {
             out.push_str("{\"type\":\"");
             out.push_str(k.name());
             out.push_str("\"}");
-        }
-        out.push_str("],");
+        });
+        out.push(',');
         text::key(out, "values");
         out.push_str(open);
         text::ints(out, &sem);
@@ -229,14 +211,9 @@ pub fn geometry(
         text::key(out, "texture");
         out.push_str("{\"visual\":{\"values\":");
         out.push_str(open);
-        out.push('[');
-        for (i, s) in surfaces.iter().enumerate() {
-            if i > 0 {
-                out.push(',');
-            }
-            appearance.write_texture_ring(out, s.material, &mesh.uvs, &s.uvs);
-        }
-        out.push(']');
+        text::array(out, surfaces, |out, s| {
+            appearance.write_texture_ring(out, s.material, &mesh.uvs, &s.uvs)
+        });
         out.push_str(close);
         out.push_str("}}");
     }
@@ -294,17 +271,12 @@ pub fn block(out: &mut String, points: &[[i64; 3]], vertices: &mut Vertices) -> 
         shell.push(vec![low[i], low[j], high[j], high[i]]);
         sem.push(1);
     }
-    out.push_str("{\"boundaries\":[[");
-    for (i, r) in shell.iter().enumerate() {
-        if i > 0 {
-            out.push(',');
-        }
-        out.push('[');
-        text::ints(out, r);
-        out.push(']');
-    }
+    out.push_str("{\"boundaries\":[");
+    text::array(out, &shell, |out, r| {
+        text::array(out, [r], |out, r| text::ints(out, r))
+    });
     out.push_str(
-        "]],\"lod\":\"1\",\"semantics\":{\"surfaces\":[{\"type\":\"RoofSurface\"},\
+        "],\"lod\":\"1\",\"semantics\":{\"surfaces\":[{\"type\":\"RoofSurface\"},\
                   {\"type\":\"WallSurface\"},{\"type\":\"GroundSurface\"}],\"values\":[",
     );
     text::ints(out, &sem);

@@ -15,16 +15,25 @@ pub fn int(out: &mut String, v: impl itoa::Integer) {
     out.push_str(itoa::Buffer::new().format(v));
 }
 
-/// Writes `[a,b,...]` of integers.
-pub fn ints<T: itoa::Integer + Copy>(out: &mut String, values: &[T]) {
+/// Writes `[a,b,...]`, each item by `each`.
+pub fn array<T>(
+    out: &mut String,
+    items: impl IntoIterator<Item = T>,
+    mut each: impl FnMut(&mut String, T),
+) {
     out.push('[');
-    for (i, v) in values.iter().enumerate() {
+    for (i, item) in items.into_iter().enumerate() {
         if i > 0 {
             out.push(',');
         }
-        int(out, *v);
+        each(out, item);
     }
     out.push(']');
+}
+
+/// Writes `[a,b,...]` of integers.
+pub fn ints<T: itoa::Integer + Copy>(out: &mut String, values: &[T]) {
+    array(out, values, |out, v| int(out, *v));
 }
 
 /// Writes `[x,y,z]` of a vertex.
