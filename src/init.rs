@@ -302,7 +302,7 @@ mod tests {
     #[test]
     fn the_synthetic_town_is_recognised_and_the_file_parses() {
         let dir = tempfile::tempdir().unwrap();
-        crate::synth::write_town(dir.path(), 80, 1, true).unwrap();
+        crate::synth::write_town(dir.path(), 80, 1, crate::synth::Profile::Grid, true).unwrap();
         let text = params_text(dir.path());
         assert!(text.contains("file = \"lots.shp\""), "{text}");
         assert!(text.contains("file = \"streets.shp\""), "{text}");

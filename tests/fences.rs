@@ -16,6 +16,7 @@ fn walled(id: u64, lot_use: &'static str, ring: Vec<[f64; 2]>) -> SynthLot {
         lot_use,
         mtype: "",
         district: "",
+        gate: "",
     }
 }
 
@@ -313,6 +314,7 @@ fn free_standing_fence_lines_from_a_line_layer() {
             lot_use: "machiya",
             mtype: "平屋",
             district: "",
+            gate: "",
         }],
     )
     .unwrap();

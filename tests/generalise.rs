@@ -23,6 +23,7 @@ fn collinear_vertices_are_removed_and_counted() {
         lot_use: "machiya",
         mtype: "平屋",
         district: "",
+        gate: "",
     };
     write_lots(&dir.path().join("lots.shp"), &[lot]).unwrap();
     write_blocks(

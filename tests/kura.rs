@@ -16,6 +16,7 @@ fn lot(id: u64, ring: Vec<[f64; 2]>) -> SynthLot {
         lot_use: "machiya",
         mtype: "平屋",
         district: "",
+        gate: "",
     }
 }
 

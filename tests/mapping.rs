@@ -126,7 +126,7 @@ fn lon_lat_without_prj_is_recognised_as_degrees() {
     copy_fixture("kyoto-small", dir.path());
     // Move the fixture to degrees near Kyoto (a crude affine map is enough) and drop the .prj
     // files: the numbers alone must tell the tool they are degrees.
-    let town = edo_city::synth::make_town(60, 1);
+    let town = edo_city::synth::make_town(60, 1, edo_city::synth::Profile::Grid);
     let to_deg = |p: [f64; 2]| {
         [
             135.75 + (p[0] + 23_000.0) / 91_000.0,

@@ -170,7 +170,7 @@ mod random_geometry {
 fn a_killed_build_loses_nothing() {
     let work = tempfile::tempdir().unwrap();
     let town = work.path().join("town");
-    edo_city::synth::write_town(&town, 4000, 5, false).unwrap();
+    edo_city::synth::write_town(&town, 4000, 5, edo_city::synth::Profile::Grid, false).unwrap();
     // References: the complete old and new cities.
     let OldAndNew {
         old_params,

@@ -143,6 +143,12 @@ pub struct SynthArgs {
     /// Seed of the town's layout.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// The kind of town: `grid` (the first synthetic town: narrow lots, few kura, a few
+    /// whole-block estates) or `kyoto` (what real towns hold: quarters of walled samurai
+    /// estates with gates and halls, a kura behind about half the houses, repeated ids; what
+    /// `make bench` builds).
+    #[arg(long, default_value = "grid", value_parser = ["grid", "kyoto"])]
+    pub profile: String,
     /// Write into a directory that already holds files (files of the same names are
     /// replaced; the others stay, and a lots.csv there is joined by `build`).
     #[arg(long)]

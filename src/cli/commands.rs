@@ -100,16 +100,28 @@ pub fn synth_command(args: SynthArgs) -> Result<()> {
         dir,
         lots,
         seed,
+        profile,
         force,
     } = args;
-    let s = edo_city::synth::write_town(&dir, lots, seed, force).map_err(anyhow::Error::msg)?;
+    let profile = edo_city::synth::Profile::parse(&profile).map_err(anyhow::Error::msg)?;
+    let s = edo_city::synth::write_town(&dir, lots, seed, profile, force)
+        .map_err(anyhow::Error::msg)?;
     say!(
-        "wrote {}: {} lots ({} machiya), {} blocks, {} streets",
+        "wrote {}: {} lots ({} machiya, {} samurai estates), {} blocks, {} streets{}",
         dir.display(),
         s.lots,
         s.machiya,
+        s.estates,
         s.blocks,
-        s.streets
+        s.streets,
+        if s.repeated_ids > 0 {
+            format!(
+                "; {} records repeat the id before them (the build lists them as skipped)",
+                s.repeated_ids
+            )
+        } else {
+            String::new()
+        }
     );
     Ok(())
 }

@@ -52,7 +52,8 @@ pub fn build_ok(input: &Path, out: &Path, extra: &[&str]) -> serde_json::Value {
 /// A synthetic town of `lots` lots written by the library's `synth` (the same as the CLI's).
 #[allow(dead_code)]
 pub fn synth(dir: &Path, lots: usize, seed: u64) {
-    edo_city::synth::write_town(dir, lots, seed, true).expect("synth writes the town");
+    edo_city::synth::write_town(dir, lots, seed, edo_city::synth::Profile::Grid, true)
+        .expect("synth writes the town");
 }
 
 pub fn read_json(path: &Path) -> serde_json::Value {
