@@ -202,12 +202,26 @@ fn colours(tris: &[([[f64; 3]; 3], [u8; 4])]) -> ([u8; 4], [u8; 4]) {
     )
 }
 
-/// Where each point's search for its nearest triangle starts, both ways of [`hausdorff`]
-/// (`usize::MAX`: where the point before it ended); sized by the first call.
+/// Where the searches of [`hausdorff`] start, both ways, carried from one candidate height to
+/// the next (the candidates differ in a few heights, so the nearest face and the farthest
+/// point rarely move).
 #[derive(Debug, Clone, Default)]
 pub struct Starts {
-    there: Vec<usize>,
-    back: Vec<usize>,
+    there: Search,
+    back: Search,
+}
+
+/// Where one way of [`hausdorff`] starts: each point's first triangle, and the point measured
+/// first.
+#[derive(Debug, Clone, Default)]
+pub struct Search {
+    /// Point `i`'s search starts at triangle `starts[i]` (`usize::MAX`, past the end or
+    /// missing: where the point before it ended); left where it ended.
+    starts: Vec<usize>,
+    /// The point measured first: the one that set the largest distance last time. Measured
+    /// first, it makes every other point's search stop at its first triangle within that
+    /// distance.
+    hot: usize,
 }
 
 /// The distance between a building (its vertices `points`, its triangles `original`) and its
@@ -223,13 +237,13 @@ pub fn hausdorff(
     cutoff: f64,
     starts: &mut Starts,
 ) -> f64 {
-    starts.there.resize(points.len(), usize::MAX);
+    starts.there.starts.resize(points.len(), usize::MAX);
     let there = error(points, tris, 0.0, cutoff, &mut starts.there);
     if there >= cutoff {
         return there;
     }
     let samples = samples(tris);
-    starts.back.resize(samples.len(), usize::MAX);
+    starts.back.starts.resize(samples.len(), usize::MAX);
     // The way back only matters where it is larger than the way there.
     error(&samples, original, there, cutoff, &mut starts.back)
 }
@@ -246,9 +260,8 @@ fn samples(tris: &[[[f64; 3]; 3]]) -> Vec<[f64; 3]> {
 }
 
 /// The largest of `floor` and the distances from each point to the nearest of the triangles;
-/// once that reaches `cutoff`, some figure no smaller. Point `i`'s search starts at triangle
-/// `starts[i]` (`usize::MAX`, or past the end: where the point before it ended), and
-/// `starts[i]` is left where it ended.
+/// once that reaches `cutoff`, some figure no smaller. `search` says where the searches start
+/// and is left where they ended ([`Search`]); the figure does not depend on it.
 ///
 /// Exact, with the early break of Taha and Hanbury (2015): a point's search stops as soon as
 /// some triangle is no farther than the largest distance found so far, since that point can
@@ -264,7 +277,7 @@ pub fn error(
     tris: &[[[f64; 3]; 3]],
     floor: f64,
     cutoff: f64,
-    starts: &mut [usize],
+    search: &mut Search,
 ) -> f64 {
     let n = tris.len();
     if n == 0 {
@@ -274,25 +287,35 @@ pub fn error(
             f64::INFINITY
         };
     }
+    let boxes: Vec<[[f64; 3]; 2]> = tris.iter().map(bounds).collect();
     let (mut worst, mut before) = (floor, 0);
-    for (i, &p) in points.iter().enumerate() {
-        let start = match starts.get(i) {
+    let hot = search.hot.min(points.len().saturating_sub(1));
+    let order = (hot..hot + 1).chain((0..points.len()).filter(|&i| i != hot));
+    for i in order.take(points.len()) {
+        let p = points[i];
+        let start = match search.starts.get(i) {
             Some(&s) if s < n => s,
             _ => before,
         };
-        let (mut nearest, mut at) = (f64::INFINITY, start);
+        let (mut nearest, mut nearest2, mut at) = (f64::INFINITY, f64::INFINITY, start);
         for k in 0..n {
             let j = (start + k) % n;
-            let d = distance(p, &tris[j]);
-            if d < nearest {
-                (nearest, at) = (d, j);
+            // A triangle whose box is no nearer than the nearest so far cannot be nearer.
+            if box_distance2(p, &boxes[j]) >= nearest2 {
+                continue;
+            }
+            let d2 = distance2(p, &tris[j]);
+            if d2 < nearest2 {
+                (nearest, nearest2, at) = (d2.sqrt(), d2, j);
                 if nearest <= worst {
                     break;
                 }
             }
         }
-        worst = worst.max(nearest);
-        if let Some(s) = starts.get_mut(i) {
+        if nearest > worst {
+            (worst, search.hot) = (nearest, i);
+        }
+        if let Some(s) = search.starts.get_mut(i) {
             *s = at;
         }
         before = at;
@@ -301,6 +324,22 @@ pub fn error(
         }
     }
     worst
+}
+
+/// A triangle's bounding box, grown by a micrometre so that a closest point computed with
+/// rounding still lies inside it: the box's distance stays a lower bound of the triangle's.
+fn bounds(t: &[[f64; 3]; 3]) -> [[f64; 3]; 2] {
+    const SLACK: f64 = 1e-6;
+    let lo = [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k]) - SLACK);
+    let hi = [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k]) + SLACK);
+    [lo, hi]
+}
+
+/// The squared distance from `p` to the box `b`.
+fn box_distance2(p: [f64; 3], b: &[[f64; 3]; 2]) -> f64 {
+    let gap = |k: usize| (b[0][k] - p[k]).max(p[k] - b[1][k]).max(0.0);
+    let (x, y, z) = (gap(0), gap(1), gap(2));
+    x * x + y * y + z * z
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -322,9 +361,14 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// The distance from `p` to triangle `t`: to its closest point, found by the triangle's
 /// Voronoi regions (Ericson, Real-Time Collision Detection, 5.1.5).
 pub fn distance(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
+    distance2(p, t).sqrt()
+}
+
+/// The squared distance from `p` to triangle `t` (the root is taken only for a new nearest).
+fn distance2(p: [f64; 3], t: &[[f64; 3]; 3]) -> f64 {
     let [a, b, c] = *t;
     let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
-    let at = |q: [f64; 3]| dot(sub(p, q), sub(p, q)).sqrt();
+    let at = |q: [f64; 3]| dot(sub(p, q), sub(p, q));
     let lerp =
         |u: [f64; 3], d: [f64; 3], s: f64| [u[0] + d[0] * s, u[1] + d[1] * s, u[2] + d[2] * s];
     let (d1, d2) = (dot(ab, ap), dot(ac, ap));
@@ -460,34 +504,44 @@ mod tests {
             .fold(0.0, f64::max);
         let inf = f64::INFINITY;
         assert_eq!(
-            error(&points, &tris, 0.0, inf, &mut []).to_bits(),
+            error(&points, &tris, 0.0, inf, &mut Search::default()).to_bits(),
             brute.to_bits()
         );
-        assert_eq!(error(&[], &tris, 0.0, inf, &mut []), 0.0);
-        assert_eq!(error(&points, &[], 0.0, inf, &mut []), inf);
+        assert_eq!(error(&[], &tris, 0.0, inf, &mut Search::default()), 0.0);
+        assert_eq!(error(&points, &[], 0.0, inf, &mut Search::default()), inf);
         // Any starts, and the starts a search left, find the same.
-        let mut starts = vec![usize::MAX; 300];
-        starts[..150].fill(7);
+        let mut search = Search {
+            starts: vec![usize::MAX; 300],
+            hot: 123,
+        };
+        search.starts[..150].fill(7);
         for _ in 0..2 {
-            let e = error(&points, &tris, 0.0, inf, &mut starts);
+            let e = error(&points, &tris, 0.0, inf, &mut search);
             assert_eq!(e.to_bits(), brute.to_bits());
         }
-        assert!(starts.iter().all(|&s| s < 200));
+        assert!(search.starts.iter().all(|&s| s < 200));
+        // The point measured first is the farthest one.
+        let farthest = |p: [f64; 3]| {
+            tris.iter()
+                .map(|t| distance(p, t))
+                .fold(f64::INFINITY, f64::min)
+        };
+        assert_eq!(farthest(points[search.hot]).to_bits(), brute.to_bits());
         // A floor below the largest distance does not change it; one above it is the answer.
         assert_eq!(
-            error(&points, &tris, brute / 2.0, inf, &mut []).to_bits(),
+            error(&points, &tris, brute / 2.0, inf, &mut Search::default()).to_bits(),
             brute.to_bits()
         );
         assert_eq!(
-            error(&points, &tris, brute * 2.0, inf, &mut []),
+            error(&points, &tris, brute * 2.0, inf, &mut Search::default()),
             brute * 2.0
         );
         // A cutoff below it stops early with a figure no smaller than the cutoff; one above
         // it changes nothing.
-        let cut = error(&points, &tris, 0.0, brute / 2.0, &mut []);
+        let cut = error(&points, &tris, 0.0, brute / 2.0, &mut Search::default());
         assert!(cut >= brute / 2.0 && cut <= brute, "{cut} of {brute}");
         assert_eq!(
-            error(&points, &tris, 0.0, brute * 1.01, &mut []).to_bits(),
+            error(&points, &tris, 0.0, brute * 1.01, &mut Search::default()).to_bits(),
             brute.to_bits()
         );
     }
@@ -521,8 +575,8 @@ mod tests {
         let original: Vec<_> = tris.iter().map(|(t, _)| *t).collect();
         let full = |massing: &[[[f64; 3]; 3]]| {
             let inf = f64::INFINITY;
-            let there = error(&points, massing, 0.0, inf, &mut []);
-            there.max(error(&samples(massing), &original, 0.0, inf, &mut []))
+            let there = error(&points, massing, 0.0, inf, &mut Search::default());
+            there.max(error(&samples(massing), &original, 0.0, inf, &mut Search::default()))
         };
         let (mut gable, mut flat) = ((f64::INFINITY, 0.0), (f64::INFINITY, 0.0));
         for k in STEPS / 2..=STEPS {
