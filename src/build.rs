@@ -27,6 +27,7 @@ use crate::templates::{Catalog, Kind, TemplateError};
 pub mod cache;
 mod check;
 mod city;
+mod clock;
 pub mod merge;
 mod names;
 mod plan_files;
@@ -34,6 +35,7 @@ pub mod shards;
 mod writing;
 
 pub use check::check;
+pub use clock::{StageClock, StageTime};
 pub use plan_files::{draw_plan_from, draw_plan_of, merge_plan_files};
 
 /// Progress of the long stages; the CLI draws bars, tests pass [`NoProgress`].
@@ -159,6 +161,10 @@ pub struct Timings {
     pub write_cpu: Duration,
     /// The whole run.
     pub total: Duration,
+    /// Wall and processor time of each stage in order: read and analyse, the tiles (with
+    /// plan.png and plan.gpkg beside them), the whole-city files (levels of detail, city
+    /// model), the plan files and report.
+    pub stages: Vec<StageTime>,
 }
 
 /// What a finished build returns to the CLI.
@@ -385,6 +391,7 @@ fn run(
             .and_then(|dir| Some((cache::file_for(dir, &opts.out), cache::key(opts)?))),
     };
     let t = Instant::now();
+    let clock = StageClock::start();
     let cached = match (&opts.selection, &cache) {
         (Selection::Tiles(_), Some((file, key))) => {
             progress.start("reading the analysis cache", 0);
@@ -404,6 +411,11 @@ fn run(
     let store = cache.as_ref().filter(|_| !reused);
     timings.read = read;
     timings.analyse = analysed;
+    timings.stages.push(clock.stop(if reused {
+        "analysis from the cache"
+    } else {
+        "read and analyse"
+    }));
     timings.kura = plan.kura_time;
     timings.billboards = plan.billboards_time;
     timings.steps = plan.step_times.clone();
@@ -527,9 +539,11 @@ fn write_city(
         (started, t.elapsed())
     };
     let draw = || city::draw_plan(&data, &plan, params, opts.plan_image);
+    let clock = StageClock::start();
     let (((image, plan_time), (gpkg, gpkg_time)), results) =
         rayon::join(|| rayon::join(draw, start_gpkg), make_tiles);
     progress.finish();
+    timings.stages.push(clock.stop("tiles"));
     // Its maps of every lot and house are not needed by the levels of detail, the slowest
     // and largest step after the tiles (1,000,000 lots: tens of MB).
     drop(directory);
@@ -542,12 +556,18 @@ fn write_city(
         .collect();
     let bytes_written: u64 =
         written.iter().map(|t| t.bytes()).sum::<u64>() + models.values().sum::<u64>();
+    let clock = StageClock::start();
     let mut manifest = writer.manifest(&data, &plan, written, previous);
     let beside = city::Beside { image, gpkg };
     let (gpkg_after, png_time) = writer.plan_files(&mut manifest, &data, beside, &sources)?;
+    timings.stages.push(clock.stop("manifest and plan files"));
     // Freeing the analysis's millions of small allocations takes a moment nobody waits for.
     std::thread::spawn(move || drop((data, plan)));
+    let clock = StageClock::start();
     let (report, stale_time) = writer.finish(manifest)?;
+    timings
+        .stages
+        .push(clock.stop("whole-city files and report"));
     timings.gpkg = [gpkg_time, gpkg_after];
     timings.generate_and_write = t.elapsed() - png_time - stale_time;
     // Drawn beside the tiles: its own time, not the wall time it added.

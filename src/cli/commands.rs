@@ -81,6 +81,17 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
             t.gpkg[1].as_secs_f64(),
             t.total.as_secs_f64()
         );
+        let stages: Vec<String> = (t.stages.iter())
+            .map(|s| {
+                format!(
+                    "{} {:.3} s (cpu/wall {:.2})",
+                    s.name,
+                    s.wall.as_secs_f64(),
+                    s.busy()
+                )
+            })
+            .collect();
+        tell!("timings of the stages: {}", stages.join(", "));
         // "people and trees" above is every step after the fences; here each of them.
         let steps: Vec<String> = t
             .steps

@@ -576,7 +576,13 @@ mod tests {
         let full = |massing: &[[[f64; 3]; 3]]| {
             let inf = f64::INFINITY;
             let there = error(&points, massing, 0.0, inf, &mut Search::default());
-            there.max(error(&samples(massing), &original, 0.0, inf, &mut Search::default()))
+            there.max(error(
+                &samples(massing),
+                &original,
+                0.0,
+                inf,
+                &mut Search::default(),
+            ))
         };
         let (mut gable, mut flat) = ((f64::INFINITY, 0.0), (f64::INFINITY, 0.0));
         for k in STEPS / 2..=STEPS {
