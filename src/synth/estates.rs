@@ -7,8 +7,7 @@
 
 use rand::RngExt;
 
-use super::layout::{rect, BLOCK};
-use super::SynthLot;
+use super::{rect, SynthLot, BLOCK};
 use crate::rng::feature_rng;
 
 /// Share of the 2 x 2-block quarters given to estates: with six estates to an estate block and

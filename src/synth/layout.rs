@@ -6,13 +6,9 @@ use std::ops::Range;
 use rand::RngExt;
 use rand_pcg::Pcg64;
 
-use super::{estates, Profile, SynthLot, Town, BASE, KEN};
+use super::{estates, rect, Profile, SynthLot, Town, BASE, BLOCK, KEN};
 use crate::rng::feature_rng;
 
-/// One jo (丈) in metres.
-pub const JO: f64 = 3.03;
-/// A block's side: 40 jo (121.2 m).
-pub(super) const BLOCK: f64 = 40.0 * JO;
 const STREET: f64 = 7.0;
 const AVENUE: f64 = 12.0;
 
@@ -171,10 +167,6 @@ pub fn make_town(lots_wanted: usize, seed: u64, profile: Profile) -> Town {
         blocks,
         streets,
     }
-}
-
-pub(super) fn rect(x0: f64, y0: f64, w: f64, h: f64) -> Vec<[f64; 2]> {
-    vec![[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]]
 }
 
 /// Frontage widths that fill `length` exactly, each within `ken` (in ken).

@@ -18,11 +18,15 @@ mod write;
 
 use std::path::Path;
 
-pub use layout::{make_town, JO};
+pub use layout::make_town;
 pub use write::{stamp_dbf_date, write_blocks, write_lots, DBF_DATE};
 
 /// One ken (間), the unit of frontage, in metres.
 pub const KEN: f64 = 1.818;
+/// One jo (丈) in metres.
+pub const JO: f64 = 3.03;
+/// A block's side: 40 jo (121.2 m).
+const BLOCK: f64 = 40.0 * JO;
 /// South-west corner of the synthetic town (zone VI: x east, y north).
 const BASE: [f64; 2] = [-23_000.0, -110_000.0];
 
@@ -61,6 +65,11 @@ impl Profile {
             Profile::Kyoto => "1",
         }
     }
+}
+
+/// An axis-aligned rectangle, counter-clockwise from its south-west corner.
+fn rect(x0: f64, y0: f64, w: f64, h: f64) -> Vec<[f64; 2]> {
+    vec![[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]]
 }
 
 /// What `synth` wrote.
