@@ -33,6 +33,8 @@ struct Cut {
     /// Share of the side lines between deep strips that are slanted (by up to 1 %), as
     /// cadastral lines are; a slanted line makes the two lots' kura plots overlap.
     slanted: f64,
+    /// A block drawn below the first is one samurai lot, below the second one temple.
+    whole_blocks: (f64, f64),
 }
 
 impl Profile {
@@ -42,6 +44,7 @@ impl Profile {
                 frontage_ken: 1.5..5.0,
                 side_depth: 14.0..22.0,
                 slanted: 1.0,
+                whole_blocks: (0.05, 0.08),
             },
             // Wider and deeper lots with mostly square side lines: a kura behind about half
             // the houses after collision avoidance, as the real towns users build hold.
@@ -49,6 +52,7 @@ impl Profile {
                 frontage_ken: 2.0..6.0,
                 side_depth: 22.0..30.0,
                 slanted: 0.35,
+                whole_blocks: (0.01, 0.03),
             },
         }
     }
@@ -124,10 +128,7 @@ pub fn make_town(lots_wanted: usize, seed: u64, profile: Profile) -> Town {
                 continue;
             }
             let roll = rng.random::<f64>();
-            let (buke, jisha) = match profile {
-                Profile::Grid => (0.05, 0.08),
-                Profile::Kyoto => (0.01, 0.03),
-            };
+            let (buke, jisha) = cut.whole_blocks;
             if roll < buke || (roll < jisha && lots_wanted - lots.len() > 1) {
                 lots.push(SynthLot {
                     id: lots.len() as u64 + 1,
@@ -143,8 +144,8 @@ pub fn make_town(lots_wanted: usize, seed: u64, profile: Profile) -> Town {
         }
         by += 1;
     }
+    // `ys` reaches the last row built, or the planned grid's last.
     let ny = by.max(ny_planned);
-    let ys = street_lines(ny);
     let mut streets = Vec::new();
     let (x_end, y_end) = (xs[nx], ys[ny]);
     for (i, x) in xs.iter().enumerate() {
