@@ -61,6 +61,8 @@ pub fn mass(id: u32, tris: &[([[f64; 3]; 3], [u8; 4])]) -> Option<Mass> {
         flat_error: f64::INFINITY,
     };
     let original: Vec<[[f64; 3]; 3]> = tris.iter().map(|(t, _)| *t).collect();
+    // Measured against by every candidate: its boxes once.
+    let original = Faces::new(&original);
     // Where each point's search starts, per kind of massing: where it ended for the height
     // before (the candidates differ in a few heights, so the nearest face rarely moves).
     let (mut gable_starts, mut flat_starts) = (Starts::default(), Starts::default());
@@ -232,13 +234,13 @@ pub struct Search {
 /// has lost, by how much does not matter.
 pub fn hausdorff(
     points: &[[f64; 3]],
-    original: &[[[f64; 3]; 3]],
+    original: &Faces,
     tris: &[[[f64; 3]; 3]],
     cutoff: f64,
     starts: &mut Starts,
 ) -> f64 {
     starts.there.starts.resize(points.len(), usize::MAX);
-    let there = error(points, tris, 0.0, cutoff, &mut starts.there);
+    let there = error(points, &Faces::new(tris), 0.0, cutoff, &mut starts.there);
     if there >= cutoff {
         return there;
     }
@@ -274,11 +276,12 @@ fn samples(tris: &[[[f64; 3]; 3]]) -> Vec<[f64; 3]> {
 /// lots: the massing's error was still 52 % of the build without them).
 pub fn error(
     points: &[[f64; 3]],
-    tris: &[[[f64; 3]; 3]],
+    faces: &Faces,
     floor: f64,
     cutoff: f64,
     search: &mut Search,
 ) -> f64 {
+    let Faces { tris, boxes } = faces;
     let n = tris.len();
     if n == 0 {
         return if points.is_empty() {
@@ -287,7 +290,6 @@ pub fn error(
             f64::INFINITY
         };
     }
-    let boxes: Vec<[[f64; 3]; 2]> = tris.iter().map(bounds).collect();
     let (mut worst, mut before) = (floor, 0);
     let hot = search.hot.min(points.len().saturating_sub(1));
     let order = (hot..hot + 1).chain((0..points.len()).filter(|&i| i != hot));
@@ -324,6 +326,24 @@ pub fn error(
         }
     }
     worst
+}
+
+/// Triangles with their bounding boxes, made once for every search against them: a box
+/// farther than the nearest triangle found so far rules its triangle out for three clamps.
+#[derive(Debug, Clone)]
+pub struct Faces<'a> {
+    tris: &'a [[[f64; 3]; 3]],
+    boxes: Vec<[[f64; 3]; 2]>,
+}
+
+impl<'a> Faces<'a> {
+    /// The triangles `tris` and their boxes.
+    pub fn new(tris: &'a [[[f64; 3]; 3]]) -> Self {
+        Faces {
+            tris,
+            boxes: tris.iter().map(bounds).collect(),
+        }
+    }
 }
 
 /// A triangle's bounding box, grown by a micrometre so that a closest point computed with
@@ -504,11 +524,24 @@ mod tests {
             .fold(0.0, f64::max);
         let inf = f64::INFINITY;
         assert_eq!(
-            error(&points, &tris, 0.0, inf, &mut Search::default()).to_bits(),
+            error(
+                &points,
+                &Faces::new(&tris),
+                0.0,
+                inf,
+                &mut Search::default()
+            )
+            .to_bits(),
             brute.to_bits()
         );
-        assert_eq!(error(&[], &tris, 0.0, inf, &mut Search::default()), 0.0);
-        assert_eq!(error(&points, &[], 0.0, inf, &mut Search::default()), inf);
+        assert_eq!(
+            error(&[], &Faces::new(&tris), 0.0, inf, &mut Search::default()),
+            0.0
+        );
+        assert_eq!(
+            error(&points, &Faces::new(&[]), 0.0, inf, &mut Search::default()),
+            inf
+        );
         // Any starts, and the starts a search left, find the same.
         let mut search = Search {
             starts: vec![usize::MAX; 300],
@@ -516,7 +549,7 @@ mod tests {
         };
         search.starts[..150].fill(7);
         for _ in 0..2 {
-            let e = error(&points, &tris, 0.0, inf, &mut search);
+            let e = error(&points, &Faces::new(&tris), 0.0, inf, &mut search);
             assert_eq!(e.to_bits(), brute.to_bits());
         }
         assert!(search.starts.iter().all(|&s| s < 200));
@@ -529,19 +562,45 @@ mod tests {
         assert_eq!(farthest(points[search.hot]).to_bits(), brute.to_bits());
         // A floor below the largest distance does not change it; one above it is the answer.
         assert_eq!(
-            error(&points, &tris, brute / 2.0, inf, &mut Search::default()).to_bits(),
+            error(
+                &points,
+                &Faces::new(&tris),
+                brute / 2.0,
+                inf,
+                &mut Search::default()
+            )
+            .to_bits(),
             brute.to_bits()
         );
         assert_eq!(
-            error(&points, &tris, brute * 2.0, inf, &mut Search::default()),
+            error(
+                &points,
+                &Faces::new(&tris),
+                brute * 2.0,
+                inf,
+                &mut Search::default()
+            ),
             brute * 2.0
         );
         // A cutoff below it stops early with a figure no smaller than the cutoff; one above
         // it changes nothing.
-        let cut = error(&points, &tris, 0.0, brute / 2.0, &mut Search::default());
+        let cut = error(
+            &points,
+            &Faces::new(&tris),
+            0.0,
+            brute / 2.0,
+            &mut Search::default(),
+        );
         assert!(cut >= brute / 2.0 && cut <= brute, "{cut} of {brute}");
         assert_eq!(
-            error(&points, &tris, 0.0, brute * 1.01, &mut Search::default()).to_bits(),
+            error(
+                &points,
+                &Faces::new(&tris),
+                0.0,
+                brute * 1.01,
+                &mut Search::default()
+            )
+            .to_bits(),
             brute.to_bits()
         );
     }
@@ -575,10 +634,16 @@ mod tests {
         let original: Vec<_> = tris.iter().map(|(t, _)| *t).collect();
         let full = |massing: &[[[f64; 3]; 3]]| {
             let inf = f64::INFINITY;
-            let there = error(&points, massing, 0.0, inf, &mut Search::default());
+            let there = error(
+                &points,
+                &Faces::new(massing),
+                0.0,
+                inf,
+                &mut Search::default(),
+            );
             there.max(error(
                 &samples(massing),
-                &original,
+                &Faces::new(&original),
                 0.0,
                 inf,
                 &mut Search::default(),
