@@ -66,15 +66,11 @@ pub(super) fn repeat_ids(lots: &mut [SynthLot], seed: u64) {
 mod tests {
     use super::*;
 
+    /// Signed area (geo's), positive for a counter-clockwise ring.
     fn area(ring: &[[f64; 2]]) -> f64 {
-        let n = ring.len();
-        (0..n)
-            .map(|i| {
-                let (a, b) = (ring[i], ring[(i + 1) % n]);
-                a[0] * b[1] - b[0] * a[1]
-            })
-            .sum::<f64>()
-            / 2.0
+        use geo::Area;
+        let line: Vec<(f64, f64)> = ring.iter().map(|p| (p[0], p[1])).collect();
+        geo::Polygon::new(line.into(), vec![]).signed_area()
     }
 
     #[test]
