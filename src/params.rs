@@ -14,6 +14,7 @@ mod billboards;
 mod crowd;
 mod garden;
 mod halls;
+mod input;
 mod landmarks;
 mod layers;
 pub mod output;
@@ -24,6 +25,7 @@ pub use billboards::{PeopleParams, PointsLayer, TreesParams};
 pub use crowd::CrowdParams;
 pub use garden::GardenParams;
 pub use halls::{GroundParams, HallParams};
+pub use input::InputParams;
 pub use landmarks::{LandmarkParams, LandmarksLayer, MAX_OFFSET, MAX_SIZE, MIN_SIZE};
 pub use layers::*;
 pub use output::OutputParams;
@@ -84,6 +86,9 @@ pub struct Params {
     pub crs: String,
     /// Where each layer is and which fields hold what.
     pub layers: Layers,
+    /// The input's extra files: the per-lot overrides. Left out of a manifest when unset.
+    #[serde(default, skip_serializing_if = "InputParams::is_empty")]
+    pub input: InputParams,
     /// The constants of Fig.4.
     pub frontage: FrontageParams,
     /// The machiya: depth, minimum depth, type templates.

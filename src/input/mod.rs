@@ -24,6 +24,7 @@ mod landmarks;
 mod lines;
 mod links;
 pub mod models;
+pub mod overrides;
 mod polygons;
 mod target;
 

@@ -8,7 +8,7 @@ use super::crs::Crs;
 use super::fields::AttributeRule;
 use super::geometry::{check_polygon, map_polygon, polygons_of};
 use super::target::to_target;
-use super::{join, rule, shp, table, InputError, Opened};
+use super::{join, overrides, rule, shp, table, InputError, Opened};
 use crate::model::{Dataset, Footprint, Lot, LotUse, Skipped, SkippedShape};
 use crate::params::Params;
 
@@ -96,6 +96,11 @@ pub(super) fn read_lots(
         data.joins
             .push(join(&mut lots, &base_ids, t, "lots", &mut data.skipped));
     }
+    let overrides = overrides::read(&params.input.overrides)?;
+    if let Some((file, rows)) = &overrides {
+        let joined = overrides::apply_attributes(&mut lots, &base_ids, rows, file)?;
+        data.joins.push(joined);
+    }
     let mut bad_ground = 0usize;
     for lot in &mut lots {
         lot.lot_use = LotUse::parse(&use_rule.value(&lot.attrs).unwrap_or_default());
@@ -108,6 +113,9 @@ pub(super) fn read_lots(
                 _ => bad_ground += 1,
             }
         }
+    }
+    if let Some((file, rows)) = &overrides {
+        overrides::apply_roles(&mut lots, &base_ids, rows, file)?;
     }
     lots.retain(|lot| match ground_problem(lot.ground) {
         None => true,

@@ -17,6 +17,7 @@ pub struct Params {
     origin: Option<[f64; 2]>,
     crs: Option<String>,
     layers: Option<Layers>,
+    input: Option<super::input::partial::Input>,
     frontage: Option<Frontage>,
     machiya: Option<Machiya>,
     kura: Option<Kura>,

@@ -61,15 +61,23 @@ pub(super) fn resolved_table(
     Ok(merged)
 }
 
-/// `garden.designs`, when relative, made relative to `base_dir` (the directory of the file
-/// that names it: a parameter file kept beside its designs works from anywhere), and
+/// `garden.designs` and `input.overrides`, when relative, made relative to `base_dir` (the
+/// directory of the file that names it: a parameter file kept beside its designs or its
+/// overrides works from anywhere), and
 /// absolute: the analysis cache's key (`build::cache::key`) hashes the file the parameter
 /// names, which a path relative to the current directory would not find.
 fn anchor_designs(table: &mut toml::Table, base_dir: &Path) {
-    let Some(toml::Value::Table(garden)) = table.get_mut("garden") else {
+    for (section, key) in [("garden", "designs"), ("input", "overrides")] {
+        anchor(table, section, key, base_dir);
+    }
+}
+
+/// `[section] key`, a file name, anchored to `base_dir` (see [`anchor_designs`]).
+fn anchor(table: &mut toml::Table, section: &str, key: &str, base_dir: &Path) {
+    let Some(toml::Value::Table(t)) = table.get_mut(section) else {
         return;
     };
-    if let Some(toml::Value::String(file)) = garden.get_mut("designs") {
+    if let Some(toml::Value::String(file)) = t.get_mut(key) {
         if !file.is_empty() && Path::new(file.as_str()).is_relative() {
             let joined = base_dir.join(file.as_str());
             let absolute = std::path::absolute(&joined).unwrap_or(joined);

@@ -1,0 +1,280 @@
+//! The per-lot overrides `[input] overrides` names (issue 61): a CSV table `lot,field,value`
+//! that the browser's workbench writes one edit a row, so that "what if this lot was a
+//! sangai?" needs no edited DBF. Later rows win over earlier ones for the same lot and field.
+//!
+//! A row naming a lot the layer does not have, a field that is no field, or a use that is no
+//! use stops the build with the file, the row and what to do: an override is a person's
+//! deliberate edit, and building past it would show a city they did not ask for. The table
+//! is listed in the report as a table joined to the lots (its rows, the lots it matched).
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use super::InputError;
+use crate::model::{Lot, LotUse, TableJoin};
+
+/// The largest overrides file read: a million edits of a few dozen bytes.
+pub const MAX_OVERRIDES_BYTES: u64 = 64 << 20;
+/// The most rows an overrides file may hold.
+pub const MAX_ROWS: usize = 1_000_000;
+/// The longest field name and value.
+const MAX_TEXT: usize = 1000;
+/// The lot fields edo-city itself decides from: set on the lot after the value maps.
+pub const ROLES: [&str; 3] = ["use", "mtype", "district"];
+/// The header an overrides file begins with.
+pub const HEADER: [&str; 3] = ["lot", "field", "value"];
+
+/// One edit: lot `lot`'s `field` is `value`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Override {
+    /// The lot's id (a multipart lot's record id reaches every part).
+    pub lot: String,
+    /// A role of [`ROLES`] or an attribute name.
+    pub field: String,
+    /// The new value; "" for a role clears it (a type drawn again, no district).
+    pub value: String,
+    /// The row in the file (the header is row 1).
+    pub row: usize,
+}
+
+/// The rows of an overrides file's text, checked; `file` names it in errors.
+pub fn parse(text: &str, file: &str) -> Result<Vec<Override>, InputError> {
+    let bad = |row: usize, message: String| InputError::Table {
+        file: file.to_string(),
+        message: format!("row {row}: {message}"),
+    };
+    let text = text.trim_start_matches('\u{feff}');
+    let mut reader = csv::ReaderBuilder::new()
+        .flexible(false)
+        .from_reader(text.as_bytes());
+    let headers: Vec<String> = reader
+        .headers()
+        .map_err(|e| bad(1, format!("cannot read the header: {e}")))?
+        .iter()
+        .map(|h| h.trim().to_lowercase())
+        .collect();
+    if headers != HEADER {
+        return Err(bad(
+            1,
+            format!(
+                "the header must be `lot,field,value`, got `{}`",
+                headers.join(",")
+            ),
+        ));
+    }
+    let mut rows = Vec::new();
+    for (n, record) in reader.records().enumerate() {
+        let row = n + 2;
+        let record = record.map_err(|e| bad(row, e.to_string()))?;
+        if rows.len() >= MAX_ROWS {
+            return Err(bad(
+                row,
+                format!("more than {MAX_ROWS} overrides: fold them into the lots' table"),
+            ));
+        }
+        let cell = |i: usize| record.get(i).unwrap_or("").trim().to_string();
+        let o = Override {
+            lot: cell(0),
+            field: cell(1),
+            value: cell(2),
+            row,
+        };
+        check(&o).map_err(|m| bad(row, m))?;
+        rows.push(o);
+    }
+    Ok(rows)
+}
+
+/// What is wrong with one row on its own, if anything.
+fn check(o: &Override) -> Result<(), String> {
+    if o.lot.is_empty() {
+        return Err("no lot id".into());
+    }
+    if o.field.is_empty() || o.field.len() > 64 || o.field.chars().any(char::is_control) {
+        return Err(format!(
+            "`{}` is not a field name (up to 64 characters, no control characters)",
+            o.field
+        ));
+    }
+    if o.value.len() > MAX_TEXT || o.lot.len() > MAX_TEXT {
+        return Err(format!("a value longer than {MAX_TEXT} bytes"));
+    }
+    if o.field == "use" {
+        use_of(&o.value)?;
+    }
+    Ok(())
+}
+
+/// A use an override may give: one edo-city knows, or `other`.
+pub fn use_of(value: &str) -> Result<LotUse, String> {
+    match LotUse::parse(value) {
+        LotUse::Other(v) if !v.eq_ignore_ascii_case("other") => Err(format!(
+            "`{value}` is not a lot use: give machiya, buke, kuge, jisha or other"
+        )),
+        u => Ok(u),
+    }
+}
+
+/// The overrides as a CSV table, header first, one row an edit, as [`parse`] reads it.
+pub fn to_csv(rows: &[Override]) -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let _ = w.write_record(HEADER);
+    for o in rows {
+        let _ = w.write_record([&o.lot, &o.field, &o.value]);
+    }
+    let bytes = w.into_inner().unwrap_or_default();
+    String::from_utf8(bytes).unwrap_or_default()
+}
+
+/// Reads the file `[input] overrides` names, if any: its label for the report and its rows.
+pub(super) fn read(name: &str) -> Result<Option<(String, Vec<Override>)>, InputError> {
+    if name.is_empty() {
+        return Ok(None);
+    }
+    let text = crate::bounded::read_text(Path::new(name), MAX_OVERRIDES_BYTES).map_err(|e| {
+        InputError::Table {
+            file: name.to_string(),
+            message: format!(
+                "the overrides file {e}: `input.overrides` names it, relative to the parameter \
+                 file (`edo-city serve OUT --edit PARAMS.toml` writes one)"
+            ),
+        }
+    })?;
+    // Named by its file name alone: it may lie outside the input, and a build publishes no
+    // one's directories.
+    let label = Path::new(name)
+        .file_name()
+        .map_or_else(|| name.to_string(), |n| n.to_string_lossy().into_owned());
+    Ok(Some((label.clone(), parse(&text, &label)?)))
+}
+
+/// Where each override lands: the lots by id (a record id reaches each of its parts); an
+/// error names the first row whose lot the layer does not have.
+fn targets(
+    lots: &[Lot],
+    base_ids: &[String],
+    rows: &[Override],
+    file: &str,
+) -> Result<Vec<Vec<usize>>, InputError> {
+    let mut index: HashMap<&str, Vec<usize>> = HashMap::new();
+    for (i, (lot, base)) in lots.iter().zip(base_ids).enumerate() {
+        index.entry(base.as_str()).or_default().push(i);
+        if lot.id != *base {
+            index.entry(lot.id.as_str()).or_default().push(i);
+        }
+    }
+    rows.iter()
+        .map(|o| {
+            index
+                .get(o.lot.as_str())
+                .cloned()
+                .ok_or_else(|| InputError::Table {
+                    file: file.to_string(),
+                    message: format!(
+                    "row {}: no lot has the id `{}`: remove the row, or give an id of the lots \
+                     layer",
+                    o.row, o.lot
+                ),
+                })
+        })
+        .collect()
+}
+
+/// The attribute rows applied to the lots (before the lots' fields are read from their
+/// attributes, so a template's attribute and a mapped field see them); the table's entry
+/// for the report.
+pub(super) fn apply_attributes(
+    lots: &mut [Lot],
+    base_ids: &[String],
+    rows: &[Override],
+    file: &str,
+) -> Result<TableJoin, InputError> {
+    let at = targets(lots, base_ids, rows, file)?;
+    let mut names = crate::model::FieldNames::default();
+    let mut matched = vec![false; lots.len()];
+    for (o, at) in rows.iter().zip(&at) {
+        for &i in at {
+            matched[i] = true;
+            if !ROLES.contains(&o.field.as_str()) {
+                lots[i]
+                    .attrs
+                    .insert(names.intern(&o.field), o.value.as_str());
+            }
+        }
+    }
+    Ok(TableJoin {
+        layer: "lots".into(),
+        file: file.to_string(),
+        rows: rows.len(),
+        matched: rows.len(),
+        rows_without_feature: 0,
+        rows_without_feature_ids: Vec::new(),
+        features_without_row: matched.iter().filter(|m| !**m).count(),
+    })
+}
+
+/// The role rows (use, type, district) applied to the lots, after their fields were read:
+/// an override gives edo-city's own value, not the data's raw one a value map would turn.
+pub(super) fn apply_roles(
+    lots: &mut [Lot],
+    base_ids: &[String],
+    rows: &[Override],
+    file: &str,
+) -> Result<(), InputError> {
+    let at = targets(lots, base_ids, rows, file)?;
+    let some = |v: &str| (!v.is_empty()).then(|| v.to_string());
+    for (o, at) in rows.iter().zip(&at) {
+        for &i in at {
+            let lot = &mut lots[i];
+            match o.field.as_str() {
+                "use" => lot.lot_use = use_of(&o.value).unwrap_or(LotUse::Machiya),
+                "mtype" => lot.mtype = some(&o.value),
+                "district" => lot.district = some(&o.value),
+                _ => {}
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_read_back_as_written() {
+        let rows = vec![
+            Override {
+                lot: "12_3".into(),
+                field: "mtype".into(),
+                value: "sangai".into(),
+                row: 2,
+            },
+            Override {
+                lot: "a,b \"c\"".into(),
+                field: "storeys".into(),
+                value: "3".into(),
+                row: 3,
+            },
+        ];
+        let text = to_csv(&rows);
+        assert!(text.starts_with("lot,field,value\n"), "{text}");
+        assert_eq!(parse(&text, "o.csv").unwrap(), rows);
+        assert!(parse("lot,field,value\n", "o.csv").unwrap().is_empty());
+    }
+
+    #[test]
+    fn bad_rows_are_named_with_what_to_do() {
+        let err = |t: &str| parse(t, "o.csv").unwrap_err().to_string();
+        assert!(err("id,f,v\n").contains("row 1: the header must be"));
+        let e = err("lot,field,value\n1,use,castle\n");
+        assert!(
+            e.contains("o.csv") && e.contains("row 2") && e.contains("`castle`"),
+            "{e}"
+        );
+        assert!(err("lot,field,value\n,use,buke\n").contains("no lot id"));
+        assert!(err("lot,field,value\n1,,buke\n").contains("not a field name"));
+        assert!(err("lot,field,value\n1,use\n").contains("row 2"));
+        assert!(use_of("武家地").is_ok() && use_of("Other").is_ok());
+    }
+}
