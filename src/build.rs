@@ -31,6 +31,7 @@ mod clock;
 pub mod merge;
 mod names;
 mod plan_files;
+pub mod reuse;
 pub mod shards;
 mod writing;
 
@@ -133,6 +134,11 @@ pub struct BuildOptions {
     /// The analysis cache's directory (`cache::dir_from` the environment, at the command
     /// line); `None`: no cache.
     pub cache: Option<PathBuf>,
+    /// The fingerprints of the build before this one in the same directory, when this build
+    /// may keep the tiles that would come out the same (`reuse`: the workbench's rebuilds;
+    /// an empty set makes every tile and starts the record). The directory is then the
+    /// caller's: a build of other parameters in it is replaced, as with `force`.
+    pub reuse: Option<std::sync::Arc<reuse::Fingerprints>>,
 }
 
 /// Wall time of each stage.
@@ -180,6 +186,9 @@ pub struct BuildOutcome {
     pub tiles_written: usize,
     /// Whether the analysis ran or came from the cache.
     pub cache: cache::CacheUse,
+    /// With [`BuildOptions::reuse`]: what each tile was made from, for the next build, and
+    /// the tiles this one made (the others were kept).
+    pub fingerprints: Option<(reuse::Fingerprints, Vec<String>)>,
 }
 
 /// Loads the machiya types and checks `type_mix` against them.
@@ -506,14 +515,18 @@ fn write_city(
     let tiles: Vec<&String> = (plan.tiles.iter())
         .filter(|id| selected.contains(id.as_str()))
         .collect();
+    let reuse = (opts.reuse.as_deref()).map(|before| {
+        let city = reuse::city_hash(params, &data, &plan);
+        reuse::Reuse::new(before, city, &opts.out)
+    });
     progress.start("writing tiles", tiles.len() as u64);
-    let make_tiles = || -> Vec<Result<report::ManifestTile, BuildError>> {
+    let make_tiles = || -> Vec<Result<city::Made, BuildError>> {
         tiles
             .par_iter()
             .map(|&id| {
-                let entry = writer.tile(id, &data, &plan, &directory);
+                let made = writer.made(id, &data, &plan, &directory, reuse.as_ref());
                 progress.inc(1);
-                entry
+                made
             })
             .collect()
     };
@@ -548,14 +561,26 @@ fn write_city(
     // and largest step after the tiles (1,000,000 lots: tens of MB).
     drop(directory);
     (timings.generate_cpu, timings.write_cpu) = writer.cpu();
-    let written = results.into_iter().collect::<Result<Vec<_>, _>>()?;
-    let tiles_written = written.len();
+    let made = results.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let fingerprints = reuse.map(|r| city::fingerprints(&r, &made));
+    let written: Vec<report::ManifestTile> = made.into_iter().map(|m| m.entry).collect();
+    let tiles_written = match &fingerprints {
+        Some((_, remade)) => remade.len(),
+        None => written.len(),
+    };
+    // The tiles this run made (a build that may keep tiles kept the others as they were).
+    let made_here = |t: &&report::ManifestTile| match &fingerprints {
+        Some((_, remade)) => remade.binary_search(&t.id).is_ok(),
+        None => true,
+    };
     // Each shared model once, however many tiles draw it.
-    let models: std::collections::BTreeMap<&str, u64> = (written.iter())
+    let models: std::collections::BTreeMap<&str, u64> = (written.iter().filter(made_here))
         .flat_map(|t| t.models.iter().map(|f| (f.path.as_str(), f.bytes)))
         .collect();
-    let bytes_written: u64 =
-        written.iter().map(|t| t.bytes()).sum::<u64>() + models.values().sum::<u64>();
+    let bytes_written: u64 = (written.iter().filter(made_here))
+        .map(|t| t.bytes())
+        .sum::<u64>()
+        + models.values().sum::<u64>();
     let clock = StageClock::start();
     let mut manifest = writer.manifest(&data, &plan, written, previous);
     let beside = city::Beside { image, gpkg };
@@ -579,6 +604,7 @@ fn write_city(
         bytes_written,
         tiles_written,
         cache: cache::CacheUse::Off,
+        fingerprints,
     })
 }
 

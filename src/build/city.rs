@@ -21,6 +21,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
+use super::reuse::{Fingerprints, Mark, Reuse};
 use super::{
     check::input_summary, shards, write_err, BuildError, BuildOptions, Library, Selection,
 };
@@ -98,23 +99,53 @@ impl<'a> CityWriter<'a> {
         })
     }
 
-    /// Generates tile `id` and writes it in every format, with its walkers' clips; its
-    /// manifest entry.
-    pub fn tile(
+    /// Tile `id`: kept as the build before left it when `reuse` says its files would come
+    /// out the same, else generated and written.
+    pub fn made(
         &self,
         id: &str,
         data: &Dataset,
         plan: &Plan,
         directory: &output::features::Directory,
-    ) -> Result<report::ManifestTile, BuildError> {
-        let (params, out) = (&self.opts.params, &self.opts.out);
-        let t = Instant::now();
+        reuse: Option<&Reuse>,
+    ) -> Result<Made, BuildError> {
         let tile = generate::TilePlan {
-            ground: super::terrain_of(data, params, id),
+            ground: super::terrain_of(data, &self.opts.params, id),
             ..generate::TilePlan::of(plan, id)
         };
+        let Some(reuse) = reuse else {
+            let (entry, _) = self.tile(id, &tile, plan, directory, false)?;
+            return Ok(Made { entry, mark: None });
+        };
+        if let Some((entry, mark)) = reuse.kept(id, &tile, directory, &self.opts.out) {
+            return Ok(Made {
+                entry,
+                mark: Some((mark, false)),
+            });
+        }
+        let (entry, owners) = self.tile(id, &tile, plan, directory, true)?;
+        let mark = Reuse::made(&tile, owners, directory);
+        Ok(Made {
+            entry,
+            mark: Some((mark, true)),
+        })
+    }
+
+    /// Generates tile `id` and writes it in every format, with its walkers' clips; its
+    /// manifest entry, and with `owners` the ids of the lots, houses and others its objects
+    /// belong to.
+    fn tile(
+        &self,
+        id: &str,
+        tile: &generate::TilePlan,
+        plan: &Plan,
+        directory: &output::features::Directory,
+        owners: bool,
+    ) -> Result<(report::ManifestTile, Vec<String>), BuildError> {
+        let (params, out) = (&self.opts.params, &self.opts.out);
+        let t = Instant::now();
         let mut meshes =
-            generate::generate_tile(&tile, self.catalog, params, plan.origin, &self.files);
+            generate::generate_tile(tile, self.catalog, params, plan.origin, &self.files);
         self.generate_ns
             .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
         let t = Instant::now();
@@ -164,7 +195,16 @@ impl<'a> CityWriter<'a> {
         meshes.stats.tree_bytes = bytes_of([ObjectKind::Trees, ObjectKind::GrownTrees]);
         meshes.stats.ground_bytes = bytes_of([ObjectKind::Ground, ObjectKind::Streets]);
         entry.stats = meshes.stats;
-        Ok(entry)
+        let owners = match owners {
+            true => (meshes.meshes.iter().map(|m| m.owner.id.clone()))
+                .chain(
+                    (meshes.instanced.iter())
+                        .flat_map(|g| g.trees.iter().filter_map(|t| t.lot.clone())),
+                )
+                .collect(),
+            false => Vec::new(),
+        };
+        Ok((entry, owners))
     }
 
     /// The CPU time generating and writing the tiles took, summed over threads.
@@ -285,6 +325,29 @@ impl<'a> CityWriter<'a> {
         let report = shards::write_manifest_and_report(&opts.out, &manifest)?;
         Ok((report, stale))
     }
+}
+
+/// A tile of this build: its manifest entry and, when the build may keep tiles, its
+/// fingerprint and whether it was made (else kept).
+pub(super) struct Made {
+    pub entry: report::ManifestTile,
+    pub mark: Option<(Mark, bool)>,
+}
+
+/// The fingerprints of a build that may keep tiles, and the tiles it made.
+pub(super) fn fingerprints(reuse: &Reuse, made: &[Made]) -> (Fingerprints, Vec<String>) {
+    let mut marks = Vec::new();
+    let mut remade = Vec::new();
+    for m in made {
+        if let Some((mark, new)) = &m.mark {
+            marks.push((m.entry.id.clone(), mark.clone()));
+            if *new {
+                remade.push(m.entry.id.clone());
+            }
+        }
+    }
+    remade.sort_unstable();
+    (reuse.fingerprints(marks), remade)
 }
 
 /// What is made beside the tiles, on the cores the tiles leave: plan.png's image (written

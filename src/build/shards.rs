@@ -86,7 +86,7 @@ pub fn check_out_dir(opts: &BuildOptions) -> Result<(), BuildError> {
     // `--tiles` keeps the earlier build's other tiles: with other parameters the manifest
     // would stamp them on tiles they did not make, so `--force` does not cover it.
     let tiles = matches!(opts.selection, Selection::Tiles(_));
-    if opts.force && !tiles {
+    if (opts.force || opts.reuse.is_some()) && !tiles {
         return Ok(());
     }
     // Compared as published: a published manifest names paths outside the input by their

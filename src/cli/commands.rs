@@ -50,6 +50,7 @@ pub fn build_command(args: BuildArgs) -> Result<()> {
         },
         force,
         cache: edo_city::build::cache::dir_from(|k| std::env::var_os(k)),
+        reuse: None,
     };
     let bars = Bars::new(quiet || !std::io::stderr().is_terminal());
     let outcome = build(&opts, &bars).context("the build did not finish")?;

@@ -80,6 +80,18 @@ impl<'a> Directory<'a> {
         }
     }
 
+    /// The lot and the house of id `id`, as the metadata rows read them (`build::reuse`
+    /// hashes them for each tile that draws something of theirs).
+    pub fn records(
+        &self,
+        id: &str,
+    ) -> (
+        Option<&'a crate::model::Lot>,
+        Option<&'a crate::model::PlannedHouse>,
+    ) {
+        (self.lots.get(id).copied(), self.houses.get(id).copied())
+    }
+
     /// The id of the street nearest the middle of a house's frontage.
     fn street_of(&self, house: &crate::model::PlannedHouse) -> String {
         let (a, b) = (house.frontage.a, house.frontage.b);

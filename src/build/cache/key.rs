@@ -242,6 +242,7 @@ mod tests {
             selection: crate::build::Selection::All,
             force: false,
             cache: None,
+            reuse: None,
         }
     }
 
