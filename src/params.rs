@@ -10,7 +10,9 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+pub mod allowed;
 mod billboards;
+pub mod catalogue;
 mod crowd;
 mod garden;
 mod halls;

@@ -8,6 +8,8 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use super::allowed;
+
 /// A point layer of people or trees (`people.shp`, `trees.shp`). When it is present its
 /// points are used and none are generated.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -113,28 +115,17 @@ impl PeopleParams {
         common(
             "people",
             &[
-                ("per_100m", self.per_100m, MAX_PER_100M),
-                ("edge_margin", self.edge_margin, 100.0),
-                ("min_spacing", self.min_spacing, 100.0),
-                ("clearance", self.clearance, 100.0),
+                ("per_100m", self.per_100m),
+                ("edge_margin", self.edge_margin),
+                ("min_spacing", self.min_spacing),
+                ("clearance", self.clearance),
             ],
             self.height,
             &self.textures,
             self.max_points_per_tile,
         )?;
-        if !["scatter", "boids"].contains(&self.motion.as_str()) {
-            return Err(format!(
-                "`people.motion` must be \"scatter\" or \"boids\", got \"{}\"",
-                self.motion
-            ));
-        }
-        if !(0.0..=180.0).contains(&self.max_turn_deg) {
-            return Err(format!(
-                "`people.max_turn_deg` must be in [0, 180], got {}",
-                self.max_turn_deg
-            ));
-        }
-        Ok(())
+        allowed::check_word("people.motion", &self.motion)?;
+        allowed::check_number("people.max_turn_deg", self.max_turn_deg)
     }
 }
 
@@ -180,12 +171,7 @@ pub fn check_species(
 impl TreesParams {
     pub(super) fn validate(&self) -> Result<(), String> {
         check_style("trees.style", &self.style)?;
-        if !["spring", "summer", "autumn", "winter"].contains(&self.season.as_str()) {
-            return Err(format!(
-                "`trees.season` must be spring, summer, autumn or winter, got \"{}\"",
-                self.season
-            ));
-        }
+        allowed::check_word("trees.season", &self.season)?;
         if self.max_tile_bytes > MAX_TILE_BYTES {
             return Err(format!(
                 "`trees.max_tile_bytes` must be at most {MAX_TILE_BYTES}, got {}",
@@ -202,10 +188,10 @@ impl TreesParams {
         common(
             "trees",
             &[
-                ("per_ha", self.per_ha, MAX_PER_HA),
-                ("per_ha_machiya", self.per_ha_machiya, MAX_PER_HA),
-                ("min_spacing", self.min_spacing, 100.0),
-                ("clearance", self.clearance, 100.0),
+                ("per_ha", self.per_ha),
+                ("per_ha_machiya", self.per_ha_machiya),
+                ("min_spacing", self.min_spacing),
+                ("clearance", self.clearance),
             ],
             self.height,
             &self.textures,
@@ -214,19 +200,17 @@ impl TreesParams {
     }
 }
 
-/// Densities and distances are from 0 to their bound, the height range is positive, ordered
+/// Densities and distances are within their ranges (`params::allowed`), the height range is positive, ordered
 /// and under 100 m, the per-tile cap bounded, and there is a texture to draw from.
 fn common(
     table: &str,
-    bounded: &[(&str, f64, f64)],
+    bounded: &[(&str, f64)],
     height: [f64; 2],
     textures: &[String],
     max_points_per_tile: usize,
 ) -> Result<(), String> {
-    for (key, v, high) in bounded {
-        if !(v.is_finite() && (0.0..=*high).contains(v)) {
-            return Err(format!("`{table}.{key}` must be from 0 to {high}, got {v}"));
-        }
+    for (key, v) in bounded {
+        super::allowed::check_number(&format!("{table}.{key}"), *v)?;
     }
     let [lo, hi] = height;
     if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= hi && hi <= 100.0) {

@@ -54,12 +54,7 @@ impl OutputParams {
                 self.glb_compression
             ));
         }
-        match self.obj_objects.as_str() {
-            "each" | "kind" => Ok(()),
-            other => Err(format!(
-                "`output.obj_objects` must be \"each\" or \"kind\", got \"{other}\""
-            )),
-        }
+        super::allowed::check_word("output.obj_objects", &self.obj_objects)
     }
 }
 

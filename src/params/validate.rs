@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use super::{billboards, output, Params, ParamsError};
+use super::{allowed, billboards, output, Params, ParamsError};
 
 impl Params {
     /// Checks the values, naming the file `path` and the first key that is wrong.
@@ -39,46 +39,25 @@ impl Params {
     fn sizes(&self) -> Result<(), String> {
         let k = &self.kura;
         let fp = &self.layers.footprints;
-        let sizes = [
-            ("fence.gate_width", self.fence.gate_width, 100.0),
-            ("kura.width", k.width, 100.0),
-            ("kura.depth", k.depth, 100.0),
-            ("kura.min_width", k.min_width, 100.0),
-            ("kura.min_depth", k.min_depth, 100.0),
-            ("tile_size", self.tile_size, 1e6),
-            ("frontage.min_length", self.frontage.min_length, 1000.0),
-            ("machiya.depth", self.machiya.depth, 1000.0),
+        for (key, value) in [
+            ("tile_size", self.tile_size),
+            ("fence.gate_width", self.fence.gate_width),
+            ("kura.width", k.width),
+            ("kura.depth", k.depth),
+            ("kura.min_width", k.min_width),
+            ("kura.min_depth", k.min_depth),
+            ("frontage.min_length", self.frontage.min_length),
+            ("machiya.depth", self.machiya.depth),
             (
                 "layers.streets.default_width",
                 self.layers.streets.default_width,
-                crate::model::MAX_STREET_WIDTH,
             ),
-            ("layers.footprints.storey_height", fp.storey_height, 100.0),
-            (
-                "layers.footprints.default_height",
-                fp.default_height,
-                1000.0,
-            ),
+            ("layers.footprints.storey_height", fp.storey_height),
+            ("layers.footprints.default_height", fp.default_height),
             (
                 "layers.street_widths.max_distance",
                 self.layers.street_widths.max_distance,
-                1e5,
             ),
-        ];
-        for (key, value, high) in sizes {
-            if !(value.is_finite() && value > 0.0 && value <= high) {
-                return Err(format!(
-                    "`{key}` must be a positive number up to {high}, got {value}"
-                ));
-            }
-        }
-        if self.tile_size < 1.0 {
-            return Err(format!(
-                "`tile_size` must be at least 1 (metres), got {}",
-                self.tile_size
-            ));
-        }
-        for (key, value) in [
             ("kura.min_frontage", k.min_frontage),
             ("kura.depth_ratio", k.depth_ratio),
             ("kura.gap", k.gap),
@@ -87,30 +66,16 @@ impl Params {
             ("kura.overlap_tolerance", k.overlap_tolerance),
             ("simplify.tolerance", self.simplify.tolerance),
             ("machiya.min_depth", self.machiya.min_depth),
+            ("simplify.max_vertices", self.simplify.max_vertices as f64),
+            ("frontage.max_angle_deg", self.frontage.max_angle_deg),
         ] {
-            if !(value.is_finite() && (0.0..=1000.0).contains(&value)) {
-                return Err(format!(
-                    "`{key}` must be a number from 0 to 1000, got {value}"
-                ));
-            }
-        }
-        if self.simplify.max_vertices == 0 || self.simplify.max_vertices > 100_000_000 {
-            return Err(format!(
-                "`simplify.max_vertices` must be from 1 to 100000000, got {}",
-                self.simplify.max_vertices
-            ));
+            allowed::check_number(key, value)?;
         }
         if k.min_width > k.width || k.min_depth > k.depth {
             return Err(
                 "`kura.min_width` / `kura.min_depth` must not exceed `kura.width` / `kura.depth`"
                     .into(),
             );
-        }
-        let angle = self.frontage.max_angle_deg;
-        if !(angle > 0.0 && angle <= 180.0) {
-            return Err(format!(
-                "`frontage.max_angle_deg` must be in (0, 180], got {angle}"
-            ));
         }
         Ok(())
     }
