@@ -361,6 +361,14 @@ impl Params {
         Params::from_toml_in(&text, &path.display().to_string(), base, &mut Vec::new())
     }
 
+    /// Reads `text` as the parameter file `path` would be read if it held it (its `extends`
+    /// and the files it names found beside it): the workbench's unsaved edits, resolved as
+    /// `build --params` will resolve them once saved.
+    pub fn from_text_at(text: &str, path: &Path) -> Result<Params, ParamsError> {
+        let base = path.parent().unwrap_or(Path::new("."));
+        Params::from_toml_in(text, &path.display().to_string(), base, &mut Vec::new())
+    }
+
     /// Parses parameter text over the defaults: a user file may give only the keys it changes.
     /// `extends` paths are relative to the current directory.
     pub fn from_toml_str(text: &str, path: &str) -> Result<Params, ParamsError> {

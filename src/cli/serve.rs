@@ -20,6 +20,7 @@ mod api;
 mod designer;
 mod guard;
 mod http;
+mod workbench;
 
 /// The flags of `edo-city serve`.
 #[derive(Args)]
@@ -42,6 +43,19 @@ pub struct ServeArgs {
     /// a build reads it through `[garden] designs`). Without it the designer is read-only.
     #[arg(long)]
     pub designs: Option<PathBuf>,
+    /// Edit a hypothesis in the browser (docs/workbench.md): the first build is rebuilt from
+    /// its input with this parameter file as you change parameters and lots, keeping the
+    /// tiles that stay the same; `save` writes the file (created if it does not exist), its
+    /// overrides (`<params>.overrides.csv`) and its log (`<params>.history.jsonl`).
+    #[arg(long, value_name = "PARAMS.toml")]
+    pub edit: Option<PathBuf>,
+    /// With --edit: the input directory the first build was made from (found by itself when
+    /// it is where the build was run from, beside the build, or beside the parameter file).
+    #[arg(long, requires = "edit")]
+    pub input: Option<PathBuf>,
+    /// With --edit: worker threads of the rebuilds (0 = one per core).
+    #[arg(short = 'j', long, default_value_t = 0, requires = "edit")]
+    pub threads: usize,
 }
 
 /// One build being served.
@@ -177,6 +191,15 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
     let builds = hypotheses(&args.outs)?;
     let dirs: Vec<PathBuf> = builds.iter().map(|b| b.dir.clone()).collect();
     let designer = api::Api::new(&dirs, args.designs.clone())?;
+    let bench = match &args.edit {
+        Some(params) => Some(start_workbench(
+            params,
+            &builds[0].dir,
+            args.input.as_deref(),
+            args.threads,
+        )?),
+        None => None,
+    };
     let list = serde_json::to_vec(&serde_json::json!(builds
         .iter()
         .enumerate()
@@ -205,6 +228,15 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
     if viewer.join("node_modules/cesium").is_dir() {
         text += &format!("  in CesiumJS: {url}viewer/cesium.html?h=0\n");
     }
+    if let Some(b) = &bench {
+        let f = b.files();
+        text += &format!(
+            "  editing {} (overrides {}, log {}): build 0 is rebuilt as you edit\n",
+            f.params.display(),
+            f.overrides.display(),
+            f.history.display()
+        );
+    }
     if let Some(d) = &args.designs {
         text += &format!("  garden designs are kept in {}\n", d.display());
     }
@@ -226,6 +258,9 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
                 message: r.message,
             };
         }
+        if let Some(a) = workbench::routes::answer(bench.as_deref(), call, &guard) {
+            return a;
+        }
         if let Some(a) = designer.answer(call, &guard) {
             return a;
         }
@@ -235,6 +270,72 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
         }
     });
     http::serve(listener, handler, http::Limits::default()).context("the server stopped")
+}
+
+/// The workbench of `--edit params` over the build in `out`, its input found (given, else
+/// where the manifest says, checked by its fingerprint) and its first build started.
+fn start_workbench(
+    params: &Path,
+    out: &Path,
+    input: Option<&Path>,
+    threads: usize,
+) -> Result<std::sync::Arc<workbench::Workbench>> {
+    let bytes = edo_city::bounded::read(&out.join("manifest.json"), 2 << 30)?;
+    let m: serde_json::Value = serde_json::from_slice(&bytes)
+        .with_context(|| format!("{}: not a manifest", out.join("manifest.json").display()))?;
+    let input = find_input(&m, out, params, input)?;
+    let templates = m["input"]["templates"].as_str().map(PathBuf::from);
+    let files = workbench::Files::of(params)?;
+    let place = workbench::Place {
+        input,
+        out: out.to_path_buf(),
+        templates,
+        threads,
+    };
+    workbench::Workbench::start(files, place)
+}
+
+/// The input directory a build was made from: `given`, else the manifest's own path (a
+/// shard's), else its name looked for where the build was run from, beside the build and
+/// beside the parameter file, each checked against the manifest's fingerprint of it.
+fn find_input(
+    m: &serde_json::Value,
+    out: &Path,
+    params: &Path,
+    given: Option<&Path>,
+) -> Result<PathBuf> {
+    if let Some(dir) = given {
+        if !dir.is_dir() {
+            bail!("--input {}: not a directory", dir.display());
+        }
+        return Ok(workbench::absolute(dir));
+    }
+    let named = m["input"]["input"].as_str().unwrap_or_default();
+    let id = m["input"]["input_id"].as_str();
+    let mut tried = Vec::new();
+    let near = |p: &Path| p.parent().map(|d| workbench::absolute(d).join(named));
+    for candidate in [Some(PathBuf::from(named)), near(out), near(params)]
+        .into_iter()
+        .flatten()
+    {
+        let abs = workbench::absolute(&candidate);
+        let same = match id {
+            Some(id) => edo_city::output::report::input_id(&abs) == id,
+            None => true,
+        };
+        if abs.is_dir() && same {
+            return Ok(abs);
+        }
+        let shown = abs.display().to_string();
+        if !tried.contains(&shown) {
+            tried.push(shown);
+        }
+    }
+    bail!(
+        "cannot find the input {} was built from (`{named}`; looked at {}): give it with --input",
+        out.display(),
+        tried.join(", ")
+    )
 }
 
 /// The answer to a GET of `url`: a file, the hypotheses list, or 404.

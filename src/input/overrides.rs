@@ -11,6 +11,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use super::InputError;
+pub use crate::model::overrides::Override;
 use crate::model::{Lot, LotUse, TableJoin};
 
 /// The largest overrides file read: a million edits of a few dozen bytes.
@@ -23,19 +24,6 @@ const MAX_TEXT: usize = 1000;
 pub const ROLES: [&str; 3] = ["use", "mtype", "district"];
 /// The header an overrides file begins with.
 pub const HEADER: [&str; 3] = ["lot", "field", "value"];
-
-/// One edit: lot `lot`'s `field` is `value`.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Override {
-    /// The lot's id (a multipart lot's record id reaches every part).
-    pub lot: String,
-    /// A role of [`ROLES`] or an attribute name.
-    pub field: String,
-    /// The new value; "" for a role clears it (a type drawn again, no district).
-    pub value: String,
-    /// The row in the file (the header is row 1).
-    pub row: usize,
-}
 
 /// The rows of an overrides file's text, checked; `file` names it in errors.
 pub fn parse(text: &str, file: &str) -> Result<Vec<Override>, InputError> {
@@ -126,8 +114,15 @@ pub fn to_csv(rows: &[Override]) -> String {
     String::from_utf8(bytes).unwrap_or_default()
 }
 
-/// Reads the file `[input] overrides` names, if any: its label for the report and its rows.
-pub(super) fn read(name: &str) -> Result<Option<(String, Vec<Override>)>, InputError> {
+/// Reads the file `[input] overrides` names, if any (or takes the rows given in memory):
+/// its label for the report and its rows.
+pub(super) fn read(
+    input: &crate::params::InputParams,
+) -> Result<Option<(String, Vec<Override>)>, InputError> {
+    let name = input.overrides.as_str();
+    if let Some(rows) = &input.rows {
+        return Ok(Some((label_of(name), rows.as_ref().clone())));
+    }
     if name.is_empty() {
         return Ok(None);
     }
@@ -140,12 +135,18 @@ pub(super) fn read(name: &str) -> Result<Option<(String, Vec<Override>)>, InputE
             ),
         }
     })?;
-    // Named by its file name alone: it may lie outside the input, and a build publishes no
-    // one's directories.
-    let label = Path::new(name)
-        .file_name()
-        .map_or_else(|| name.to_string(), |n| n.to_string_lossy().into_owned());
+    let label = label_of(name);
     Ok(Some((label.clone(), parse(&text, &label)?)))
+}
+
+/// The overrides file by its name alone: it may lie outside the input, and a build publishes
+/// no one's directories.
+fn label_of(name: &str) -> String {
+    match Path::new(name).file_name() {
+        Some(n) => n.to_string_lossy().into_owned(),
+        None if name.is_empty() => "overrides".into(),
+        None => name.to_string(),
+    }
 }
 
 /// Where each override lands: the lots by id (a record id reaches each of its parts); an

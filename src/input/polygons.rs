@@ -96,7 +96,7 @@ pub(super) fn read_lots(
         data.joins
             .push(join(&mut lots, &base_ids, t, "lots", &mut data.skipped));
     }
-    let overrides = overrides::read(&params.input.overrides)?;
+    let overrides = overrides::read(&params.input)?;
     if let Some((file, rows)) = &overrides {
         let joined = overrides::apply_attributes(&mut lots, &base_ids, rows, file)?;
         data.joins.push(joined);

@@ -12,6 +12,7 @@ pub mod dem;
 pub mod design;
 pub mod landmark;
 pub mod object;
+pub mod overrides;
 mod plan;
 pub mod precinct;
 pub mod source;

@@ -11,6 +11,11 @@ pub struct InputParams {
     /// directory of the parameter file that names it, as `garden.designs` is.
     #[serde(default)]
     pub overrides: String,
+    /// The overrides given in memory instead of read from `overrides` (the workbench's
+    /// edits not saved yet, which a build must show as `build --params` will once they
+    /// are): never in a parameter file or a manifest.
+    #[serde(skip)]
+    pub rows: Option<std::sync::Arc<Vec<crate::model::overrides::Override>>>,
 }
 
 impl InputParams {

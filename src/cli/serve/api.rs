@@ -507,7 +507,7 @@ fn read_designs(path: &Path) -> Result<Designs, Refusal> {
     Designs::parse(&text).map_err(bad)
 }
 
-fn parse<T: for<'de> Deserialize<'de>>(body: &[u8]) -> Result<T, Refusal> {
+pub(super) fn parse<T: for<'de> Deserialize<'de>>(body: &[u8]) -> Result<T, Refusal> {
     serde_json::from_slice(body).map_err(|e| {
         refuse(
             400,
@@ -517,11 +517,11 @@ fn parse<T: for<'de> Deserialize<'de>>(body: &[u8]) -> Result<T, Refusal> {
 }
 
 /// An error as the API promises it: JSON `{error}`, whatever the client accepts.
-fn refused(r: Refusal) -> Answer {
+pub(super) fn refused(r: Refusal) -> Answer {
     json_answer(r.status, &json!({ "error": r.message }))
 }
 
-fn json_answer(status: u16, v: &serde_json::Value) -> Answer {
+pub(super) fn json_answer(status: u16, v: &serde_json::Value) -> Answer {
     Answer::Bytes {
         status,
         content_type: "application/json",
