@@ -235,6 +235,98 @@ fn unreadable(path: &Path, e: rusqlite::Error) -> DiffError {
     }
 }
 
+/// What differs of a lot between two builds (`type, kura`), `only in A` / `B`, or "".
+fn differs(x: Option<&LotRow>, y: Option<&LotRow>) -> String {
+    match (x, y) {
+        (Some(x), Some(y)) => {
+            let (vx, vy) = (x.values(), y.values());
+            let d: Vec<&str> = ASPECTS
+                .iter()
+                .zip(vx.iter().zip(vy.iter()))
+                .filter(|(_, (p, q))| p != q)
+                .map(|(name, _)| *name)
+                .collect();
+            d.join(", ")
+        }
+        (Some(_), None) => "only in A".into(),
+        (None, Some(_)) => "only in B".into(),
+        (None, None) => String::new(),
+    }
+}
+
+/// The lots of one build's `plan.gpkg` as `compare --gpkg` reads them.
+#[derive(Debug, Clone, Default)]
+pub struct PlanLots(BTreeMap<String, LotRow>);
+
+/// The lots of the build in `dir` (its `plan.gpkg`, read as untrusted input).
+pub fn plan_lots(dir: &Path) -> Result<PlanLots, DiffError> {
+    Build::open(dir)?.lots().map(PlanLots)
+}
+
+/// A lot two builds disagree on: its id, what differs, its outline's exterior ring in the
+/// CRS's metres (the workbench outlines it in the viewer).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct LotDiff {
+    /// The lot's id.
+    pub lot: String,
+    /// `type, kura, house, trees` (those that differ), `only in A` or `only in B`.
+    pub differs: String,
+    /// The exterior ring, east and north.
+    pub ring: Vec<[f64; 2]>,
+}
+
+/// The lots whose type, kura, house or trees differ between `a` and `b`, in id order.
+pub fn lot_differences(a: &PlanLots, b: &PlanLots) -> Vec<LotDiff> {
+    let ids: std::collections::BTreeSet<&String> = a.0.keys().chain(b.0.keys()).collect();
+    let mut out = Vec::new();
+    for id in ids {
+        let (x, y) = (a.0.get(id), b.0.get(id));
+        let differs = differs(x, y);
+        if differs.is_empty() {
+            continue;
+        }
+        let geom = y.or(x).and_then(|r| r.geom.as_deref());
+        out.push(LotDiff {
+            lot: id.clone(),
+            differs,
+            ring: geom.map(ring_of).unwrap_or_default(),
+        });
+    }
+    out
+}
+
+/// The exterior ring of a GeoPackage polygon blob (its header, then WKB); empty when it is
+/// none.
+fn ring_of(blob: &[u8]) -> Vec<[f64; 2]> {
+    use geo_traits::to_geo::ToGeoGeometry;
+    // The header: "GP", version, flags, srs id; then an envelope its flags size.
+    let Some(&flags) = blob.get(3) else {
+        return Vec::new();
+    };
+    let envelope = match (flags >> 1) & 0b111 {
+        0 => 0,
+        1 => 32,
+        2 | 3 => 48,
+        4 => 64,
+        _ => return Vec::new(),
+    };
+    let Some(wkb) = blob.get(8 + envelope..) else {
+        return Vec::new();
+    };
+    let Ok(g) = wkb::reader::read_wkb(wkb) else {
+        return Vec::new();
+    };
+    let ring = match g.to_geometry() {
+        geo_types::Geometry::Polygon(p) => p.exterior().clone(),
+        geo_types::Geometry::MultiPolygon(m) => match m.0.first() {
+            Some(p) => p.exterior().clone(),
+            None => return Vec::new(),
+        },
+        _ => return Vec::new(),
+    };
+    ring.0.iter().map(|c| [c.x, c.y]).collect()
+}
+
 /// Writes `out`: layer `lots` (each lot whose type, kura, house or trees differ between the
 /// builds in `a` and `b`, or that only one has) and layer `tiles` (the tiles `differ`,
 /// `only_a` and `only_b` name). Returns the number of lots that differ.
@@ -274,20 +366,7 @@ pub fn write_diff(
     let ids: std::collections::BTreeSet<&String> = la.keys().chain(lb.keys()).collect();
     for id in ids {
         let (x, y) = (la.get(id), lb.get(id));
-        let differs = match (x, y) {
-            (Some(x), Some(y)) => {
-                let (vx, vy) = (x.values(), y.values());
-                let d: Vec<&str> = ASPECTS
-                    .iter()
-                    .zip(vx.iter().zip(vy.iter()))
-                    .filter(|(_, (p, q))| p != q)
-                    .map(|(name, _)| *name)
-                    .collect();
-                d.join(", ")
-            }
-            (Some(_), None) => "only in A".into(),
-            (None, _) => "only in B".into(),
-        };
+        let differs = differs(x, y);
         if differs.is_empty() {
             continue;
         }

@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 
 use rusqlite::{params, Connection};
 
-pub use diff::{write_diff, DiffError};
+pub use diff::{lot_differences, plan_lots, write_diff, DiffError, LotDiff, PlanLots};
 pub use layer::LayerWriter;
 pub use layers::{write_plan, write_problems, PlanWriter};
 pub use rows::PlanSources;

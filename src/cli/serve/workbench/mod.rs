@@ -21,6 +21,7 @@ use std::time::{Duration, Instant};
 use edo_city::build::reuse::Fingerprints;
 use edo_city::build::{BuildOptions, NoProgress, Selection};
 use edo_city::input::overrides::{self, Override};
+use edo_city::output::gpkg::{lot_differences, plan_lots, LotDiff, PlanLots};
 use edo_city::params::Params;
 
 use super::designer::{refuse, Refusal};
@@ -73,6 +74,11 @@ struct State {
     failed: Option<(u64, String)>,
     busy: bool,
     changed_tiles: Vec<String>,
+    /// The lots whose type, kura, house or trees the last build changed (as `compare
+    /// --gpkg` finds them), their rings in metres from the build's origin.
+    changed_lots: Vec<LotDiff>,
+    /// The lots of what OUT holds, to find the next build's changes against.
+    lots: Arc<PlanLots>,
     last_ms: u64,
     fingerprints: Arc<Fingerprints>,
 }
@@ -93,6 +99,7 @@ impl Workbench {
         let saved = files.read()?;
         // The hypothesis must read as a build would read it, before anything is served.
         resolve(&files, &saved).map_err(|m| anyhow::anyhow!("{m}"))?;
+        let lots = Arc::new(plan_lots(&place.out).unwrap_or_default());
         let wb = Arc::new(Workbench {
             files,
             place,
@@ -108,6 +115,8 @@ impl Workbench {
                 failed: None,
                 busy: false,
                 changed_tiles: Vec::new(),
+                changed_lots: Vec::new(),
+                lots,
                 last_ms: 0,
                 fingerprints: Arc::new(Fingerprints::default()),
             }),
@@ -127,16 +136,26 @@ impl Workbench {
     /// The builder's loop: the newest edit not tried yet, built; forever.
     fn builds(&self) {
         loop {
-            let (rev, hyp, before) = {
+            let (rev, hyp, before, lots) = {
                 let mut s = self.lock();
                 while s.tried == s.requested {
                     s = self.bell.wait(s).unwrap_or_else(|e| e.into_inner());
                 }
                 s.busy = true;
-                (s.requested, s.now.clone(), s.fingerprints.clone())
+                let lots = s.lots.clone();
+                (s.requested, s.now.clone(), s.fingerprints.clone(), lots)
             };
             let t = Instant::now();
             let result = self.build(&hyp, before);
+            // What changed, lot by lot, off the lock: the pages' polls go on meanwhile.
+            let new_lots = result
+                .as_ref()
+                .ok()
+                .map(|_| plan_lots(&self.place.out).unwrap_or_default());
+            let changed_lots = match &new_lots {
+                Some(new) => self.outlines(lot_differences(&lots, new)),
+                None => Vec::new(),
+            };
             let mut s = self.lock();
             s.busy = false;
             s.tried = rev;
@@ -145,6 +164,8 @@ impl Workbench {
                     s.built = rev;
                     s.good = hyp;
                     s.changed_tiles = made;
+                    s.changed_lots = changed_lots;
+                    s.lots = Arc::new(new_lots.unwrap_or_default());
                     s.last_ms = t.elapsed().as_millis() as u64;
                     s.fingerprints = Arc::new(marks);
                     s.failed = None;
@@ -190,6 +211,25 @@ impl Workbench {
         outcome
             .fingerprints
             .ok_or_else(|| "the build kept no fingerprints".to_string())
+    }
+
+    /// The lots' rings moved to metres from the build's origin (the viewer's frame).
+    fn outlines(&self, mut lots: Vec<LotDiff>) -> Vec<LotDiff> {
+        let origin = edo_city::bounded::read(&self.place.out.join("manifest.json"), 2 << 30)
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+            .map_or([0.0, 0.0], |m| {
+                [
+                    m["origin"][0].as_f64().unwrap_or(0.0),
+                    m["origin"][1].as_f64().unwrap_or(0.0),
+                ]
+            });
+        for l in &mut lots {
+            for p in &mut l.ring {
+                *p = [p[0] - origin[0], p[1] - origin[1]];
+            }
+        }
+        lots
     }
 
     /// Applies an edit made by `change` from the hypothesis as it stands (checked as the
@@ -372,6 +412,7 @@ impl Workbench {
             "revision": s.built,
             "requested": s.requested,
             "changedTiles": s.changed_tiles,
+            "changedLots": s.changed_lots,
             "lastMs": s.last_ms,
             "error": s.failed.as_ref().map(|f| f.1.clone()),
             "saved": s.saved == s.now,
