@@ -14,6 +14,7 @@ import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { createDesigner } from './garden.js';
 import { createCrowd, lambdaChart, nearestStretch } from './crowd.js';
+import { createWorkbench } from './workbench.js';
 
 const SKY = 0xbcd6ea;
 const EYE = 1.6;
@@ -107,6 +108,16 @@ api.garden = createDesigner({
   },
 });
 
+// The workbench of `serve --edit`: its panel shows only when the server edits a hypothesis.
+const workbench = createWorkbench({
+  scene,
+  point: (east, north, up) => point(east, north, up),
+  render: () => render(),
+  reload: (rev) => reloadBuild(0, rev),
+  base: '/h/0/',
+});
+api.edit = workbench.api;
+
 const params = new URLSearchParams(location.search);
 const hidden = new Set();
 let split = false;
@@ -133,13 +144,15 @@ function applyToggles(object) {
 }
 let designing = false;
 
-function city(k) {
+function city(k, url) {
   if (cities[k]) return cities[k];
   const h = api.hypotheses[k];
-  const tiles = new TilesRenderer(h.tileset);
+  const tiles = new TilesRenderer(url || h.tileset);
   // Tiles are EXT_meshopt_compression by default ([output] glb_compression): three.js' own
   // decoder (WebAssembly, served from the pinned npm package) unpacks them.
   tiles.registerPlugin(new GLTFExtensionsPlugin({ metadata: true, rtc: true, meshoptDecoder: MeshoptDecoder }));
+  // The workbench's rebuilds of the first build: changed tiles by their revision.
+  if (k === 0) tiles.registerPlugin(workbench.urls());
   // The tileset's parents are the city in coarser levels, each replaced by its children when
   // its measured error would cover more than 16 pixels (CesiumJS' default): the whole town
   // from above is the root alone; a street's tiles come in full as the camera nears them.
@@ -188,6 +201,37 @@ function city(k) {
   if (h.links) loadLinks(k, c);
   cities[k] = c;
   return c;
+}
+
+/** Build k loaded again after the workbench rebuilt it (revision `rev`): the tileset's
+ * URL changes, so every tile is asked for again; those that did not change come back as
+ * 304 from the browser's cache (the server sends `no-cache`: revalidate, never a stale one).
+ * Resolves once it is shown (at once when it is not on screen). */
+function reloadBuild(k, rev) {
+  const old = cities[k];
+  if (old) {
+    scene.remove(old.tiles.group);
+    if (old.links) scene.remove(old.links);
+    old.tiles.dispose();
+  }
+  cities[k] = null;
+  const c = city(k, `${api.hypotheses[k].tileset}?rev=${rev}`);
+  show(api.current);
+  if (!c.tiles.group.visible) return Promise.resolve();
+  return until(() => api.ready && c.loaded && c.tiles.loadProgress === 1);
+}
+
+/** Resolves when `done()` holds, looked at every frame (a minute at most). */
+function until(done) {
+  const t0 = performance.now();
+  return new Promise((resolve, reject) => {
+    const look = () => {
+      if (done()) resolve();
+      else if (performance.now() - t0 > 60000) reject(new Error('the build did not load in a minute'));
+      else requestAnimationFrame(look);
+    };
+    look();
+  });
 }
 
 /** Ready once the current hypothesis has tiles and nothing is loading, after one frame drawn. */
@@ -462,6 +506,7 @@ function pick(event) {
     .filter(([, v]) => v !== '' && v !== null && v !== undefined)
     .map(([k, v]) => `${k}: ${v}`)
     .join('\n');
+  workbench.pick(row);
   offerDesign(row.lot);
   if (row.kind === 'streets' || row.kind === 'ground') showLambdas(hit.point);
 }
@@ -542,7 +587,10 @@ async function main() {
     };
   }
   renderer.domElement.addEventListener('click', pick);
+  workbench.start().catch((e) => console.warn('workbench', e));
   window.addEventListener('keydown', (e) => {
+    // Typing in the workbench's fields is not steering the view.
+    if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
     const k = e.key.toLowerCase();
     if (k === ']' || k === 'h') show(api.current + 1);
     else if (k === '[') show(api.current - 1);

@@ -6,7 +6,7 @@
 //! - `GET /api/edit/status`: `{busy, revision, requested, changedTiles, lastMs, error,
 //!   saved, undo, redo}`; `revision` is what OUT shows.
 //! - `GET /api/edit/state`: the files edited and the machiya types, uses and fields a lot
-//!   may be given.
+//!   may be given; `{enabled: false}` from a server without `--edit`.
 //! - `POST /api/edit/set {key, value, base?}`, `/lot {lot, field, value, base?}`, `/undo`,
 //!   `/redo`, `/reroll` (`{base?}`): answer `{revision, changedTiles, ms, pending}` once
 //!   built; `base` is the revision the page last saw (409 when another page edited since).
@@ -76,6 +76,10 @@ pub fn answer(bench: Option<&Workbench>, call: &Call, guard: &Guard) -> Option<A
         return Some(json_answer(200, &params(bench)));
     }
     let Some(bench) = bench else {
+        // The viewer asks on every load: a read-only server says so without an error.
+        if route == "state" {
+            return Some(json_answer(200, &json!({ "enabled": false })));
+        }
         return Some(refused(refuse(
             403,
             "this server is read-only: start it with `edo-city serve OUT --edit PARAMS.toml` \
@@ -163,6 +167,7 @@ fn state(bench: &Workbench) -> Value {
         })
         .unwrap_or_default();
     json!({
+        "enabled": true,
         "params": f.params.display().to_string(),
         "overrides": f.overrides.display().to_string(),
         "history": f.history.display().to_string(),

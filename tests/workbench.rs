@@ -1,0 +1,224 @@
+//! `edo-city serve OUT --edit PARAMS.toml` (issue 61) over HTTP, as the viewer talks to it:
+//! the parameters listed from the defaults, a lot and a parameter edited (only the tiles
+//! they change rebuilt), a refused value and an unknown lot answered with the build's own
+//! message and taken back, undo restoring the bytes, a stale page refused, save writing the
+//! person's files, and a CLI build of the saved file giving what was served.
+
+mod common;
+
+use std::path::Path;
+
+use common::designer::{ask, ask_with, error};
+use common::*;
+use serde_json::{json, Value};
+
+/// The build's tiles' files and hashes, from its manifest.
+fn tile_hashes(out: &Path) -> Vec<(String, String)> {
+    let m = read_json(&out.join("manifest.json"));
+    let mut v: Vec<(String, String)> = m["tiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|t| {
+            ["obj", "glb"].map(|f| {
+                (
+                    t["id"].as_str().unwrap().to_string(),
+                    t[f]["sha256"].as_str().unwrap_or_default().to_string(),
+                )
+            })
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// A POST of the page holding `token` to `route`, as the viewer sends it.
+fn post(port: u16, token: &str, route: &str, body: Value) -> (u16, Value) {
+    ask_with(
+        port,
+        &[("X-Edo-City-Token", token)],
+        "POST",
+        route,
+        &body.to_string(),
+    )
+}
+
+fn serve_edit(dir: &Path, out: &Path, params: &Path) -> (Server, u16) {
+    let viewer = dir.join("viewer");
+    std::fs::create_dir_all(viewer.join("node_modules/three")).unwrap();
+    std::fs::write(viewer.join("index.html"), "<!doctype html>").unwrap();
+    let mut cmd = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
+    cmd.args(["serve", "--port", "0", "--viewer"])
+        .arg(&viewer)
+        .arg(out)
+        .arg("--edit")
+        .arg(params)
+        .arg("--input")
+        .arg(fixture("kyoto-small"));
+    let (server, url) = start_server(cmd);
+    let port = url
+        .trim_start_matches("http://127.0.0.1:")
+        .trim_end_matches('/')
+        .parse()
+        .unwrap();
+    (server, port)
+}
+
+/// Waits for the server's first build (every tile, to know what each is made from).
+fn settled(port: u16) -> Value {
+    for _ in 0..600 {
+        let (_, s) = ask(port, "GET", "/api/edit/status", "");
+        if s["busy"] == false && s["revision"].as_u64() >= Some(1) {
+            return s;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    panic!("the first build did not end");
+}
+
+#[test]
+fn a_hypothesis_is_edited_undone_saved_and_built_again_by_the_cli() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    build_ok(&fixture("kyoto-small"), &out, &["--quiet"]);
+    let initial = tile_hashes(&out);
+    let params = dir.path().join("hyp.toml");
+    std::fs::write(&params, "# my hypothesis\nseed = 1\n").unwrap();
+    let (server, port) = serve_edit(dir.path(), &out, &params);
+    let first = settled(port);
+    assert_eq!(
+        tile_hashes(&out),
+        initial,
+        "the same parameters rebuild the same tiles"
+    );
+
+    // The parameters, from the one place they are defined.
+    let (status, list) = ask(port, "GET", "/api/params", "");
+    assert_eq!(status, 200);
+    let list = list.as_array().unwrap();
+    let gap = list.iter().find(|p| p["key"] == "kura.gap").unwrap();
+    assert_eq!(gap["section"], "kura");
+    assert_eq!(gap["allowed"]["max"], 1000.0);
+    assert!(gap["doc"].as_str().unwrap().contains("courtyard"));
+    let seed = list.iter().find(|p| p["key"] == "seed").unwrap();
+    assert_eq!(seed["set"], true);
+
+    let (_, t) = ask(port, "GET", "/api/token", "");
+    let token = t["token"].as_str().unwrap().to_string();
+    // Lot 9 becomes a sangai: its tile, and only its tile, is rebuilt.
+    let (status, lot) = post(
+        port,
+        &token,
+        "/api/edit/lot",
+        json!({"lot": "9", "field": "mtype", "value": "sangai", "base": first["requested"]}),
+    );
+    assert_eq!(status, 200, "{lot}");
+    let changed: Vec<String> = serde_json::from_value(lot["changedTiles"].clone()).unwrap();
+    assert_eq!(changed.len(), 1, "{lot}");
+    let now = tile_hashes(&out);
+    let differ: Vec<&String> = (initial.iter().zip(&now))
+        .filter(|(a, b)| a != b)
+        .map(|(a, _)| &a.0)
+        .collect();
+    assert!(
+        differ.iter().all(|id| **id == changed[0]),
+        "{differ:?} {changed:?}"
+    );
+    let (_, s) = ask(port, "GET", "/api/edit/status", "");
+    let lots = s["changedLots"].as_array().unwrap();
+    assert!(
+        lots.iter()
+            .any(|l| l["lot"] == "9" && l["differs"] == "type"),
+        "{s}"
+    );
+
+    // A value the build refuses, an unknown lot: its message, and nothing changed.
+    let (status, e) = error(post(
+        port,
+        &token,
+        "/api/edit/set",
+        json!({"key": "kura.gap", "value": -1}),
+    ));
+    assert_eq!(status, 422);
+    assert!(e.contains("`kura.gap` must be from 0 to 1000"), "{e}");
+    let (status, e) = error(post(
+        port,
+        &token,
+        "/api/edit/lot",
+        json!({"lot": "no-such-lot", "field": "mtype", "value": "sangai"}),
+    ));
+    assert_eq!(status, 422);
+    assert!(e.contains("no lot has the id `no-such-lot`"), "{e}");
+    assert_eq!(tile_hashes(&out), now);
+    // A page that saw an older revision.
+    let (status, _) = error(post(
+        port,
+        &token,
+        "/api/edit/set",
+        json!({"key": "seed", "value": 2, "base": 1}),
+    ));
+    assert_eq!(status, 409);
+
+    // Undo restores the bytes; redo brings the edit back.
+    let (status, _) = post(port, &token, "/api/edit/undo", json!({}));
+    assert_eq!(status, 200);
+    assert_eq!(tile_hashes(&out), initial);
+    let (status, _) = post(port, &token, "/api/edit/redo", json!({}));
+    assert_eq!(status, 200);
+    assert_eq!(tile_hashes(&out), now);
+
+    // A parameter, then save: the person's file keeps their comment.
+    let (status, _) = post(
+        port,
+        &token,
+        "/api/edit/set",
+        json!({"key": "kura.gap", "value": 3.0}),
+    );
+    assert_eq!(status, 200);
+    let (status, saved) = post(port, &token, "/api/edit/save", json!({}));
+    assert_eq!(status, 200, "{saved}");
+    drop(server);
+    let text = std::fs::read_to_string(&params).unwrap();
+    assert!(text.starts_with("# my hypothesis\nseed = 1\n"), "{text}");
+    assert!(text.contains("overrides = \"hyp.overrides.csv\""), "{text}");
+    let rows = std::fs::read_to_string(dir.path().join("hyp.overrides.csv")).unwrap();
+    assert_eq!(rows, "lot,field,value\n9,mtype,sangai\n");
+    let log = std::fs::read_to_string(dir.path().join("hyp.history.jsonl")).unwrap();
+    assert_eq!(log.lines().count(), 3, "{log}");
+
+    // What was served is what the CLI builds from the saved file.
+    let cli = dir.path().join("cli");
+    build_ok(
+        &fixture("kyoto-small"),
+        &cli,
+        &["--quiet", "--params", params.to_str().unwrap()],
+    );
+    assert_same_tree(&out, &cli);
+}
+
+#[test]
+fn a_server_without_edit_lists_the_parameters_and_refuses_edits() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    build_ok(
+        &fixture("kyoto-small"),
+        &out,
+        &["--quiet", "--format", "glb"],
+    );
+    let (_server, port) = common::designer::serve(dir.path(), &out, None);
+    let (status, list) = ask(port, "GET", "/api/params", "");
+    assert_eq!(status, 200);
+    assert!(list.as_array().unwrap().len() > 100);
+    let (status, state) = ask(port, "GET", "/api/edit/state", "");
+    assert_eq!((status, state["enabled"].clone()), (200, json!(false)));
+    let (_, t) = ask(port, "GET", "/api/token", "");
+    let token = t["token"].as_str().unwrap();
+    let (status, e) = error(post(
+        port,
+        token,
+        "/api/edit/set",
+        json!({"key": "seed", "value": 2}),
+    ));
+    assert_eq!(status, 403);
+    assert!(e.contains("--edit"), "{e}");
+}
