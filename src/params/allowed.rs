@@ -6,8 +6,18 @@
 //! radii in order) stay in their sections' `validate`; a key without an entry here is
 //! described by its comment in `params/default.toml`.
 
-use super::billboards::{MAX_PER_100M, MAX_PER_HA, TREE_STYLES};
-use super::output::{FORMATS, GLB_COMPRESSIONS};
+/// The densest crowd a parameter may ask for: a person every 10 cm of street.
+pub const MAX_PER_100M: f64 = 1000.0;
+/// The densest wood: a tree per square metre.
+pub const MAX_PER_HA: f64 = 10_000.0;
+/// The tree styles.
+pub const TREE_STYLES: [&str; 3] = ["billboard", "lsystem", "colonization"];
+/// The formats a build can write, as `--format` and `output.formats` spell them: two of
+/// tiles, `gpkg`, the build's decisions as GIS layers (`plan.gpkg`), and `cityjson`, the
+/// city as a CityJSON 2.0 model (`city.city.jsonl`).
+pub const FORMATS: &[&str] = &["obj", "glb", "gpkg", "cityjson"];
+/// The values of `output.glb_compression`.
+pub const GLB_COMPRESSIONS: &[&str] = &["meshopt", "none"];
 
 /// What one parameter may be.
 #[derive(Debug, Clone, Copy, PartialEq)]

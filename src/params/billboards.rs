@@ -9,6 +9,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::allowed;
+pub use super::allowed::{MAX_PER_100M, MAX_PER_HA, TREE_STYLES};
 
 /// A point layer of people or trees (`people.shp`, `trees.shp`). When it is present its
 /// points are used and none are generated.
@@ -103,10 +104,6 @@ pub struct TreesParams {
     pub species: BTreeMap<String, BTreeMap<String, f64>>,
 }
 
-/// The densest crowd a parameter may ask for: a person every 10 cm of street.
-pub const MAX_PER_100M: f64 = 1000.0;
-/// The densest wood: a tree per square metre.
-pub const MAX_PER_HA: f64 = 10_000.0;
 /// The most billboards one tile may hold (`max_points_per_tile`).
 pub const MAX_POINTS_PER_TILE: usize = 1_000_000;
 
@@ -129,8 +126,6 @@ impl PeopleParams {
     }
 }
 
-/// The tree styles.
-pub const TREE_STYLES: [&str; 3] = ["billboard", "lsystem", "colonization"];
 /// The largest `trees.max_tile_bytes`: 1 GB.
 pub const MAX_TILE_BYTES: u64 = 1_000_000_000;
 

@@ -3,10 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The formats a build can write, as `--format` and `output.formats` spell them: two of
-/// tiles, `gpkg`, the build's decisions as GIS layers (`plan.gpkg`), and `cityjson`, the
-/// city as a CityJSON 2.0 model (`city.city.jsonl`).
-pub const FORMATS: &[&str] = &["obj", "glb", "gpkg", "cityjson"];
+pub use super::allowed::{FORMATS, GLB_COMPRESSIONS};
+
 
 /// The output's settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -41,8 +39,6 @@ fn meshopt() -> String {
     "meshopt".into()
 }
 
-/// The values of `output.glb_compression`.
-pub const GLB_COMPRESSIONS: &[&str] = &["meshopt", "none"];
 
 impl OutputParams {
     pub(super) fn validate(&self) -> Result<(), String> {

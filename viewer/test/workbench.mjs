@@ -6,6 +6,9 @@
 //     lot editor (a click on the house, then its type), looks at it before and after, sets
 //     `kura.gap` in the panel, then undoes both; prints one JSON line: each step's answer,
 //     the pictures' hashes, the panel's marks.
+//   node test/workbench.mjs <url> picture <lot> <type> <screenshot-dir>
+//     the picture of docs/workbench.md: the lot's type and `kura.gap` changed, the lot
+//     outlined, the panel showing the parameter.
 //   node test/workbench.mjs <url> save <lot> <type>
 //     gives <lot> <type>, sets `kura.gap` = 3, saves; prints the answers.
 //   node test/workbench.mjs <url> attack
@@ -88,6 +91,31 @@ try {
     const undone = await look();
     out.redoAfterUndo = await page.evaluate(() => window.edoCity.edit.status.redo);
     out.pictures = { after: after.hash, undone: undone.hash, drawn: [after.drawn, undone.drawn] };
+  } else if (phase === 'picture') {
+    // The pictures of docs/workbench.md: a lot's type changed, seen from above with its
+    // outline; the panel with a parameter found and changed.
+    out.lot = await page.evaluate(([l, t]) => window.edoCity.edit.lot(l, 'mtype', t), [lot, type]);
+    const ring = (await page.evaluate(() => window.edoCity.edit.changedLots)).find((c) => c.lot === lot).ring;
+    const [e, n] = [0, 1].map((i) => ring.reduce((s, p) => s + p[i], 0) / ring.length);
+    await page.evaluate(([x, y]) => window.edoCity.lookAt(x - 25, y - 25, 0, 45), [e, n]);
+    await page.evaluate(([x, y]) => {
+      const c = window.edoCity.camera();
+      return c;
+    }, [e, n]);
+    await page.waitForFunction(() => window.edoCity.ready);
+    await page.fill('#wsearch', 'gap');
+    await page.fill('.wparam[data-key="kura.gap"] input', '3');
+    const before = await page.evaluate(() => window.edoCity.edit.status.revision);
+    await page.press('.wparam[data-key="kura.gap"] input', 'Enter');
+    await page.waitForFunction((r) => {
+      const w = window.edoCity.edit;
+      return w.status.revision > r && !w.status.busy && w.shown === w.status.revision && window.edoCity.ready;
+    }, before);
+    await page.waitForSelector('.wparam.changed[data-key="kura.gap"]');
+    await page.evaluate(([x, y]) => window.edoCity.lookFrom(x, y, 20), [e, n]);
+    await page.waitForFunction(() => window.edoCity.ready);
+    await page.screenshot({ path: `${shots}/workbench.png` });
+    out.status = await page.evaluate(() => ({ ...window.edoCity.edit.status, changedLots: undefined }));
   } else if (phase === 'save') {
     out.lot = await page.evaluate(([l, t]) => window.edoCity.edit.lot(l, 'mtype', t), [lot, type]);
     out.gap = await page.evaluate(() => window.edoCity.edit.set('kura.gap', 3.0));
