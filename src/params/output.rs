@@ -5,7 +5,6 @@ use serde::{Deserialize, Serialize};
 
 pub use super::allowed::{FORMATS, GLB_COMPRESSIONS};
 
-
 /// The output's settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -38,7 +37,6 @@ fn each() -> String {
 fn meshopt() -> String {
     "meshopt".into()
 }
-
 
 impl OutputParams {
     pub(super) fn validate(&self) -> Result<(), String> {

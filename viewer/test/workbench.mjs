@@ -7,8 +7,8 @@
 //     `kura.gap` in the panel, then undoes both; prints one JSON line: each step's answer,
 //     the pictures' hashes, the panel's marks.
 //   node test/workbench.mjs <url> picture <lot> <type> <screenshot-dir>
-//     the picture of docs/workbench.md: the lot's type and `kura.gap` changed, the lot
-//     outlined, the panel showing the parameter.
+//     the picture of docs/workbench.md: the lot's type changed, the lot outlined, the lot
+//     editor and the panel's search showing.
 //   node test/workbench.mjs <url> save <lot> <type>
 //     gives <lot> <type>, sets `kura.gap` = 3, saves; prints the answers.
 //   node test/workbench.mjs <url> attack
@@ -92,30 +92,25 @@ try {
     out.redoAfterUndo = await page.evaluate(() => window.edoCity.edit.status.redo);
     out.pictures = { after: after.hash, undone: undone.hash, drawn: [after.drawn, undone.drawn] };
   } else if (phase === 'picture') {
-    // The pictures of docs/workbench.md: a lot's type changed, seen from above with its
-    // outline; the panel with a parameter found and changed.
+    // The picture of docs/workbench.md: a lot's type changed, seen from above with its
+    // outline, the house clicked so the lot editor shows it, the panel's search used.
     out.lot = await page.evaluate(([l, t]) => window.edoCity.edit.lot(l, 'mtype', t), [lot, type]);
     const ring = (await page.evaluate(() => window.edoCity.edit.changedLots)).find((c) => c.lot === lot).ring;
     const [e, n] = [0, 1].map((i) => ring.reduce((s, p) => s + p[i], 0) / ring.length);
-    await page.evaluate(([x, y]) => window.edoCity.lookAt(x - 25, y - 25, 0, 45), [e, n]);
-    await page.evaluate(([x, y]) => {
-      const c = window.edoCity.camera();
-      return c;
-    }, [e, n]);
+    await page.evaluate(([x, y]) => window.edoCity.lookAt(x, y, 0, 55), [e, n]);
     await page.waitForFunction(() => window.edoCity.ready);
-    await page.fill('#wsearch', 'gap');
-    await page.fill('.wparam[data-key="kura.gap"] input', '3');
-    const before = await page.evaluate(() => window.edoCity.edit.status.revision);
-    await page.press('.wparam[data-key="kura.gap"] input', 'Enter');
-    await page.waitForFunction((r) => {
-      const w = window.edoCity.edit;
-      return w.status.revision > r && !w.status.busy && w.shown === w.status.revision && window.edoCity.ready;
-    }, before);
-    await page.waitForSelector('.wparam.changed[data-key="kura.gap"]');
-    await page.evaluate(([x, y]) => window.edoCity.lookFrom(x, y, 20), [e, n]);
-    await page.waitForFunction(() => window.edoCity.ready);
+    // The house stands at the front of its lot: points between the middle and each corner
+    // are tried until one is the house.
+    for (const [cx, cy] of [[e, n], ...ring.map(([x, y]) => [(x + e) / 2, (y + n) / 2])]) {
+      const at = await page.evaluate(([x, y]) => window.edoCity.screenOf(x, y, 6), [cx, cy]);
+      await page.mouse.click(at.x, at.y);
+      const info = await page.evaluate(() => window.edoCity.info);
+      if (info && info.lot === lot && info.kind === 'machiya') break;
+    }
+    await page.waitForSelector('#wlot select[data-field="mtype"]', { timeout: 5000 }).catch(() => null);
+    await page.fill('#wsearch', 'kura');
     await page.screenshot({ path: `${shots}/workbench.png` });
-    out.status = await page.evaluate(() => ({ ...window.edoCity.edit.status, changedLots: undefined }));
+    out.clicked = await page.evaluate(() => window.edoCity.info);
   } else if (phase === 'save') {
     out.lot = await page.evaluate(([l, t]) => window.edoCity.edit.lot(l, 'mtype', t), [lot, type]);
     out.gap = await page.evaluate(() => window.edoCity.edit.set('kura.gap', 3.0));
