@@ -222,3 +222,41 @@ fn a_server_without_edit_lists_the_parameters_and_refuses_edits() {
     assert_eq!(status, 403);
     assert!(e.contains("--edit"), "{e}");
 }
+
+#[test]
+fn the_hypothesis_is_never_kept_inside_the_input_or_the_build() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("town");
+    copy_fixture("kyoto-small", &input);
+    let out = dir.path().join("out");
+    build_ok(&input, &out, &["--quiet", "--format", "glb"]);
+    for params in [input.join("hyp.toml"), out.join("hyp.toml")] {
+        let o = edo_city()
+            .args(["serve", "--port", "0", "--edit"])
+            .arg(&params)
+            .arg("--input")
+            .arg(&input)
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains("would be written inside"), "{err}");
+    }
+    // A parameter file beside them whose overrides name the lots' table in the input.
+    let params = dir.path().join("hyp.toml");
+    std::fs::write(&params, "[input]\noverrides = \"town/lots.csv\"\n").unwrap();
+    let o = edo_city()
+        .args(["serve", "--port", "0", "--edit"])
+        .arg(&params)
+        .arg("--input")
+        .arg(&input)
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("its overrides") && err.contains("inside the input"),
+        "{err}"
+    );
+}

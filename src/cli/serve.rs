@@ -286,6 +286,33 @@ fn start_workbench(
     let input = find_input(&m, out, params, input)?;
     let templates = m["input"]["templates"].as_str().map(PathBuf::from);
     let files = workbench::Files::of(params)?;
+    // The hypothesis's files are written at `save`: never into what the build reads or
+    // writes (an overrides file named `lots.csv` in the input would replace the lots' table).
+    for (path, what) in [
+        (&files.params, "the parameter file"),
+        (&files.overrides, "its overrides"),
+        (&files.history, "its log"),
+    ] {
+        let real = path
+            .parent()
+            .and_then(|d| d.canonicalize().ok())
+            .map(|d| d.join(path.file_name().unwrap_or_default()));
+        for (dir, name) in [(&input, "the input"), (&out.to_path_buf(), "the build")] {
+            let inside = match (&real, dir.canonicalize()) {
+                (Some(r), Ok(d)) => r.starts_with(&d),
+                _ => false,
+            };
+            if inside {
+                bail!(
+                    "--edit {}: {what} ({}) would be written inside {name} ({}); keep the \
+                     hypothesis beside it, not in it",
+                    params.display(),
+                    path.display(),
+                    dir.display()
+                );
+            }
+        }
+    }
     let place = workbench::Place {
         input,
         out: out.to_path_buf(),
