@@ -73,8 +73,9 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<Override>, InputError> {
     Ok(rows)
 }
 
-/// What is wrong with one row on its own, if anything.
-fn check(o: &Override) -> Result<(), String> {
+/// What is wrong with one row on its own, if anything (the lot's existence is the build's
+/// to check: only the input knows its lots).
+pub fn check(o: &Override) -> Result<(), String> {
     if o.lot.is_empty() {
         return Err("no lot id".into());
     }

@@ -9,7 +9,7 @@ use super::DEFAULT_TOML;
 
 /// Tables given whole: a user who lists them means exactly those entries (see
 /// `resolve::merge`), so the panel sets them as one value.
-const WHOLE: &[&str] = &["type_mix", "values", "constants"];
+pub const WHOLE: &[&str] = &["type_mix", "values", "constants"];
 
 /// One parameter as the defaults document it.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -171,7 +171,7 @@ fn changes(before: &Hypothesis, after: &Hypothesis) -> Vec<Value> {
 }
 
 /// Every key a parameter text sets (a table given whole, `type_mix`, as one).
-fn leaves(text: &str) -> BTreeMap<String, Value> {
+pub fn leaves(text: &str) -> BTreeMap<String, Value> {
     let mut out = BTreeMap::new();
     if let Ok(t) = text.parse::<::toml::Table>() {
         if let Ok(v) = serde_json::to_value(t) {
@@ -182,13 +182,9 @@ fn leaves(text: &str) -> BTreeMap<String, Value> {
 }
 
 fn flatten(v: &Value, at: &str, out: &mut BTreeMap<String, Value>) {
-    let whole = ["type_mix", "values", "constants"];
+    let name = at.rsplit('.').next().unwrap_or(at);
     match v {
-        Value::Object(map)
-            if !whole
-                .iter()
-                .any(|w| at == *w || at.ends_with(&format!(".{w}"))) =>
-        {
+        Value::Object(map) if !edo_city::params::catalogue::WHOLE.contains(&name) => {
             for (k, v) in map {
                 let key = if at.is_empty() {
                     k.clone()

@@ -324,19 +324,13 @@ impl Workbench {
         field: &str,
         value: &str,
     ) -> Result<Done, Refusal> {
-        let row = format!(
-            "lot,field,value\n{}",
-            overrides::to_csv(&[Override {
-                lot: lot.into(),
-                field: field.into(),
-                value: value.into(),
-                row: 2,
-            }])
-            .lines()
-            .nth(1)
-            .unwrap_or_default()
-        );
-        let mut one = overrides::parse(&row, "the edit").map_err(|e| refuse(422, e.to_string()))?;
+        let one = Override {
+            lot: lot.trim().into(),
+            field: field.trim().into(),
+            value: value.trim().into(),
+            row: 0,
+        };
+        overrides::check(&one).map_err(|m| refuse(422, format!("lot `{lot}`: {m}")))?;
         let name = self.files.overrides_name();
         self.edit(base, |h| {
             let mut next = h.clone();
@@ -344,9 +338,10 @@ impl Workbench {
                 next.text = toml::set_key(&h.text, "input.overrides", &name.into())
                     .map_err(|m| refuse(400, m))?;
             }
-            let mut o = one.remove(0);
-            o.row = next.rows.len() + 2;
-            next.rows.push(o);
+            next.rows.push(Override {
+                row: next.rows.len() + 2,
+                ..one
+            });
             Ok(next)
         })
     }
@@ -365,15 +360,14 @@ impl Workbench {
         let rev = {
             let mut s = self.lock();
             stale(&s, base)?;
-            let (from, to) = match back {
-                true => (s.undo.pop(), &mut s.redo),
-                false => (s.redo.pop(), &mut s.undo),
+            let from = match back {
+                true => s.undo.pop(),
+                false => s.redo.pop(),
             };
             let Some(h) = from else {
                 let what = if back { "undo" } else { "redo" };
                 return Err(refuse(409, format!("nothing to {what}")));
             };
-            let _ = to;
             let now = std::mem::replace(&mut s.now, h);
             match back {
                 true => s.redo.push(now),

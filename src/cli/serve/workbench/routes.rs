@@ -128,6 +128,12 @@ fn params(bench: Option<&Workbench>) -> Value {
         None => (None, String::new()),
     };
     let values = serde_json::to_value(current.unwrap_or_else(Params::default)).unwrap_or_default();
+    // The keys the person's file sets, read once (a table's key is set when any of its own is).
+    let set = super::files::leaves(&text);
+    let sets = |key: &str| {
+        set.keys()
+            .any(|k| k == key || k.strip_prefix(key).is_some_and(|r| r.starts_with('.')))
+    };
     let list: Vec<Value> = catalogue::catalogue()
         .into_iter()
         .map(|p| {
@@ -145,7 +151,7 @@ fn params(bench: Option<&Workbench>) -> Value {
                 "value": value,
                 "allowed": allowed::allowed(&p.key).map(|a| a.to_json()),
                 "doc": p.doc,
-                "set": super::toml::get_key(&text, &p.key).is_some(),
+                "set": sets(&p.key),
             })
         })
         .collect();
