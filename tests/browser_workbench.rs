@@ -77,6 +77,7 @@ fn a_visitor_changes_a_lot_and_a_parameter_undoes_them_and_saves_a_hypothesis() 
     assert_eq!(glbs(&out), initial);
     assert_ne!(e["pictures"]["after"], e["pictures"]["undone"], "{e}");
     assert_eq!(e["redoAfterUndo"], 2);
+    assert_eq!(e["againstSelf"], 0, "{e}");
 
     let s = workbench_mjs(&url, &["save", "5", "hiraya"]);
     assert_eq!(s["errors"], serde_json::json!([]), "{s}");

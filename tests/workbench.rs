@@ -260,3 +260,59 @@ fn the_hypothesis_is_never_kept_inside_the_input_or_the_build() {
         "{err}"
     );
 }
+
+#[test]
+fn the_outlines_compare_against_another_served_hypothesis() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    build_ok(&fixture("kyoto-small"), &out, &["--quiet"]);
+    // Another hypothesis: lot 9 a sangai.
+    std::fs::write(
+        dir.path().join("b.overrides.csv"),
+        "lot,field,value\n9,mtype,sangai\n",
+    )
+    .unwrap();
+    let b = dir.path().join("b.toml");
+    std::fs::write(&b, "[input]\noverrides = \"b.overrides.csv\"\n").unwrap();
+    let other = dir.path().join("other");
+    build_ok(
+        &fixture("kyoto-small"),
+        &other,
+        &["--quiet", "--params", b.to_str().unwrap()],
+    );
+    let viewer = dir.path().join("viewer");
+    std::fs::create_dir_all(viewer.join("node_modules/three")).unwrap();
+    std::fs::write(viewer.join("index.html"), "<!doctype html>").unwrap();
+    let mut cmd = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
+    cmd.args(["serve", "--port", "0", "--viewer"])
+        .arg(&viewer)
+        .arg(&out)
+        .arg(&other)
+        .arg("--edit")
+        .arg(dir.path().join("hyp.toml"))
+        .arg("--input")
+        .arg(fixture("kyoto-small"));
+    let (_server, url) = start_server(cmd);
+    let port: u16 = url
+        .trim_start_matches("http://127.0.0.1:")
+        .trim_end_matches('/')
+        .parse()
+        .unwrap();
+    settled(port);
+    let (status, c) = ask(port, "GET", "/api/edit/compare?h=1", "");
+    assert_eq!(status, 200, "{c}");
+    let lots = c["changedLots"].as_array().unwrap();
+    assert_eq!(lots.len(), 1, "{c}");
+    assert_eq!(
+        (lots[0]["lot"].as_str(), lots[0]["differs"].as_str()),
+        (Some("9"), Some("type"))
+    );
+    assert!(lots[0]["ring"].as_array().unwrap().len() >= 4);
+    let (status, c) = ask(port, "GET", "/api/edit/compare?h=0", "");
+    assert_eq!(
+        (status, c["changedLots"].as_array().map(Vec::len)),
+        (200, Some(0))
+    );
+    assert_eq!(ask(port, "GET", "/api/edit/compare?h=7", "").0, 404);
+    assert_eq!(ask(port, "GET", "/api/edit/compare?h=x", "").0, 400);
+}

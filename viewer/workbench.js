@@ -7,7 +7,10 @@
 // overrides and its log beside it) are buttons and calls:
 //
 // window.edoCity.edit = { enabled, params(), set(key, value), lot(id, field, value), undo(),
-//   redo(), save(), reroll(), status, changedLots }
+//   redo(), save(), reroll(), status, changedLots, compare(h) }
+//
+// The outlines show the lots the last rebuild changed, or (`compare(h)`, the panel's
+// "outline against") those where another served build and the hypothesis disagree.
 //
 // `set`, `lot`, `undo`, `redo` and `reroll` return a Promise that resolves when the changed
 // tiles are shown (with the server's answer) and rejects with the build's message.
@@ -64,6 +67,14 @@ export function createWorkbench({ scene, point, render, reload, base }) {
     undo: () => write('undo', {}),
     redo: () => write('redo', {}),
     reroll: () => write('reroll', {}),
+    /** Outlines the lots where served build `h` and the hypothesis disagree (null: those
+     * the last rebuild changed); resolves with them. */
+    compare: (h) => {
+      against = h === null || h === undefined ? null : Number(h);
+      const select = document.getElementById('wagainst');
+      if (select) select.value = against === null ? '' : String(against);
+      return outline(edit.status);
+    },
     save: async () => {
       const answer = await post('save', {});
       await poll();
@@ -126,21 +137,32 @@ export function createWorkbench({ scene, point, render, reload, base }) {
     for (const id of s.changedTiles) versions.set(id, s.revision);
     showing = (async () => {
       await reload(s.revision);
-      edit.changedLots = s.changedLots || [];
-      await drawOutlines(s);
-      render();
+      await outline(s);
     })();
     return showing;
   }
 
-  /** Each changed lot outlined at the ground and at eave height; each changed tile boxed. */
-  async function drawOutlines(s) {
+  /** The lots outlined: those the last rebuild changed, or, against a served build, those
+   * where it and the hypothesis disagree. */
+  let against = null;
+  async function outline(s) {
+    const lots = against === null
+      ? s.changedLots || []
+      : (await (await fetch(`/api/edit/compare?h=${against}`)).json()).changedLots || [];
+    edit.changedLots = lots;
+    await drawOutlines(lots, against === null ? s.changedTiles : []);
+    render();
+    return lots;
+  }
+
+  /** Each lot outlined at the ground and at eave height; each tile of `tiles` boxed. */
+  async function drawOutlines(lots, tiles) {
     for (const o of [...outlines.children]) {
       outlines.remove(o);
       o.geometry.dispose();
     }
     const line = new THREE.LineBasicMaterial({ color: OUTLINE, depthTest: false, transparent: true });
-    for (const l of s.changedLots || []) {
+    for (const l of lots) {
       for (const up of [0.4, 9]) {
         const pts = l.ring.map(([e, n]) => point(e, n, up));
         const loop = new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(pts), line);
@@ -153,7 +175,7 @@ export function createWorkbench({ scene, point, render, reload, base }) {
     if (!manifest) return;
     const box = new THREE.LineBasicMaterial({ color: TILE_BOX, transparent: true, opacity: 0.6 });
     for (const t of manifest.tiles) {
-      if (!s.changedTiles.includes(t.id) || !t.bounds) continue;
+      if (!tiles.includes(t.id) || !t.bounds) continue;
       const [e0, n0, u0, e1, n1, u1] = t.bounds;
       const b = new THREE.Box3().setFromPoints([point(e0, n0, u0), point(e1, n1, u1)]);
       const helper = new THREE.Box3Helper(b, TILE_BOX);
@@ -304,6 +326,10 @@ export function createWorkbench({ scene, point, render, reload, base }) {
     document.getElementById('wfile').textContent = state.params.split('/').pop();
     document.getElementById('wfile').title = state.params;
     document.getElementById('wsearch').oninput = drawPanel;
+    const select = document.getElementById('wagainst');
+    const builds = await (await fetch('/hypotheses.json')).json();
+    for (const b of builds.slice(1)) select.add(new Option(`build ${b.index}: ${b.name}`, b.index));
+    select.onchange = () => edit.compare(select.value === '' ? null : select.value).catch(() => {});
     document.getElementById('wundo').onclick = () => edit.undo().catch(() => {});
     document.getElementById('wredo').onclick = () => edit.redo().catch(() => {});
     document.getElementById('wreroll').onclick = () => edit.reroll().catch(() => {});

@@ -194,7 +194,7 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
     let bench = match &args.edit {
         Some(params) => Some(start_workbench(
             params,
-            &builds[0].dir,
+            &dirs,
             args.input.as_deref(),
             args.threads,
         )?),
@@ -276,10 +276,11 @@ pub fn serve_command(args: ServeArgs) -> Result<()> {
 /// where the manifest says, checked by its fingerprint) and its first build started.
 fn start_workbench(
     params: &Path,
-    out: &Path,
+    dirs: &[PathBuf],
     input: Option<&Path>,
     threads: usize,
 ) -> Result<std::sync::Arc<workbench::Workbench>> {
+    let out = &dirs[0];
     let bytes = edo_city::bounded::read(&out.join("manifest.json"), 2 << 30)?;
     let m: serde_json::Value = serde_json::from_slice(&bytes)
         .with_context(|| format!("{}: not a manifest", out.join("manifest.json").display()))?;
@@ -318,6 +319,7 @@ fn start_workbench(
         out: out.to_path_buf(),
         templates,
         threads,
+        served: dirs.to_vec(),
     };
     workbench::Workbench::start(files, place)
 }

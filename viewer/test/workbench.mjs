@@ -90,6 +90,9 @@ try {
     ];
     const undone = await look();
     out.redoAfterUndo = await page.evaluate(() => window.edoCity.edit.status.redo);
+    // Outlined against the one build served (itself): nothing differs; back to the revisions.
+    out.againstSelf = await page.evaluate(async () => (await window.edoCity.edit.compare(0)).length);
+    await page.evaluate(() => window.edoCity.edit.compare(null));
     out.pictures = { after: after.hash, undone: undone.hash, drawn: [after.drawn, undone.drawn] };
   } else if (phase === 'picture') {
     // The picture of docs/workbench.md: a lot's type changed, seen from above with its

@@ -46,6 +46,8 @@ pub struct Place {
     pub out: PathBuf,
     pub templates: Option<PathBuf>,
     pub threads: usize,
+    /// Every build served, `out` first: the hypotheses the outlines may compare against.
+    pub served: Vec<PathBuf>,
 }
 
 /// The workbench: its files, the builds' place, the state the pages share.
@@ -230,6 +232,23 @@ impl Workbench {
             }
         }
         lots
+    }
+
+    /// The lots where served build `h` and the hypothesis as built disagree (type, kura,
+    /// house, trees), as `compare --gpkg` finds them; rings in the viewer's frame.
+    pub fn compare(&self, h: usize) -> Result<Vec<LotDiff>, Refusal> {
+        let dir = self.place.served.get(h).ok_or_else(|| {
+            refuse(
+                404,
+                format!(
+                    "no build {h}: serve has {} build(s)",
+                    self.place.served.len()
+                ),
+            )
+        })?;
+        let other = plan_lots(dir).map_err(|e| refuse(422, e.to_string()))?;
+        let now = self.lock().lots.clone();
+        Ok(self.outlines(lot_differences(&other, &now)))
     }
 
     /// Applies an edit made by `change` from the hypothesis as it stands (checked as the

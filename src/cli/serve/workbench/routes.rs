@@ -5,6 +5,8 @@
 //!   stands, `set` whether its file sets the key). Served read-only without `--edit`.
 //! - `GET /api/edit/status`: `{busy, revision, requested, changedTiles, lastMs, error,
 //!   saved, undo, redo}`; `revision` is what OUT shows.
+//! - `GET /api/edit/compare?h=K`: `{h, changedLots}`, the lots where served build K and
+//!   the hypothesis as built disagree (as `compare --gpkg` finds them).
 //! - `GET /api/edit/state`: the files edited and the machiya types, uses and fields a lot
 //!   may be given; `{enabled: false}` from a server without `--edit`.
 //! - `POST /api/edit/set {key, value, base?}`, `/lot {lot, field, value, base?}`, `/undo`,
@@ -57,7 +59,7 @@ pub fn answer(bench: Option<&Workbench>, call: &Call, guard: &Guard) -> Option<A
         "/api/params" => "params",
         p => p.strip_prefix("/api/edit/")?,
     };
-    let reads = matches!(route, "params" | "status" | "state");
+    let reads = matches!(route, "params" | "status" | "state" | "compare");
     let writes = matches!(route, "set" | "lot" | "undo" | "redo" | "reroll" | "save");
     if !reads && !writes {
         return Some(refused(refuse(404, format!("no such API route: {path}"))));
@@ -97,6 +99,7 @@ pub fn answer(bench: Option<&Workbench>, call: &Call, guard: &Guard) -> Option<A
     let result = match route {
         "status" => Ok(bench.status()),
         "state" => Ok(state(bench)),
+        "compare" => compare(bench, &call.target),
         "set" => parse(body).and_then(|s: Set| bench.set(s.base, &s.key, &s.value).map(done)),
         "lot" => {
             parse(body).and_then(|l: Lot| bench.lot(l.base, &l.lot, &l.field, &l.value).map(done))
@@ -156,6 +159,19 @@ fn params(bench: Option<&Workbench>) -> Value {
         })
         .collect();
     Value::Array(list)
+}
+
+/// `GET /api/edit/compare?h=K`: the lots where build K and the hypothesis disagree.
+fn compare(bench: &Workbench, target: &str) -> Result<Value, Refusal> {
+    let query = target.split_once('?').map_or("", |q| q.1);
+    let h = query
+        .split('&')
+        .find_map(|kv| kv.strip_prefix("h="))
+        .unwrap_or("0");
+    let h: usize = h
+        .parse()
+        .map_err(|_| refuse(400, format!("`h` must be a build's number, got `{h}`")))?;
+    Ok(json!({ "h": h, "changedLots": bench.compare(h)? }))
 }
 
 /// The files edited and what a lot may be given.
