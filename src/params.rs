@@ -73,6 +73,11 @@ pub enum ParamsError {
 pub struct Params {
     /// Seed of every random choice; same seed, same city.
     pub seed: u64,
+    /// A seed of its own for one section's draws (`[seeds] trees = 7`): kept when `seed`
+    /// changes, so a liked draw of trees stays while the rest is drawn again (the
+    /// workbench's seed lock). Left out of a manifest when empty.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub seeds: BTreeMap<String, u64>,
     /// Edge of a square tile, metres.
     pub tile_size: f64,
     /// A point of the tile grid, metres. Tile `c_r` spans
@@ -350,7 +355,16 @@ fn read_file(path: &Path) -> std::io::Result<String> {
     })
 }
 
+/// The sections that may draw from a seed of their own (`[seeds]`): the machiya's types and
+/// forms (and their kura), the trees, the people and crowds, the rock gardens.
+pub const SEED_SECTIONS: [&str; 4] = ["machiya", "trees", "people", "gardens"];
+
 impl Params {
+    /// The seed `section`'s draws come from: its own in `[seeds]`, else `seed`.
+    pub fn seed_for(&self, section: &str) -> u64 {
+        self.seeds.get(section).copied().unwrap_or(self.seed)
+    }
+
     /// Reads a parameter file. Keys it leaves out keep their default values.
     pub fn from_path(path: &Path) -> Result<Params, ParamsError> {
         let text = read_file(path).map_err(|cause| ParamsError::Io {

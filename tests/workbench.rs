@@ -316,3 +316,61 @@ fn the_outlines_compare_against_another_served_hypothesis() {
     assert_eq!(ask(port, "GET", "/api/edit/compare?h=7", "").0, 404);
     assert_eq!(ask(port, "GET", "/api/edit/compare?h=x", "").0, 400);
 }
+
+/// Every tree of a build's plan.gpkg: id, place, species, height.
+fn trees(out: &Path) -> Vec<(String, String, Option<String>, f64)> {
+    let db = rusqlite::Connection::open(out.join("plan.gpkg")).unwrap();
+    let mut q = db
+        .prepare("SELECT id, hex(geom), species, height FROM trees ORDER BY id")
+        .unwrap();
+    q.query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?, r.get(3)?)))
+        .unwrap()
+        .map(Result::unwrap)
+        .collect()
+}
+
+#[test]
+fn a_kept_draw_survives_a_reroll() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    build_ok(&fixture("kyoto-small"), &out, &["--quiet"]);
+    let params = dir.path().join("hyp.toml");
+    std::fs::write(&params, "[trees]\nper_ha_machiya = 200.0\n").unwrap();
+    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    settled(port);
+    let before = trees(&out);
+    assert!(before.len() > 100);
+    let (_, t) = ask(port, "GET", "/api/token", "");
+    let token = t["token"].as_str().unwrap().to_string();
+    let (status, a) = post(
+        port,
+        &token,
+        "/api/edit/lock",
+        json!({"section": "trees", "keep": true}),
+    );
+    assert_eq!(status, 200, "{a}");
+    let (_, state) = ask(port, "GET", "/api/edit/state", "");
+    assert_eq!(state["locks"], json!(["trees"]));
+    let (status, r) = post(port, &token, "/api/edit/reroll", json!({}));
+    assert_eq!(status, 200, "{r}");
+    assert!(!r["changedTiles"].as_array().unwrap().is_empty(), "{r}");
+    assert_eq!(trees(&out), before, "the trees kept their draw");
+    // Let go: the next reroll draws them again.
+    post(
+        port,
+        &token,
+        "/api/edit/lock",
+        json!({"section": "trees", "keep": false}),
+    );
+    let (status, _) = post(port, &token, "/api/edit/reroll", json!({}));
+    assert_eq!(status, 200);
+    assert_ne!(trees(&out), before);
+    let (status, e) = error(post(
+        port,
+        &token,
+        "/api/edit/lock",
+        json!({"section": "roofs", "keep": true}),
+    ));
+    assert_eq!(status, 422);
+    assert!(e.contains("`seeds.roofs`"), "{e}");
+}

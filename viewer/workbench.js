@@ -7,7 +7,10 @@
 // overrides and its log beside it) are buttons and calls:
 //
 // window.edoCity.edit = { enabled, params(), set(key, value), lot(id, field, value), undo(),
-//   redo(), save(), reroll(), status, changedLots, compare(h) }
+//   redo(), save(), reroll(), lock(section, keep), status, changedLots, compare(h) }
+//
+// `lock` keeps a section's draw (the machiya's types and forms, the trees, the people, the
+// gardens: `[seeds]`) while `reroll` draws the rest again.
 //
 // The outlines show the lots the last rebuild changed, or (`compare(h)`, the panel's
 // "outline against") those where another served build and the hypothesis disagree.
@@ -67,11 +70,24 @@ export function createWorkbench({ scene, point, render, reload, base }) {
     undo: () => write('undo', {}),
     redo: () => write('redo', {}),
     reroll: () => write('reroll', {}),
+    /** Keeps `section`'s draw (machiya, trees, people, gardens) through rerolls, or not. */
+    lock: (section, keep) => write('lock', { section, keep: Boolean(keep) }),
     /** Outlines the lots where served build `h` and the hypothesis disagree (null: those
      * the last rebuild changed); resolves with them. */
     compare: (h) => {
       against = h === null || h === undefined ? null : Number(h);
-      const select = document.getElementById('wagainst');
+      const locks = document.getElementById('wlocks');
+    for (const section of state.seedSections) {
+      const label = document.createElement('label');
+      const box = document.createElement('input');
+      box.type = 'checkbox';
+      box.value = section;
+      box.checked = state.locks.includes(section);
+      box.onchange = () => edit.lock(section, box.checked).catch(() => showLocks());
+      label.append(box, ` ${section}`);
+      locks.appendChild(label);
+    }
+    const select = document.getElementById('wagainst');
       if (select) select.value = against === null ? '' : String(against);
       return outline(edit.status);
     },
@@ -117,6 +133,7 @@ export function createWorkbench({ scene, point, render, reload, base }) {
     await showRevision();
     await fetchParams();
     drawPanel();
+    await showLocks();
     return answer;
   }
 
@@ -311,6 +328,12 @@ export function createWorkbench({ scene, point, render, reload, base }) {
     storeys.min = '1';
     storeys.max = '5';
     field('storeys', storeys, '');
+  }
+
+  /** The "keep the draw of" boxes as the hypothesis has them (an undo may change them). */
+  async function showLocks() {
+    const s = await (await fetch('/api/edit/state')).json();
+    for (const box of document.querySelectorAll('#wlocks input')) box.checked = s.locks.includes(box.value);
   }
 
   async function start() {

@@ -325,7 +325,7 @@ fn design(site: &Site, kept: Option<&Design>, obstacles: &Obstacles, p: &Params)
                 gathered: true,
                 ..GaParams::default()
             };
-            let mut rng = crate::rng::feature_rng(p.seed, "gardens", &site.key);
+            let mut rng = crate::rng::feature_rng(p.seed_for("gardens"), "gardens", &site.key);
             let (pop, _) = ga::run(&s, &gp, g.generations, &mut rng);
             (pop.best().clone(), false)
         }

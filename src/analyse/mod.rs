@@ -394,7 +394,7 @@ fn plan_footprint(
 pub fn draw_type(params: &Params, id: &str, district: Option<&str>) -> String {
     let mix = params.type_mix_of(district);
     let total: f64 = mix.values().sum();
-    let mut r = feature_rng(params.seed, "lots/mtype", id).random::<f64>() * total;
+    let mut r = feature_rng(params.seed_for("machiya"), "lots/mtype", id).random::<f64>() * total;
     for (name, w) in mix {
         if r < *w {
             return name.clone();

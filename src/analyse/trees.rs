@@ -91,7 +91,7 @@ pub fn plant(
                     district,
                     lot_use,
                     style,
-                    params.seed,
+                    params.seed_for("trees"),
                     &b.id,
                 ) {
                     Ok(s) => s,

@@ -75,7 +75,14 @@ pub fn build(
                         .or_default() += 1;
                     Ok(())
                 }
-                None => super::figure::build_one(b, template, catalog, params.seed, frame, mesh),
+                None => {
+                    let section = match kind {
+                        BillboardKind::Person => "people",
+                        BillboardKind::Tree => "trees",
+                    };
+                    let seed = params.seed_for(section);
+                    super::figure::build_one(b, template, catalog, seed, frame, mesh)
+                }
             };
             match built {
                 Ok(()) => {

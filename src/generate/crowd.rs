@@ -86,13 +86,20 @@ pub fn build(
             };
             let frame = Frame { origin: [0.0, 0.0] };
             let template = &params.people.template;
-            super::figure::build_one(&model, template, catalog, params.seed, frame, &mut mesh)
-                .ok()
-                .filter(|()| !mesh.faces.is_empty())
-                .map(|()| {
-                    crowd.figures.push(mesh.finish());
-                    crowd.figures.len() - 1
-                })
+            super::figure::build_one(
+                &model,
+                template,
+                catalog,
+                params.seed_for("people"),
+                frame,
+                &mut mesh,
+            )
+            .ok()
+            .filter(|()| !mesh.faces.is_empty())
+            .map(|()| {
+                crowd.figures.push(mesh.finish());
+                crowd.figures.len() - 1
+            })
         });
         if let Some(figure) = figure {
             crowd.walkers.push(Walker {

@@ -131,7 +131,7 @@ pub fn generate_tile(
         let result = match catalog.machiya(&m.mtype) {
             Some(t) => {
                 let overrides = catalog.overrides(&m.mtype, m.district.as_deref());
-                let random = template_random(params.seed, layer, &m.id);
+                let random = template_random(params.seed_for("machiya"), layer, &m.id);
                 machiya::build(m, t, &overrides, &params.machiya, random, frame)
             }
             None => Err(format!("machiya type `{}` has no template", m.mtype)),
@@ -184,7 +184,7 @@ pub fn generate_tile(
             continue;
         };
         let overrides = catalog.overrides(&t.name, m.district.as_deref());
-        let random = template_random(params.seed, "kura", &m.id);
+        let random = template_random(params.seed_for("machiya"), "kura", &m.id);
         match kura::build(m, rect, t, &overrides, &params.machiya, random, frame) {
             Ok(mesh) => {
                 out.meshes.push(mesh);
@@ -223,7 +223,8 @@ pub fn generate_tile(
     out.instanced = people_and_trees.instanced;
     out.crowd = people_and_trees.crowd;
     for g in tile.gardens {
-        out.meshes.extend(garden::planned(g, params.seed, frame));
+        out.meshes
+            .extend(garden::planned(g, params.seed_for("gardens"), frame));
         out.stats.gardens += 1;
     }
     let dem = tile.ground.map(|g| g.0);

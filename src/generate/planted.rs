@@ -107,19 +107,23 @@ pub fn build<'a>(
             squeeze: form.squeeze,
         };
         one.clear();
-        let variant = variant::variant_of(params.seed, &b.id, params.trees.variants);
+        let variant = variant::variant_of(params.seed_for("trees"), &b.id, params.trees.variants);
         let meshed = match variant {
             Some(k) => {
                 let key = (species.name.as_str(), k);
                 let at = match variants.iter().position(|(v, _)| *v == key) {
                     Some(i) => i,
                     None => {
-                        let model =
-                            variant::variant_model(species, params.seed, k, &params.trees.season)
-                                .map(|model| Instanced {
-                                    model,
-                                    trees: Vec::new(),
-                                });
+                        let model = variant::variant_model(
+                            species,
+                            params.seed_for("trees"),
+                            k,
+                            &params.trees.season,
+                        )
+                        .map(|model| Instanced {
+                            model,
+                            trees: Vec::new(),
+                        });
                         variants.push((key, model));
                         variants.len() - 1
                     }
@@ -196,7 +200,7 @@ fn own_tree(
     frame: Frame,
     one: &mut Mesh,
 ) -> Result<(), String> {
-    let mut rng = crate::rng::feature_rng(params.seed, "tree", &b.id);
+    let mut rng = crate::rng::feature_rng(params.seed_for("trees"), "tree", &b.id);
     let mut skeleton = species.grow_in_city(b.height, &mut rng)?.skeleton;
     skeleton.squeeze(squeeze);
     let look = Look::of(species, b.height, &params.trees.season);

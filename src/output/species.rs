@@ -79,7 +79,7 @@ pub fn write_species(
     }
     let variant = |b: &crate::model::PlannedBillboard, t: &crate::model::TreeForm| {
         t.grown
-            .then(|| variant::variant_of(params.seed, &b.id, params.trees.variants))
+            .then(|| variant::variant_of(params.seed_for("trees"), &b.id, params.trees.variants))
             .flatten()
     };
     // Every variant a grown tree is, at LOD1 and the species' nominal height.
@@ -91,7 +91,8 @@ pub fn write_species(
         let Some(s) = catalog.species.get(name) else {
             continue;
         };
-        let Ok(mesh) = variant::variant_model(s, params.seed, k, &params.trees.season) else {
+        let Ok(mesh) = variant::variant_model(s, params.seed_for("trees"), k, &params.trees.season)
+        else {
             continue;
         };
         let mut buf = Vec::new();

@@ -12,6 +12,7 @@ use std::collections::BTreeMap;
 pub struct Params {
     extends: Option<String>,
     seed: Option<u64>,
+    seeds: Option<BTreeMap<String, u64>>,
     tile_size: Option<f64>,
     tile_origin: Option<[f64; 2]>,
     origin: Option<[f64; 2]>,

@@ -14,6 +14,16 @@ impl Params {
             message,
         };
         self.sizes().map_err(bad)?;
+        if let Some(s) = self
+            .seeds
+            .keys()
+            .find(|s| !super::SEED_SECTIONS.contains(&s.as_str()))
+        {
+            return Err(bad(format!(
+                "`seeds.{s}`: only {} draw from a seed of their own",
+                super::SEED_SECTIONS.join(", ")
+            )));
+        }
         self.places().map_err(bad)?;
         self.lot_mappings().map_err(bad)?;
         check_mix("type_mix", &self.type_mix).map_err(bad)?;

@@ -457,7 +457,7 @@ fn draw(
     obstacles: &Obstacles,
     p: &Params,
 ) -> Vec<Candidate> {
-    let mut rng = feature_rng(p.seed, k.layer, &s.id);
+    let mut rng = feature_rng(p.seed_for(k.layer), k.layer, &s.id);
     let tile_of = |c: Coord<f64>| tile_id(c, p.tile_size, p.tile_origin);
     // Lots draw in their bounding box and keep what falls on planted ground.
     let mean = match s.shape {
@@ -545,7 +545,7 @@ fn from_points(
             });
             continue;
         }
-        let mut rng = feature_rng(p.seed, k.layer, &f.id);
+        let mut rng = feature_rng(p.seed_for(k.layer), k.layer, &f.id);
         let along = near.street_angle(f.at);
         let mut c = k.dress(
             &mut rng,

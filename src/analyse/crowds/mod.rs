@@ -219,7 +219,7 @@ fn set_out(
     net: &Network,
     p: &Params,
 ) -> Vec<Setting> {
-    let mut rng = crate::rng::feature_rng(p.seed, "crowd", stretch);
+    let mut rng = crate::rng::feature_rng(p.seed_for("people"), "crowd", stretch);
     let c = &p.crowd;
     let gap = (p.people.min_spacing + 0.2).max(c.r0);
     let mut out = Vec::with_capacity(people.len());

@@ -408,6 +408,21 @@ impl Workbench {
         self.set(base, "seed", &serde_json::json!(seed.wrapping_add(1)))
     }
 
+    /// Keeps `section`'s draw (its own seed, `[seeds]`, set to the one it draws from now) or
+    /// lets it follow `seed` again.
+    pub fn keep_draw(&self, base: Option<u64>, section: &str, keep: bool) -> Result<Done, Refusal> {
+        let key = format!("seeds.{section}");
+        let value = match keep {
+            true => {
+                let s = self.lock();
+                let p = resolve(&self.files, &s.now).map_err(|m| refuse(422, m))?;
+                serde_json::json!(p.seed_for(section))
+            }
+            false => serde_json::Value::Null,
+        };
+        self.set(base, &key, &value)
+    }
+
     /// Writes the hypothesis as it stands: the parameter file, its overrides, the log.
     pub fn save(&self) -> Result<serde_json::Value, Refusal> {
         let mut s = self.lock();

@@ -12,6 +12,8 @@
 //! - `POST /api/edit/set {key, value, base?}`, `/lot {lot, field, value, base?}`, `/undo`,
 //!   `/redo`, `/reroll` (`{base?}`): answer `{revision, changedTiles, ms, pending}` once
 //!   built; `base` is the revision the page last saw (409 when another page edited since).
+//! - `POST /api/edit/lock {section, keep, base?}`: keeps a section's draw (`[seeds]`) when
+//!   the seed changes, or lets it follow `seed` again.
 //! - `POST /api/edit/save {}`: writes the parameter file, its overrides and its log.
 //!
 //! A POST is a write: checked by `guard.rs` (this server's origin, JSON, the page's token)
@@ -46,6 +48,14 @@ struct Lot {
     base: Option<u64>,
 }
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Lock {
+    section: String,
+    keep: bool,
+    base: Option<u64>,
+}
+
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct Base {
@@ -60,7 +70,10 @@ pub fn answer(bench: Option<&Workbench>, call: &Call, guard: &Guard) -> Option<A
         p => p.strip_prefix("/api/edit/")?,
     };
     let reads = matches!(route, "params" | "status" | "state" | "compare");
-    let writes = matches!(route, "set" | "lot" | "undo" | "redo" | "reroll" | "save");
+    let writes = matches!(
+        route,
+        "set" | "lot" | "lock" | "undo" | "redo" | "reroll" | "save"
+    );
     if !reads && !writes {
         return Some(refused(refuse(404, format!("no such API route: {path}"))));
     }
@@ -96,19 +109,21 @@ pub fn answer(bench: Option<&Workbench>, call: &Call, guard: &Guard) -> Option<A
             false => parse::<Base>(body).map(|b| b.base),
         }
     };
-    let result = match route {
-        "status" => Ok(bench.status()),
-        "state" => Ok(state(bench)),
-        "compare" => compare(bench, &call.target),
-        "set" => parse(body).and_then(|s: Set| bench.set(s.base, &s.key, &s.value).map(done)),
-        "lot" => {
-            parse(body).and_then(|l: Lot| bench.lot(l.base, &l.lot, &l.field, &l.value).map(done))
-        }
-        "undo" => base().and_then(|b| bench.undo(b).map(done)),
-        "redo" => base().and_then(|b| bench.redo(b).map(done)),
-        "reroll" => base().and_then(|b| bench.reroll(b).map(done)),
-        _ => bench.save(),
-    };
+    let result =
+        match route {
+            "status" => Ok(bench.status()),
+            "state" => Ok(state(bench)),
+            "compare" => compare(bench, &call.target),
+            "set" => parse(body).and_then(|s: Set| bench.set(s.base, &s.key, &s.value).map(done)),
+            "lot" => parse(body)
+                .and_then(|l: Lot| bench.lot(l.base, &l.lot, &l.field, &l.value).map(done)),
+            "lock" => parse(body)
+                .and_then(|l: Lock| bench.keep_draw(l.base, &l.section, l.keep).map(done)),
+            "undo" => base().and_then(|b| bench.undo(b).map(done)),
+            "redo" => base().and_then(|b| bench.redo(b).map(done)),
+            "reroll" => base().and_then(|b| bench.reroll(b).map(done)),
+            _ => bench.save(),
+        };
     Some(match result {
         Ok(v) => json_answer(200, &v),
         Err(r) => refused(r),
@@ -196,6 +211,8 @@ fn state(bench: &Workbench) -> Value {
         "types": types,
         "uses": ["machiya", "buke", "kuge", "jisha", "other"],
         "fields": ["mtype", "use", "district", "storeys"],
+        "seedSections": edo_city::params::SEED_SECTIONS,
+        "locks": params.as_ref().map(|p| p.seeds.keys().cloned().collect::<Vec<_>>()).unwrap_or_default(),
         "status": bench.status(),
     })
 }
