@@ -6,18 +6,6 @@ mod common;
 use common::*;
 use edo_city::output::gpkg::{lot_differences, plan_lots};
 
-/// Every tree of a build's plan.gpkg: id, place, species, height.
-fn trees(out: &std::path::Path) -> Vec<(String, String, Option<String>, f64)> {
-    let db = rusqlite::Connection::open(out.join("plan.gpkg")).unwrap();
-    let mut q = db
-        .prepare("SELECT id, hex(geom), species, height FROM trees ORDER BY id")
-        .unwrap();
-    q.query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?, r.get(3)?)))
-        .unwrap()
-        .map(Result::unwrap)
-        .collect()
-}
-
 fn build_with(dir: &std::path::Path, name: &str, params: &str) -> std::path::PathBuf {
     let p = dir.join(format!("{name}.toml"));
     std::fs::write(&p, params).unwrap();
@@ -63,20 +51,20 @@ fn a_section_with_its_own_seed_keeps_its_draw_when_the_seed_changes() {
     };
     let redraw = aspects(&la, &lb);
     assert!(redraw.iter().any(|d| d.contains("type")), "{redraw:?}");
-    assert!(trees(&a).len() > 100);
+    assert!(plan_trees(&a).len() > 100);
     assert_ne!(
-        trees(&a),
-        trees(&redrawn),
+        plan_trees(&a),
+        plan_trees(&redrawn),
         "a new seed draws the trees again"
     );
     assert!(aspects(&la, &lc).is_empty(), "the types kept");
-    assert_eq!(trees(&a), trees(&kept), "the trees kept");
+    assert_eq!(plan_trees(&a), plan_trees(&kept), "the trees kept");
     let d = aspects(&la, &ld);
     assert!(
         d.iter().any(|d| d.contains("type")),
         "the types drawn again: {d:?}"
     );
-    assert_eq!(trees(&a), trees(&trees_only), "the trees kept");
+    assert_eq!(plan_trees(&a), plan_trees(&trees_only), "the trees kept");
     // An unknown section is refused naming the key.
     let p = dir.path().join("bad.toml");
     std::fs::write(&p, "[seeds]\nroofs = 3\n").unwrap();

@@ -43,25 +43,15 @@ fn post(port: u16, token: &str, route: &str, body: Value) -> (u16, Value) {
     )
 }
 
-fn serve_edit(dir: &Path, out: &Path, params: &Path) -> (Server, u16) {
-    let viewer = dir.join("viewer");
-    std::fs::create_dir_all(viewer.join("node_modules/three")).unwrap();
-    std::fs::write(viewer.join("index.html"), "<!doctype html>").unwrap();
-    let mut cmd = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
-    cmd.args(["serve", "--port", "0", "--viewer"])
-        .arg(&viewer)
-        .arg(out)
-        .arg("--edit")
-        .arg(params)
-        .arg("--input")
-        .arg(fixture("kyoto-small"));
-    let (server, url) = start_server(cmd);
-    let port = url
-        .trim_start_matches("http://127.0.0.1:")
-        .trim_end_matches('/')
-        .parse()
-        .unwrap();
-    (server, port)
+fn serve_edit(dir: &Path, outs: &[&Path], params: &Path) -> (Server, u16) {
+    let input = fixture("kyoto-small");
+    let more = [
+        "--edit".as_ref(),
+        params.as_os_str(),
+        "--input".as_ref(),
+        input.as_os_str(),
+    ];
+    common::designer::serve_with(dir, outs, &more)
 }
 
 /// Waits for the server's first build (every tile, to know what each is made from).
@@ -84,7 +74,7 @@ fn a_hypothesis_is_edited_undone_saved_and_built_again_by_the_cli() {
     let initial = tile_hashes(&out);
     let params = dir.path().join("hyp.toml");
     std::fs::write(&params, "# my hypothesis\nseed = 1\n").unwrap();
-    let (server, port) = serve_edit(dir.path(), &out, &params);
+    let (server, port) = serve_edit(dir.path(), &[&out], &params);
     let first = settled(port);
     assert_eq!(
         tile_hashes(&out),
@@ -280,24 +270,7 @@ fn the_outlines_compare_against_another_served_hypothesis() {
         &other,
         &["--quiet", "--params", b.to_str().unwrap()],
     );
-    let viewer = dir.path().join("viewer");
-    std::fs::create_dir_all(viewer.join("node_modules/three")).unwrap();
-    std::fs::write(viewer.join("index.html"), "<!doctype html>").unwrap();
-    let mut cmd = std::process::Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
-    cmd.args(["serve", "--port", "0", "--viewer"])
-        .arg(&viewer)
-        .arg(&out)
-        .arg(&other)
-        .arg("--edit")
-        .arg(dir.path().join("hyp.toml"))
-        .arg("--input")
-        .arg(fixture("kyoto-small"));
-    let (_server, url) = start_server(cmd);
-    let port: u16 = url
-        .trim_start_matches("http://127.0.0.1:")
-        .trim_end_matches('/')
-        .parse()
-        .unwrap();
+    let (_server, port) = serve_edit(dir.path(), &[&out, &other], &dir.path().join("hyp.toml"));
     settled(port);
     let (status, c) = ask(port, "GET", "/api/edit/compare?h=1", "");
     assert_eq!(status, 200, "{c}");
@@ -317,18 +290,6 @@ fn the_outlines_compare_against_another_served_hypothesis() {
     assert_eq!(ask(port, "GET", "/api/edit/compare?h=x", "").0, 400);
 }
 
-/// Every tree of a build's plan.gpkg: id, place, species, height.
-fn trees(out: &Path) -> Vec<(String, String, Option<String>, f64)> {
-    let db = rusqlite::Connection::open(out.join("plan.gpkg")).unwrap();
-    let mut q = db
-        .prepare("SELECT id, hex(geom), species, height FROM trees ORDER BY id")
-        .unwrap();
-    q.query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?, r.get(3)?)))
-        .unwrap()
-        .map(Result::unwrap)
-        .collect()
-}
-
 #[test]
 fn a_kept_draw_survives_a_reroll() {
     let dir = tempfile::tempdir().unwrap();
@@ -336,9 +297,9 @@ fn a_kept_draw_survives_a_reroll() {
     build_ok(&fixture("kyoto-small"), &out, &["--quiet"]);
     let params = dir.path().join("hyp.toml");
     std::fs::write(&params, "[trees]\nper_ha_machiya = 200.0\n").unwrap();
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     settled(port);
-    let before = trees(&out);
+    let before = plan_trees(&out);
     assert!(before.len() > 100);
     let (_, t) = ask(port, "GET", "/api/token", "");
     let token = t["token"].as_str().unwrap().to_string();
@@ -354,7 +315,7 @@ fn a_kept_draw_survives_a_reroll() {
     let (status, r) = post(port, &token, "/api/edit/reroll", json!({}));
     assert_eq!(status, 200, "{r}");
     assert!(!r["changedTiles"].as_array().unwrap().is_empty(), "{r}");
-    assert_eq!(trees(&out), before, "the trees kept their draw");
+    assert_eq!(plan_trees(&out), before, "the trees kept their draw");
     // Let go: the next reroll draws them again.
     post(
         port,
@@ -364,7 +325,7 @@ fn a_kept_draw_survives_a_reroll() {
     );
     let (status, _) = post(port, &token, "/api/edit/reroll", json!({}));
     assert_eq!(status, 200);
-    assert_ne!(trees(&out), before);
+    assert_ne!(plan_trees(&out), before);
     let (status, e) = error(post(
         port,
         &token,

@@ -9,16 +9,24 @@ use serde_json::Value;
 /// `edo-city serve` of `out` with a stand-in viewer in `dir/viewer`, with `--designs` when
 /// given; the server and its port.
 pub fn serve(dir: &Path, out: &Path, designs: Option<&Path>) -> (super::Server, u16) {
+    let more: Vec<&std::ffi::OsStr> = match designs {
+        Some(d) => vec!["--designs".as_ref(), d.as_os_str()],
+        None => Vec::new(),
+    };
+    serve_with(dir, &[out], &more)
+}
+
+/// `edo-city serve` of `outs` with `more` arguments and a stand-in viewer in `dir/viewer`;
+/// the server and its port.
+pub fn serve_with(dir: &Path, outs: &[&Path], more: &[&std::ffi::OsStr]) -> (super::Server, u16) {
     let viewer = dir.join("viewer");
     std::fs::create_dir_all(viewer.join("node_modules/three")).unwrap();
     std::fs::write(viewer.join("index.html"), "<!doctype html>").unwrap();
     let mut cmd = Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
     cmd.args(["serve", "--port", "0", "--viewer"])
         .arg(&viewer)
-        .arg(out);
-    if let Some(d) = designs {
-        cmd.arg("--designs").arg(d);
-    }
+        .args(outs)
+        .args(more);
     let (server, url) = super::start_server(cmd);
     let port = url
         .trim_start_matches("http://127.0.0.1:")

@@ -507,3 +507,16 @@ pub fn succeeded(o: &std::process::Output) -> String {
     assert!(o.status.success(), "{text}");
     text
 }
+
+/// Every tree of a build's plan.gpkg: its id, place, species and height.
+#[allow(dead_code)]
+pub fn plan_trees(out: &Path) -> Vec<(String, String, Option<String>, f64)> {
+    let db = rusqlite::Connection::open(out.join("plan.gpkg")).unwrap();
+    let mut q = db
+        .prepare("SELECT id, hex(geom), species, height FROM trees ORDER BY id")
+        .unwrap();
+    q.query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?, r.get(3)?)))
+        .unwrap()
+        .map(Result::unwrap)
+        .collect()
+}

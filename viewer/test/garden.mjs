@@ -15,8 +15,7 @@
 //     site would: no-cors text/plain POSTs that open a session on <lot> and keep candidates
 //     of guessed sessions, reading a page token, a JSON POST with a made-up token. Prints
 //     what each attempt got; the caller checks that the designs file did not change.
-import http from 'node:http';
-import { launchChromium } from './launch.mjs';
+import { fromElsewhere, launchChromium } from './launch.mjs';
 
 const [url, phase, lot, arg4, arg5] = process.argv.slice(2);
 if (!url || !phase || !lot) {
@@ -187,18 +186,5 @@ async function attack(target, lot) {
       return got;
     })();
   </script>`;
-  const evil = http.createServer((req, res) => {
-    res.writeHead(200, { 'content-type': 'text/html; charset=utf-8' });
-    res.end(page);
-  });
-  await new Promise((ok) => evil.listen(0, '127.0.0.2', ok));
-  const browser = await launchChromium();
-  try {
-    const tab = await browser.newPage();
-    await tab.goto(`http://127.0.0.2:${evil.address().port}/`, { waitUntil: 'load' });
-    return await tab.evaluate(() => window.attacked);
-  } finally {
-    await browser.close();
-    evil.close();
-  }
+  return fromElsewhere(page);
 }

@@ -1,5 +1,6 @@
 // Debian's chromium (headless, SwiftShader) with the viewer's test settings: no network but
 // the server's, each console error, page error and HTTP error collected in `errors`.
+import http from 'node:http';
 import { chromium } from 'playwright-core';
 
 /** Debian's chromium (`$CHROMIUM`, default /usr/bin/chromium), headless, WebGL on SwiftShader,
@@ -26,4 +27,23 @@ export async function openPage(viewport = { width: 1280, height: 720 }) {
   });
   page.setDefaultTimeout(600000);
   return { browser, page, errors };
+}
+
+/** What the page `html` finds when a browser opens it on another origin (a server of its
+ * own on 127.0.0.2): its script leaves a Promise in `window.attacked`, which is returned. */
+export async function fromElsewhere(html) {
+  const evil = http.createServer((req, res) => {
+    res.writeHead(200, { 'content-type': 'text/html; charset=utf-8' });
+    res.end(html);
+  });
+  await new Promise((ok) => evil.listen(0, '127.0.0.2', ok));
+  const browser = await launchChromium();
+  try {
+    const tab = await browser.newPage();
+    await tab.goto(`http://127.0.0.2:${evil.address().port}/`, { waitUntil: 'load' });
+    return await tab.evaluate(() => window.attacked);
+  } finally {
+    await browser.close();
+    evil.close();
+  }
 }

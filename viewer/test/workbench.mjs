@@ -14,8 +14,7 @@
 //   node test/workbench.mjs <url> attack
 //     a page of another origin POSTs edits and a save (blind no-cors text/plain, and JSON
 //     with a made-up token): prints what each attempt got; the caller checks the files.
-import http from 'node:http';
-import { launchChromium, openPage } from './launch.mjs';
+import { fromElsewhere, openPage } from './launch.mjs';
 
 const [url, phase, lot, type, shots] = process.argv.slice(2);
 if (!url || !phase) {
@@ -145,18 +144,5 @@ async function attack(target) {
       return got;
     })();
   </script>`;
-  const evil = http.createServer((req, res) => {
-    res.writeHead(200, { 'content-type': 'text/html; charset=utf-8' });
-    res.end(page);
-  });
-  await new Promise((ok) => evil.listen(0, '127.0.0.2', ok));
-  const b = await launchChromium();
-  try {
-    const tab = await b.newPage();
-    await tab.goto(`http://127.0.0.2:${evil.address().port}/`, { waitUntil: 'load' });
-    return await tab.evaluate(() => window.attacked);
-  } finally {
-    await b.close();
-    evil.close();
-  }
+  return fromElsewhere(page);
 }
