@@ -7,10 +7,9 @@
 
 mod common;
 
-use std::path::Path;
 use std::process::Command;
 
-use common::{assert_same_tree, build_ok, fixture, read_json};
+use common::{assert_same_tree, build_ok, fixture};
 
 fn workbench_mjs(url: &str, args: &[&str]) -> serde_json::Value {
     let mut all: Vec<&std::ffi::OsStr> = vec![url.as_ref()];
@@ -18,28 +17,12 @@ fn workbench_mjs(url: &str, args: &[&str]) -> serde_json::Value {
     common::run_browser_script("workbench.mjs", &all, &[]).0
 }
 
-/// Each tile's GLB hash, from the build's manifest.
-fn glbs(out: &Path) -> Vec<(String, String)> {
-    let m = read_json(&out.join("manifest.json"));
-    m["tiles"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| {
-            (
-                t["id"].as_str().unwrap().to_string(),
-                t["glb"]["sha256"].as_str().unwrap().to_string(),
-            )
-        })
-        .collect()
-}
-
 #[test]
 fn a_visitor_changes_a_lot_and_a_parameter_undoes_them_and_saves_a_hypothesis() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("edo");
     build_ok(&fixture("kyoto-small"), &out, &["--quiet"]);
-    let initial = glbs(&out);
+    let initial = common::tile_hashes(&out, &["glb"]);
     let params = dir.path().join("hyp.toml");
     let mut serve = Command::new(assert_cmd::cargo::cargo_bin("edo-city"));
     serve
@@ -74,7 +57,7 @@ fn a_visitor_changes_a_lot_and_a_parameter_undoes_them_and_saves_a_hypothesis() 
     assert!(gap >= 1 && gap < initial.len(), "{e}");
     assert_eq!(e["marked"], serde_json::json!(["kura.gap"]), "{e}");
     // Undone: the bytes of the first build, and the picture at the lot changed back.
-    assert_eq!(glbs(&out), initial);
+    assert_eq!(common::tile_hashes(&out, &["glb"]), initial);
     assert_ne!(e["pictures"]["after"], e["pictures"]["undone"], "{e}");
     assert_eq!(e["redoAfterUndo"], 2);
     assert_eq!(e["againstSelf"], 0, "{e}");

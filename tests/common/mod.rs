@@ -520,3 +520,28 @@ pub fn plan_trees(out: &Path) -> Vec<(String, String, Option<String>, f64)> {
         .map(Result::unwrap)
         .collect()
 }
+
+/// Each tile's file of each of `formats` by its sha256, from the build's manifest, sorted
+/// (tile id, hash); a tile without one of them fails.
+#[allow(dead_code)]
+pub fn tile_hashes(out: &Path, formats: &[&str]) -> Vec<(String, String)> {
+    let m = read_json(&out.join("manifest.json"));
+    let mut v: Vec<(String, String)> = m["tiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|t| {
+            formats.iter().map(move |f| {
+                let hash = t[*f]["sha256"].as_str();
+                let id = t["id"].as_str().unwrap().to_string();
+                (
+                    id,
+                    hash.unwrap_or_else(|| panic!("tile without {f}"))
+                        .to_string(),
+                )
+            })
+        })
+        .collect();
+    v.sort();
+    v
+}
