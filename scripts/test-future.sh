@@ -43,12 +43,19 @@ print(f"@{leap} 12:00:00")
 echo "== the suite under faketime '$when' ($n test binaries)"
 # Every binary runs, failing or not (as cargo's --no-fail-fast), and the failures are named
 # at the end.
+# Each binary's wall time is printed, slowest last, so a CI log shows where the suite's
+# minutes go (CI must stay under 40 of them).
 failed=()
+times=()
 while read -r exe; do
+  start=$SECONDS
   if ! FAKETIME_DONT_FAKE_MONOTONIC=1 faketime -f "$when" "$exe" --quiet; then
     failed+=("$(basename "$exe")")
   fi
+  times+=("$((SECONDS - start)) $(basename "$exe")")
 done < "$list"
+echo "== seconds per test binary"
+printf '%s\n' "${times[@]}" | sort -n | tail -15
 if [ "${#failed[@]}" -gt 0 ]; then
   echo "test-future: ${#failed[@]} test binaries failed: ${failed[*]}" >&2
   exit 1

@@ -7,7 +7,7 @@ use common::*;
 use rand::{RngExt, SeedableRng};
 
 /// A way to damage a file's bytes.
-type Damage = Box<dyn Fn(&mut Vec<u8>)>;
+type Damage = Box<dyn Fn(&mut Vec<u8>) + Send + Sync>;
 
 /// Runs a build on a copy of the fixture whose `file` was damaged by `damage`; the tool must
 /// either build or exit with code 2 and a message, never crash (exit 101 is a Rust panic).
@@ -28,7 +28,7 @@ fn build_damaged(file: &str, damage: impl Fn(&mut Vec<u8>)) -> (i32, String) {
 #[test]
 fn truncated_and_scrambled_layers_never_panic() {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
-    let (mut built, mut refused) = (0, 0);
+    let mut cases: Vec<(&str, usize, Damage)> = Vec::new();
     for file in [
         "lots.shp",
         "lots.shx",
@@ -39,9 +39,9 @@ fn truncated_and_scrambled_layers_never_panic() {
         let len = std::fs::metadata(fixture("kyoto-small").join(file))
             .unwrap()
             .len() as usize;
-        let mut cases: Vec<Damage> = Vec::new();
+        let mut damages: Vec<Damage> = Vec::new();
         for cut in [0, 10, 50, 100, 101, len / 3, len / 2, len - 1] {
-            cases.push(Box::new(move |b: &mut Vec<u8>| {
+            damages.push(Box::new(move |b: &mut Vec<u8>| {
                 b.truncate(cut.min(b.len()))
             }));
         }
@@ -51,30 +51,44 @@ fn truncated_and_scrambled_layers_never_panic() {
                 rng.random_range(1..64),
                 rng.random::<u64>(),
             );
-            cases.push(Box::new(move |b: &mut Vec<u8>| {
+            damages.push(Box::new(move |b: &mut Vec<u8>| {
                 let mut r = rand_pcg::Pcg64::seed_from_u64(seed);
                 for i in at..(at + n).min(b.len()) {
                     b[i] = r.random();
                 }
             }));
         }
-        for (k, damage) in cases.iter().enumerate() {
-            let (code, stderr) = build_damaged(file, damage);
-            assert!(
-                code == 0 || code == 2,
-                "{file} case {k}: exit {code}\n{stderr}"
-            );
-            if code == 2 {
-                assert!(
-                    stderr.contains("error:") && stderr.contains(file.split('.').next().unwrap()),
-                    "{file} case {k}: {stderr}"
-                );
-                refused += 1;
-            } else {
-                built += 1;
-            }
-        }
+        cases.extend(damages.into_iter().enumerate().map(|(k, d)| (file, k, d)));
     }
+    // The damages are drawn above, in one order; the builds run two at a time (a build of
+    // the small fixture leaves a core idle most of its time: 92 s one after the other).
+    use rayon::prelude::*;
+    let codes: Vec<i32> = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap()
+        .install(|| {
+            cases
+                .par_iter()
+                .map(|(file, k, damage)| {
+                    let (code, stderr) = build_damaged(file, damage);
+                    assert!(
+                        code == 0 || code == 2,
+                        "{file} case {k}: exit {code}\n{stderr}"
+                    );
+                    if code == 2 {
+                        let layer = file.split('.').next().unwrap();
+                        assert!(
+                            stderr.contains("error:") && stderr.contains(layer),
+                            "{file} case {k}: {stderr}"
+                        );
+                    }
+                    code
+                })
+                .collect()
+        });
+    let refused = codes.iter().filter(|&&c| c == 2).count();
+    let built = codes.len() - refused;
     // Both outcomes occur: damage that leaves a readable layer builds (with skips), the rest
     // is refused with the file named.
     assert!(

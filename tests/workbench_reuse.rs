@@ -76,7 +76,8 @@ fn write_hypothesis(dir: &Path, lots: &[String], edits: &[Edit]) -> Params {
     }
     std::fs::write(dir.join("p.overrides.csv"), rows).unwrap();
     // Dotted keys as their tables, so each key is set once.
-    let mut text = String::from("tile_size = 100.0\n");
+    // Tiles of 50 m: 45 of them in two levels of detail, so an edit keeps some parents.
+    let mut text = String::from("tile_size = 50.0\n");
     let mut tables: std::collections::BTreeMap<&str, Vec<String>> = Default::default();
     for (key, line) in &keys {
         match key.split_once('.') {
@@ -144,6 +145,7 @@ proptest! {
         let (mut marks, made) = first.fingerprints.expect("fingerprints kept");
         prop_assert_eq!(made.len(), marks.len(), "a first build makes every tile");
         let mut kept_some = false;
+        let mut kept_parents = false;
         for n in 1..=edits.len() {
             let params = write_hypothesis(&hyp, &lots, &edits[..n]);
             let mut opts = options(&input, &live, params.clone());
@@ -151,6 +153,7 @@ proptest! {
             let again = build(&opts, &NoProgress).expect("rebuild");
             let (next, made) = again.fingerprints.expect("fingerprints kept");
             kept_some |= made.len() < next.len();
+            kept_parents |= next.levels_of_detail().kept() > 0;
             marks = next;
             let full = dir.path().join(format!("full{n}"));
             build(&options(&input, &full, params), &NoProgress).expect("full build");
@@ -159,6 +162,7 @@ proptest! {
         // A lot's edit on its own keeps the tiles far from it.
         if edits.iter().all(|e| matches!(e, Edit::Lot { .. })) {
             prop_assert!(kept_some, "some tile kept");
+            prop_assert!(kept_parents, "some parent of the levels of detail kept");
         }
     }
 }

@@ -90,7 +90,12 @@ impl<'a> CityWriter<'a> {
             catalog,
             library,
             tiles_dir,
-            sinks: output::sinks(&params.output, library.atlas, &report::params_id(params)),
+            sinks: output::sinks(
+                &params.output,
+                library.atlas,
+                &report::params_id(params),
+                None,
+            ),
             files: super::layer_files(&opts.input, params),
             textures,
             species,
@@ -314,7 +319,8 @@ impl<'a> CityWriter<'a> {
     ) -> Result<(report::Report, Duration), BuildError> {
         let opts = self.opts;
         if manifest.shard.is_none() {
-            shards::finish_formats(&opts.out, &mut manifest)?;
+            let memory = opts.reuse.as_ref().map(|r| r.levels_of_detail());
+            shards::finish_formats(&opts.out, &mut manifest, memory)?;
         }
         let t = Instant::now();
         if opts.selection == Selection::All {

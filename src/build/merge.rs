@@ -104,7 +104,7 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     let mut merged = first.clone();
     merged.shard = None;
     merged.tiles = tiles.into_values().collect();
-    finish_formats(target, &mut merged)?;
+    finish_formats(target, &mut merged, None)?;
     // The whole city's plan, as a full build draws it (shards leave it to the merge); drawn
     // before the manifest, which is written last, so a failing plan leaves no merged manifest.
     // The shards' manifests hold the input's path (the merged one will not).

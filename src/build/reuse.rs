@@ -18,13 +18,14 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::generate::TilePlan;
 use crate::model::{Dataset, Plan};
-use crate::output::{features::Directory, report};
+use crate::output::{features::Directory, report, tiles3d::memory::Memory};
 use crate::params::Params;
 
 /// Parameters only the analysis reads: a change to one remakes the tiles whose plan it
@@ -63,9 +64,16 @@ pub const ANALYSIS_ONLY: &[&str] = &[
 pub struct Fingerprints {
     city: [u8; 32],
     tiles: BTreeMap<String, TileMark>,
+    /// The parents of the levels of detail, carried from build to build.
+    lod: Arc<Memory>,
 }
 
 impl Fingerprints {
+    /// The levels of detail's parents as the build before left them.
+    pub fn levels_of_detail(&self) -> &Arc<Memory> {
+        &self.lod
+    }
+
     /// How many tiles it knows.
     pub fn len(&self) -> usize {
         self.tiles.len()
@@ -222,6 +230,7 @@ impl<'a> Reuse<'a> {
         Fingerprints {
             city: self.city,
             tiles: marks.into_iter().map(|(id, m)| (id, m.0)).collect(),
+            lod: self.before.lod.clone(),
         }
     }
 }

@@ -323,7 +323,11 @@ pub fn remove_stale_textures(out: &Path, textures: &[report::ManifestFile]) {
 
 /// Runs every format's whole-build step (`tileset.json`) over `manifest`, listing the files
 /// it writes in the manifest and what it noticed in the warnings.
-pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildError> {
+pub fn finish_formats(
+    out: &Path,
+    manifest: &mut Manifest,
+    memory: Option<&std::sync::Arc<crate::output::tiles3d::memory::Memory>>,
+) -> Result<(), BuildError> {
     let mut warnings = Vec::new();
     // What the sinks wrote before is written again; the build's own files (links.json) stay.
     manifest.files.retain(|f| f.path == "links.json");
@@ -334,7 +338,7 @@ pub fn finish_formats(out: &Path, manifest: &mut Manifest) -> Result<(), BuildEr
     // The whole-build steps draw no tile: no atlas needed. They run side by side (the
     // city model's copy beside the levels of detail: at 30,052 lots a tenth of its cost);
     // their files and warnings are taken in the formats' order, so the manifest is the same.
-    let sinks = crate::output::sinks(&output, None, &report::params_id(&manifest.params));
+    let sinks = crate::output::sinks(&output, None, &report::params_id(&manifest.params), memory);
     let done: Vec<_> = {
         use rayon::prelude::*;
         let m: &Manifest = manifest;

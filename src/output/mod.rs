@@ -73,10 +73,12 @@ pub fn write_listed(out: &Path, path: String, parts: &[&[u8]]) -> std::io::Resul
 /// formats, each format imports the trait, and only this names the formats (issue 58: the
 /// registry beside the trait made the two import each other).
 /// `hypothesis` is the parameters' fingerprint ([`report::params_id`]) the city model names.
+/// `memory` keeps the levels of detail between builds into one directory (the workbench's).
 pub fn sinks(
     output: &crate::params::OutputParams,
     atlas: Option<&atlas::Atlas>,
     hypothesis: &str,
+    memory: Option<&std::sync::Arc<tiles3d::memory::Memory>>,
 ) -> Vec<Box<dyn sink::Sink>> {
     let mut out: Vec<Box<dyn sink::Sink>> = Vec::new();
     for f in &output.formats {
@@ -88,6 +90,7 @@ pub fn sinks(
                 meshopt: output.glb_compression == "meshopt",
                 atlas: atlas.cloned(),
                 shared: Default::default(),
+                memory: memory.cloned(),
             }),
             "cityjson" => Box::new(cityjson::CityJsonSink::new(
                 hypothesis.to_string(),

@@ -535,6 +535,8 @@ pub struct GlbSink {
     pub atlas: Option<Atlas>,
     /// The grown trees' variants, written once for every tile that plants them.
     pub shared: models::Shared,
+    /// The parents of the build before in this directory ([`crate::output::tiles3d::memory`]).
+    pub memory: Option<std::sync::Arc<crate::output::tiles3d::memory::Memory>>,
 }
 
 impl crate::output::sink::Sink for GlbSink {
@@ -571,7 +573,7 @@ impl crate::output::sink::Sink for GlbSink {
         manifest: &crate::output::report::Manifest,
         warnings: &mut Vec<String>,
     ) -> std::io::Result<Vec<crate::output::report::ManifestFile>> {
-        crate::output::tiles3d::write_tileset(out, manifest, warnings)
+        crate::output::tiles3d::write_tileset(out, manifest, warnings, self.memory.as_deref())
     }
 }
 

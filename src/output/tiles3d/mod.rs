@@ -14,15 +14,18 @@
 
 pub mod globe;
 pub mod lod;
+pub mod memory;
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::{Mutex, OnceLock};
 
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use super::report::{Manifest, ManifestFile, ManifestTile};
 use globe::{Affine, Globe};
+use memory::{Keys, Memory, Remembered};
 
 /// Tiles per side of a group, at every level.
 const FANOUT: i64 = 4;
@@ -131,12 +134,14 @@ enum Source {
 
 /// The tileset's JSON for `manifest` (see the module docs), writing the parents' content
 /// into `out` (listed in `files`); `warnings` gets why the city is not on the globe, when it
-/// is not.
+/// is not. With `memory`, a parent made from what it was made from before is taken from
+/// it, and it is left holding this tileset's parents ([`memory`]).
 pub fn tileset(
     out: &Path,
     manifest: &Manifest,
     warnings: &mut Vec<String>,
     files: &mut Vec<ManifestFile>,
+    memory: Option<&Memory>,
 ) -> Result<Value, String> {
     let globe = placement(manifest)?;
     let origin = manifest.origin;
@@ -187,13 +192,19 @@ pub fn tileset(
     for l in &mut leaves {
         l.cell = (l.cell.0 - first.0, l.cell.1 - first.1);
     }
+    let groups = hierarchy(&leaves.iter().map(|l| l.cell).collect::<Vec<_>>());
+    let meshopt = manifest.params.output.glb_compression == "meshopt";
     let tree = Tree {
         out,
         leaves: &leaves,
-        groups: hierarchy(&leaves.iter().map(|l| l.cell).collect::<Vec<_>>()),
         size,
-        meshopt: manifest.params.output.glb_compression == "meshopt",
-        sources: lod::read::Sources::of(out),
+        meshopt,
+        sources: OnceLock::new(),
+        keys: memory.map(|_| Keys::of(manifest, &leaves, &groups, meshopt)),
+        before: memory.map(Memory::take).unwrap_or_default(),
+        now: Mutex::default(),
+        kept: Default::default(),
+        groups,
     };
     let level = tree.groups.len();
     // No level above the leaves: one leaf or none.
@@ -202,11 +213,18 @@ pub fn tileset(
     } else {
         let (node, mut made) = tree.node(level, 0)?;
         // In the order the levels were once made one after the other: the first level's
-        // groups by cell, then the second's, ...
-        made.sort_by_key(|(level, index, _)| (*level, *index));
+        // groups by cell, then the second's, ... (a level's groups are in cell order).
+        made.sort_by_key(|(level, cell, _)| (*level, *cell));
         files.extend(made.into_iter().map(|(_, _, file)| file));
         Some(node)
     };
+    if let Some(memory) = memory {
+        let kept = tree.kept.load(std::sync::atomic::Ordering::Relaxed);
+        memory.put(
+            tree.now.into_inner().unwrap_or_else(|e| e.into_inner()),
+            kept,
+        );
+    }
     let mut root = match top {
         Some(n) if n.json.get("children").is_some() => n.json,
         // One tile (or none): the root is a group over it.
@@ -290,7 +308,14 @@ struct Tree<'a> {
     groups: Vec<Vec<Group>>,
     size: f64,
     meshopt: bool,
-    sources: lod::read::Sources,
+    /// Read when the first parent is made (none may be).
+    sources: OnceLock<lod::read::Sources>,
+    /// With a [`Memory`]: every node's key, the parents remembered from the build before and
+    /// the ones of this build.
+    keys: Option<Keys>,
+    before: BTreeMap<String, Remembered>,
+    now: Mutex<BTreeMap<String, Remembered>>,
+    kept: std::sync::atomic::AtomicUsize,
 }
 
 impl Tree<'_> {
@@ -309,6 +334,26 @@ impl Tree<'_> {
             return Ok((leaf_node(&self.leaves[index]), Vec::new()));
         }
         let (cell, children) = &self.groups[level - 1][index];
+        let name = format!("{level}_{}_{}", cell.0, cell.1);
+        let key = self.keys.as_ref().map(|k| k.get(level, index));
+        if let Some(r) =
+            (self.before.get(&name)).filter(|r| Some(r.key) == key && r.on_disk(self.out))
+        {
+            // Its subtree is kept whole, so a later edit under it finds its other parents.
+            for (l, c, _) in &r.made {
+                let below = format!("{l}_{}_{}", c.0, c.1);
+                if let Some(kept) = self.before.get(&below) {
+                    self.remember(below, kept.clone());
+                    self.kept.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                }
+            }
+            let node = Node {
+                bounds: r.bounds,
+                json: r.json.clone(),
+                source: Source::Made(r.content.clone()),
+            };
+            return Ok((node, r.made.clone()));
+        }
         let below: Vec<Result<(Node, Vec<Made>), String>> = if level == 2 {
             children
                 .par_iter()
@@ -326,22 +371,41 @@ impl Tree<'_> {
         }
         let width = (0..level).fold(self.size, |w, _| w * FANOUT as f64);
         let target = width / TARGET_PER_WIDTH;
+        let sources = self
+            .sources
+            .get_or_init(|| lod::read::Sources::of(self.out));
         let (node, file) = parent(
             self.out,
-            *cell,
+            &name,
             nodes,
             level as u32,
             target,
             self.meshopt,
-            &self.sources,
+            sources,
         )?;
-        made.push((level, index, file));
+        made.push((level, *cell, file));
+        if let (Some(key), Source::Made(content)) = (key, &node.source) {
+            let r = Remembered {
+                key,
+                bounds: node.bounds,
+                json: node.json.clone(),
+                content: content.clone(),
+                made: made.clone(),
+            };
+            self.remember(name, r);
+        }
         Ok((node, made))
+    }
+
+    /// Keeps parent `name` for the next build (with a memory).
+    fn remember(&self, name: String, r: Remembered) {
+        let mut now = self.now.lock().unwrap_or_else(|e| e.into_inner());
+        now.insert(name, r);
     }
 }
 
-/// A parent's file with its level and index there.
-type Made = (usize, usize, ManifestFile);
+/// A parent's file with its level and cell there.
+type Made = (usize, (i64, i64), ManifestFile);
 
 /// A leaf as a node: its box in the root frame (for its parent's), its JSON.
 fn leaf_node(l: &Leaf) -> Node {
@@ -364,10 +428,11 @@ fn leaf_node(l: &Leaf) -> Node {
     }
 }
 
-/// The parent at `cell` of `level` over `children`: its content made and written, its node.
+/// The parent `name` (`<level>_<x>_<y>`) of `level` over `children`: its content made and
+/// written, its node.
 fn parent(
     out: &Path,
-    cell: (i64, i64),
+    name: &str,
     children: Vec<Node>,
     level: u32,
     target: f64,
@@ -398,8 +463,7 @@ fn parent(
         .into_iter()
         .collect::<Result<_, _>>()?;
     let mut content = lod::coarsen(contents, level, target);
-    let name = format!("{level}_{}_{}", cell.0, cell.1);
-    let glb = lod::write::content_glb(&name, &content, level, meshopt);
+    let glb = lod::write::content_glb(name, &content, level, meshopt);
     let path = format!("{LOD_DIR}/{name}.glb");
     let file =
         super::write_listed(out, path.clone(), &glb.parts()).map_err(|e| format!("{path}: {e}"))?;
@@ -434,14 +498,17 @@ fn content_points(content: &lod::Content) -> Vec<[f64; 3]> {
 }
 
 /// Writes `<out>/tileset.json` and the parents' content; returns their manifest entries.
+/// With `memory`, the parents made as before are kept ([`memory`]).
 pub fn write_tileset(
     out: &Path,
     manifest: &Manifest,
     warnings: &mut Vec<String>,
+    memory: Option<&Memory>,
 ) -> std::io::Result<Vec<ManifestFile>> {
     let mut files = Vec::new();
     std::fs::create_dir_all(out.join(LOD_DIR))?;
-    let json = tileset(out, manifest, warnings, &mut files).map_err(std::io::Error::other)?;
+    let json =
+        tileset(out, manifest, warnings, &mut files, memory).map_err(std::io::Error::other)?;
     let bytes = serde_json::to_vec_pretty(&json).expect("serialises");
     files.push(super::write_listed(out, "tileset.json".into(), &[&bytes])?);
     Ok(files)

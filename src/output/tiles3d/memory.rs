@@ -1,0 +1,166 @@
+//! The parents of the build before, kept between the workbench's rebuilds (issue 61): a
+//! parent whose leaves, their frames and shared models, the textures and the settings are
+//! what they were is taken as it was made (its node, its shed content, its subtree's files)
+//! instead of reading its leaves back and coarsening them again. One lot edited remakes the
+//! parents on its leaf's way to the root and no others.
+//!
+//! A parent's key hashes everything its file and node are made from: its level and cell,
+//! the build-wide part ([`Keys::base`]: program version, textures, compression, tile size),
+//! and its children's keys down to the leaves' (a leaf's GLB and shared models by sha256,
+//! its frame and box). Equal keys make equal bytes: the property test
+//! `tests/workbench_reuse.rs` compares every rebuild with a full build, file for file.
+//!
+//! The memory is taken out when a tileset starts and put back whole when it is written, so a
+//! build that fails among the parents leaves none remembered (the files on disk may then be
+//! anybody's), and a remembered parent is used only while its file is on disk at its size.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use serde_json::Value;
+use sha2::{Digest, Sha256};
+
+use super::{lod, Aabb, Group, Leaf, Made};
+use crate::output::report::{Manifest, ManifestFile};
+
+/// The parents a tileset made or kept, by name (`<level>_<x>_<y>`), for the next build into
+/// the same directory. Empty until a tileset is written with it.
+#[derive(Debug, Default)]
+pub struct Memory {
+    parents: Mutex<BTreeMap<String, Remembered>>,
+    /// How many parents the last tileset kept rather than made.
+    kept: AtomicUsize,
+}
+
+impl Memory {
+    /// How many parents it holds.
+    pub fn len(&self) -> usize {
+        self.lock().len()
+    }
+
+    /// Whether it holds none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// How many parents the last tileset written with it kept as they were.
+    pub fn kept(&self) -> usize {
+        self.kept.load(Ordering::Relaxed)
+    }
+
+    /// Everything remembered, leaving the memory empty.
+    pub(super) fn take(&self) -> BTreeMap<String, Remembered> {
+        std::mem::take(&mut *self.lock())
+    }
+
+    /// Remembers `parents` in place of whatever it held, `kept` of them as they were.
+    pub(super) fn put(&self, parents: BTreeMap<String, Remembered>, kept: usize) {
+        *self.lock() = parents;
+        self.kept.store(kept, Ordering::Relaxed);
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, BTreeMap<String, Remembered>> {
+        // A panic elsewhere never leaves the map half-changed: it is swapped whole.
+        self.parents.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// One parent as it was made.
+#[derive(Debug, Clone)]
+pub(super) struct Remembered {
+    /// What it was made from.
+    pub key: [u8; 32],
+    /// Its box in the root's frame.
+    pub bounds: Aabb,
+    /// Its node in `tileset.json`, children and all.
+    pub json: Value,
+    /// Its content, shed for its own parent.
+    pub content: lod::Content,
+    /// The parents' files of its subtree, itself included.
+    pub made: Vec<Made>,
+}
+
+impl Remembered {
+    /// Whether its subtree's files are on disk at their sizes (the directory is locked and
+    /// was written by the tileset that remembered them).
+    pub fn on_disk(&self, out: &Path) -> bool {
+        self.made.iter().all(|(_, _, f)| on_disk(out, f))
+    }
+}
+
+fn on_disk(out: &Path, f: &ManifestFile) -> bool {
+    std::fs::metadata(out.join(&f.path)).is_ok_and(|m| m.is_file() && m.len() == f.bytes)
+}
+
+/// Every node's key, level by level (`keys[0]` the leaves').
+pub(super) struct Keys(Vec<Vec<[u8; 32]>>);
+
+impl Keys {
+    /// The keys of the tree over `leaves` grouped as `groups` ([`super::hierarchy`]).
+    pub fn of(manifest: &Manifest, leaves: &[Leaf], groups: &[Vec<Group>], meshopt: bool) -> Keys {
+        let base = Self::base(manifest, meshopt);
+        let mut levels = vec![leaves.iter().map(leaf_key).collect::<Vec<_>>()];
+        for (l, level) in groups.iter().enumerate() {
+            let below = &levels[l];
+            let keys = level
+                .iter()
+                .map(|(cell, children)| {
+                    let mut h = Sha256::new();
+                    h.update(base);
+                    h.update((l as u64 + 1).to_le_bytes());
+                    h.update(cell.0.to_le_bytes());
+                    h.update(cell.1.to_le_bytes());
+                    for &c in children {
+                        h.update(below[c]);
+                    }
+                    h.finalize().into()
+                })
+                .collect();
+            levels.push(keys);
+        }
+        Keys(levels)
+    }
+
+    /// The key of node `index` of `level`.
+    pub fn get(&self, level: usize, index: usize) -> [u8; 32] {
+        self.0[level][index]
+    }
+
+    /// What every parent is made with besides its leaves: this program, the textures whose
+    /// mean colours replace them, the compression and the tile size (each level's target).
+    fn base(manifest: &Manifest, meshopt: bool) -> [u8; 32] {
+        let mut h = Sha256::new();
+        h.update(env!("CARGO_PKG_VERSION").as_bytes());
+        h.update([meshopt as u8]);
+        h.update(manifest.tile_size.to_le_bytes());
+        for t in &manifest.textures {
+            file(&mut h, t);
+        }
+        h.finalize().into()
+    }
+}
+
+/// A leaf's GLB and the shared models it draws, its frame and its box.
+fn leaf_key(l: &Leaf) -> [u8; 32] {
+    let mut h = Sha256::new();
+    h.update(l.cell.0.to_le_bytes());
+    h.update(l.cell.1.to_le_bytes());
+    for f in l.tile.glb.iter().chain(&l.tile.models) {
+        file(&mut h, f);
+    }
+    for v in l.transform.column_major() {
+        h.update(v.to_le_bytes());
+    }
+    for v in l.local.lo.iter().chain(&l.local.hi) {
+        h.update(v.to_le_bytes());
+    }
+    h.finalize().into()
+}
+
+fn file(h: &mut Sha256, f: &ManifestFile) {
+    h.update(f.path.as_bytes());
+    h.update([0]);
+    h.update(f.sha256.as_bytes());
+}
