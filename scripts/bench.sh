@@ -172,3 +172,6 @@ print(f"default / script: {med['default'] / med['script']:.2f} (target 2.5); "
       f"OBJ / script: {med['obj'] / med['script']:.2f} (target 1.5); "
       f"every feature: {med['all']:.2f} s (target 6 s)")
 PY
+
+echo "== the workbench (issue 61): an edit's POST to its answer on 30,052 lots"
+python3 scripts/bench_workbench.py "$bin" "$work/town-30052" "$work/workbench" 3

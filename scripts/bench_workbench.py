@@ -6,7 +6,8 @@ Usage: bench_workbench.py EDO_CITY TOWN WORK [ROUNDS]
 Builds TOWN into WORK/out (release binary EDO_CITY), serves it with `--edit WORK/hyp.toml`,
 then makes each edit of EDITS in turn, ROUNDS times (each round undoes its edits, so every
 round starts from the same city), and prints the median time of each with the tiles it
-rebuilt. Standard library only: `make bench` runs it beside the other benchmarks.
+rebuilt; WORK/serve.log has the server's line per rebuild, stage by stage. Standard
+library only: `make bench` runs it beside the other benchmarks.
 """
 
 import json
@@ -60,7 +61,8 @@ def main():
     server = subprocess.Popen(
         [exe, "serve", out, "--edit", hyp, "--input", town, "--port", "0"],
         stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
+        # Its line per rebuild, stage by stage.
+        stderr=open(work / "serve.log", "w"),
         text=True,
     )
     try:

@@ -19,7 +19,7 @@ use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
 use edo_city::build::reuse::Fingerprints;
-use edo_city::build::{BuildOptions, NoProgress, Selection};
+use edo_city::build::{BuildOptions, NoProgress, Selection, StageTime};
 use edo_city::input::overrides::{self, Override};
 use edo_city::output::gpkg::{lot_differences, plan_lots, LotDiff, PlanLots};
 use edo_city::params::Params;
@@ -150,6 +150,7 @@ impl Workbench {
             let t = Instant::now();
             let result = self.build(&hyp, before);
             // What changed, lot by lot, off the lock: the pages' polls go on meanwhile.
+            let t_lots = Instant::now();
             let new_lots = result
                 .as_ref()
                 .ok()
@@ -158,6 +159,10 @@ impl Workbench {
                 Some(new) => self.outlines(lot_differences(&lots, new)),
                 None => Vec::new(),
             };
+            if let Ok((_, made, stages)) = &result {
+                log_rebuild(rev, made.len(), t.elapsed(), stages, t_lots.elapsed());
+            }
+            let result = result.map(|(marks, made, _)| (marks, made));
             let mut s = self.lock();
             s.busy = false;
             s.tried = rev;
@@ -195,7 +200,7 @@ impl Workbench {
         &self,
         hyp: &Hypothesis,
         before: Arc<Fingerprints>,
-    ) -> Result<(Fingerprints, Vec<String>), String> {
+    ) -> Result<(Fingerprints, Vec<String>, Vec<StageTime>), String> {
         let params = resolve(&self.files, hyp)?;
         let opts = BuildOptions {
             input: self.place.input.clone(),
@@ -210,9 +215,9 @@ impl Workbench {
             reuse: Some(before),
         };
         let outcome = edo_city::build::build(&opts, &NoProgress).map_err(|e| e.to_string())?;
-        outcome
-            .fingerprints
-            .ok_or_else(|| "the build kept no fingerprints".to_string())
+        let (marks, made) =
+            (outcome.fingerprints).ok_or_else(|| "the build kept no fingerprints".to_string())?;
+        Ok((marks, made, outcome.timings.stages))
     }
 
     /// The lots' rings moved to metres from the build's origin (the viewer's frame).
@@ -494,4 +499,18 @@ fn resolve(files: &Files, hyp: &Hypothesis) -> Result<Params, String> {
 /// `path` absolute, for a build that names files wherever it is started.
 pub fn absolute(path: &Path) -> PathBuf {
     edo_city::build::absolute(path)
+}
+
+/// One line on the server's stderr per rebuild: what was made, in how long, stage by stage
+/// (as `build --timings` names them), and the lots compared after it.
+fn log_rebuild(rev: u64, tiles: usize, took: Duration, stages: &[StageTime], compared: Duration) {
+    let mut line = format!(
+        "revision {rev}: {tiles} tile(s) made in {:.2} s (",
+        took.as_secs_f64()
+    );
+    for st in stages {
+        line += &format!("{} {:.2} s, ", st.name, st.wall.as_secs_f64());
+    }
+    line += &format!("lots compared {:.2} s)", compared.as_secs_f64());
+    eprintln!("{line}");
 }
