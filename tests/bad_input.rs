@@ -272,18 +272,26 @@ fn every_broken_input_gets_its_class_of_message() {
         "only {} cases in tests/bad_input",
         cases.len()
     );
-    // Every case runs; the failures are listed together.
-    let failed: Vec<String> = cases
-        .iter()
-        .filter_map(|case| {
-            std::panic::catch_unwind(|| run_case(case)).err().map(|e| {
-                match e.downcast_ref::<String>() {
-                    Some(m) => m.clone(),
-                    None => format!("{}: {:?}", case.display(), e.downcast_ref::<&str>()),
-                }
+    // Every case runs, two at a time (a build of a small case leaves a core idle); the
+    // failures are listed together, in the cases' order.
+    use rayon::prelude::*;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let failed: Vec<String> = pool.install(|| {
+        cases
+            .par_iter()
+            .filter_map(|case| {
+                std::panic::catch_unwind(|| run_case(case)).err().map(|e| {
+                    match e.downcast_ref::<String>() {
+                        Some(m) => m.clone(),
+                        None => format!("{}: {:?}", case.display(), e.downcast_ref::<&str>()),
+                    }
+                })
             })
-        })
-        .collect();
+            .collect()
+    });
     assert!(
         failed.is_empty(),
         "{} case(s) failed:\n{}",

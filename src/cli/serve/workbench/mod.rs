@@ -19,7 +19,7 @@ use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
 use edo_city::build::reuse::Fingerprints;
-use edo_city::build::{BuildOptions, NoProgress, Selection, StageTime};
+use edo_city::build::{BuildOptions, NoProgress, Selection, Timings};
 use edo_city::input::overrides::{self, Override};
 use edo_city::output::gpkg::{lot_differences, plan_lots, LotDiff, PlanLots};
 use edo_city::params::Params;
@@ -159,8 +159,8 @@ impl Workbench {
                 Some(new) => self.outlines(lot_differences(&lots, new)),
                 None => Vec::new(),
             };
-            if let Ok((_, made, stages)) = &result {
-                log_rebuild(rev, made.len(), t.elapsed(), stages, t_lots.elapsed());
+            if let Ok((_, made, timings)) = &result {
+                log_rebuild(rev, made.len(), t.elapsed(), timings, t_lots.elapsed());
             }
             let result = result.map(|(marks, made, _)| (marks, made));
             let mut s = self.lock();
@@ -200,7 +200,7 @@ impl Workbench {
         &self,
         hyp: &Hypothesis,
         before: Arc<Fingerprints>,
-    ) -> Result<(Fingerprints, Vec<String>, Vec<StageTime>), String> {
+    ) -> Result<(Fingerprints, Vec<String>, Timings), String> {
         let params = resolve(&self.files, hyp)?;
         let opts = BuildOptions {
             input: self.place.input.clone(),
@@ -217,7 +217,7 @@ impl Workbench {
         let outcome = edo_city::build::build(&opts, &NoProgress).map_err(|e| e.to_string())?;
         let (marks, made) =
             (outcome.fingerprints).ok_or_else(|| "the build kept no fingerprints".to_string())?;
-        Ok((marks, made, outcome.timings.stages))
+        Ok((marks, made, outcome.timings))
     }
 
     /// The lots' rings moved to metres from the build's origin (the viewer's frame).
@@ -502,15 +502,21 @@ pub fn absolute(path: &Path) -> PathBuf {
 }
 
 /// One line on the server's stderr per rebuild: what was made, in how long, stage by stage
-/// (as `build --timings` names them), and the lots compared after it.
-fn log_rebuild(rev: u64, tiles: usize, took: Duration, stages: &[StageTime], compared: Duration) {
+/// (as `build --timings` names them), the plan files drawn beside the tiles, and the lots
+/// compared after it.
+fn log_rebuild(rev: u64, tiles: usize, took: Duration, timings: &Timings, compared: Duration) {
     let mut line = format!(
         "revision {rev}: {tiles} tile(s) made in {:.2} s (",
         took.as_secs_f64()
     );
-    for st in stages {
+    for st in &timings.stages {
         line += &format!("{} {:.2} s, ", st.name, st.wall.as_secs_f64());
     }
+    line += &format!(
+        "of which plan.png {:.2} s and plan.gpkg {:.2} s, ",
+        timings.plan.as_secs_f64(),
+        (timings.gpkg[0] + timings.gpkg[1]).as_secs_f64()
+    );
     line += &format!("lots compared {:.2} s)", compared.as_secs_f64());
     eprintln!("{line}");
 }
