@@ -100,8 +100,13 @@ pub(super) struct Keys(Vec<Vec<[u8; 32]>>);
 impl Keys {
     /// The keys of the tree over `leaves` grouped as `groups` ([`super::hierarchy`]).
     pub fn of(manifest: &Manifest, leaves: &[Leaf], groups: &[Vec<Group>], meshopt: bool) -> Keys {
-        let base = Self::base(manifest, meshopt);
-        let mut levels = vec![leaves.iter().map(leaf_key).collect::<Vec<_>>()];
+        let leaves = leaves.iter().map(leaf_key).collect();
+        Self::above(Self::base(manifest, meshopt), leaves, groups)
+    }
+
+    /// The keys of the parents over leaves of keys `leaves`, each hashing `base`.
+    fn above(base: [u8; 32], leaves: Vec<[u8; 32]>, groups: &[Vec<Group>]) -> Keys {
+        let mut levels = vec![leaves];
         for (l, level) in groups.iter().enumerate() {
             let below = &levels[l];
             let keys = level
@@ -163,4 +168,33 @@ fn file(h: &mut Sha256, f: &ManifestFile) {
     h.update(f.path.as_bytes());
     h.update([0]);
     h.update(f.sha256.as_bytes());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A leaf's change changes the keys of its parents up to the root, and no other: what
+    /// lets an edit remake one path of the tree.
+    #[test]
+    fn a_leaf_changes_its_ancestors_keys_only() {
+        // Eight leaves in two groups of four, under one root.
+        let cells: Vec<(i64, i64)> = (0..8).map(|i| (i % 4, i / 4 * 4)).collect();
+        let groups = super::super::hierarchy(&cells);
+        assert_eq!(groups.len(), 2, "{groups:?}");
+        let leaves: Vec<[u8; 32]> = (0..8u8).map(|i| [i; 32]).collect();
+        let before = Keys::above([0; 32], leaves.clone(), &groups);
+        let mut edited = leaves;
+        edited[5] = [99; 32];
+        let after = Keys::above([0; 32], edited, &groups);
+        let holder = groups[0].iter().position(|(_, c)| c.contains(&5)).unwrap();
+        for (g, _) in groups[0].iter().enumerate() {
+            let same = before.get(1, g) == after.get(1, g);
+            assert_eq!(same, g != holder, "group {g} of level 1");
+        }
+        assert_ne!(before.get(2, 0), after.get(2, 0), "the root");
+        // The build-wide part is in every parent's key.
+        let other = Keys::above([1; 32], (0..8u8).map(|i| [i; 32]).collect(), &groups);
+        assert!((0..groups[0].len()).all(|g| other.get(1, g) != before.get(1, g)));
+    }
 }
