@@ -25,7 +25,7 @@ use sha2::{Digest, Sha256};
 
 use crate::generate::TilePlan;
 use crate::model::{Dataset, Plan};
-use crate::output::{features::Directory, report, tiles3d::memory::Memory};
+use crate::output::{features::Directory, listed, report, tiles3d::memory::Memory};
 use crate::params::Params;
 
 /// Parameters only the analysis reads: a change to one remakes the tiles whose plan it
@@ -210,7 +210,7 @@ impl<'a> Reuse<'a> {
         let entry = self.previous.get(id)?;
         let same = mark.plan == plan_hash(tile)
             && mark.owners == owners_hash(&mark.owner_ids, directory)
-            && entry.files().all(|f| on_disk(out, f));
+            && entry.files().all(|f| listed::at_size(out, f));
         same.then(|| (entry.clone(), Mark(mark.clone())))
     }
 
@@ -238,12 +238,6 @@ impl<'a> Reuse<'a> {
 /// A tile's fingerprint, between [`Reuse`] and the build.
 #[derive(Debug, Clone)]
 pub struct Mark(TileMark);
-
-/// Whether a file of a manifest is in `out` with its size (its bytes are the build's own:
-/// the directory is locked and was written by the build before).
-fn on_disk(out: &Path, f: &report::ManifestFile) -> bool {
-    std::fs::metadata(out.join(&f.path)).is_ok_and(|m| m.is_file() && m.len() == f.bytes)
-}
 
 #[cfg(test)]
 mod tests {

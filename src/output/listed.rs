@@ -92,6 +92,16 @@ pub fn locate(dir: &Path, path: &str) -> Result<PathBuf, Unlisted> {
     Ok(real)
 }
 
+/// Whether `dir/f.path` is a file [`locate`] finds, of the size `f` lists: for a rebuild
+/// into a locked directory that keeps files of the build before (its bytes are that build's
+/// own), where hashing every kept file would cost what keeping it saves.
+pub fn at_size(dir: &Path, f: &ManifestFile) -> bool {
+    locate(dir, &f.path)
+        .ok()
+        .and_then(|real| std::fs::metadata(real).ok())
+        .is_some_and(|m| m.len() == f.bytes)
+}
+
 /// Checks that `dir/f.path` is the file `f` lists: its size first (nothing is read when it
 /// differs), then its sha256, read a piece at a time.
 pub fn check(dir: &Path, f: &ManifestFile) -> Result<(), Unlisted> {

@@ -86,12 +86,8 @@ impl Remembered {
     /// Whether its subtree's files are on disk at their sizes (the directory is locked and
     /// was written by the tileset that remembered them).
     pub fn on_disk(&self, out: &Path) -> bool {
-        self.made.iter().all(|(_, _, f)| on_disk(out, f))
+        (self.made.iter()).all(|(_, _, f)| crate::output::listed::at_size(out, f))
     }
-}
-
-fn on_disk(out: &Path, f: &ManifestFile) -> bool {
-    std::fs::metadata(out.join(&f.path)).is_ok_and(|m| m.is_file() && m.len() == f.bytes)
 }
 
 /// Every node's key, level by level (`keys[0]` the leaves').

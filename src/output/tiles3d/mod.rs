@@ -334,14 +334,14 @@ impl Tree<'_> {
             return Ok((leaf_node(&self.leaves[index]), Vec::new()));
         }
         let (cell, children) = &self.groups[level - 1][index];
-        let name = format!("{level}_{}_{}", cell.0, cell.1);
+        let name = parent_name(level, *cell);
         let key = self.keys.as_ref().map(|k| k.get(level, index));
         if let Some(r) =
             (self.before.get(&name)).filter(|r| Some(r.key) == key && r.on_disk(self.out))
         {
             // Its subtree is kept whole, so a later edit under it finds its other parents.
             for (l, c, _) in &r.made {
-                let below = format!("{l}_{}_{}", c.0, c.1);
+                let below = parent_name(*l, *c);
                 if let Some(kept) = self.before.get(&below) {
                     self.remember(below, kept.clone());
                     self.kept.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -402,6 +402,11 @@ impl Tree<'_> {
         let mut now = self.now.lock().unwrap_or_else(|e| e.into_inner());
         now.insert(name, r);
     }
+}
+
+/// A parent's name, its file's stem: `<level>_<x>_<y>`.
+fn parent_name(level: usize, cell: (i64, i64)) -> String {
+    format!("{level}_{}_{}", cell.0, cell.1)
 }
 
 /// A parent's file with its level and cell there.
