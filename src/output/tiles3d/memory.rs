@@ -176,7 +176,7 @@ mod tests {
     fn a_leaf_changes_its_ancestors_keys_only() {
         // Eight leaves in two groups of four, under one root.
         let cells: Vec<(i64, i64)> = (0..8).map(|i| (i % 4, i / 4 * 4)).collect();
-        let groups = super::super::hierarchy(&cells);
+        let groups = crate::output::tiles3d::hierarchy(&cells);
         assert_eq!(groups.len(), 2, "{groups:?}");
         let leaves: Vec<[u8; 32]> = (0..8u8).map(|i| [i; 32]).collect();
         let before = Keys::above([0; 32], leaves.clone(), &groups);
