@@ -35,16 +35,6 @@ pub struct Memory {
 }
 
 impl Memory {
-    /// How many parents it holds.
-    pub fn len(&self) -> usize {
-        self.lock().len()
-    }
-
-    /// Whether it holds none.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// How many parents the last tileset written with it kept as they were.
     pub fn kept(&self) -> usize {
         self.kept.load(Ordering::Relaxed)
