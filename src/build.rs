@@ -22,7 +22,7 @@ use crate::input::{self, InputError};
 use crate::model::{Dataset, LotUse, Plan};
 use crate::output::{self, report};
 use crate::params::{Params, ParamsError};
-use crate::templates::{Catalog, Kind, TemplateError};
+use crate::templates::{Catalog, TemplateError};
 
 pub mod cache;
 mod check;
@@ -37,6 +37,7 @@ mod writing;
 
 pub use check::check;
 pub use clock::{StageClock, StageTime};
+pub use names::load_catalog;
 pub use plan_files::{draw_plan_from, draw_plan_of, merge_plan_files};
 
 /// Progress of the long stages; the CLI draws bars, tests pass [`NoProgress`].
@@ -189,70 +190,6 @@ pub struct BuildOutcome {
     /// With [`BuildOptions::reuse`]: what each tile was made from, for the next build, and
     /// the tiles this one made (the others were kept).
     pub fingerprints: Option<(reuse::Fingerprints, Vec<String>)>,
-}
-
-/// Loads the machiya types and checks `type_mix` against them.
-pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog, BuildError> {
-    let dir = templates.map(Path::to_path_buf).or_else(|| {
-        (!params.machiya.templates.is_empty()).then(|| PathBuf::from(&params.machiya.templates))
-    });
-    let mut catalog = Catalog::load(dir.as_deref())?;
-    catalog.configure(&params.template, &params.district_templates())?;
-    if params.fence.enabled {
-        let f = &params.fence;
-        let named = f.types.values().chain([&f.default_type]);
-        for name in named {
-            if catalog
-                .get(name)
-                .is_none_or(|t| t.kind != Kind::Fence || t.is_abstract)
-            {
-                return Err(BuildError::Config(format!(
-                    "fence.types / fence.default_type name `{name}`, which is not a fence template \
-                     (fence templates: {})",
-                    catalog.names_of(Kind::Fence).join(", ")
-                )));
-            }
-        }
-        let g = &f.gate_template;
-        if catalog
-            .get(g)
-            .is_none_or(|t| t.kind != Kind::Gate || t.is_abstract)
-        {
-            return Err(BuildError::Config(format!(
-                "fence.gate_template names `{g}`, which is not a gate template (gate templates: {})",
-                catalog.names_of(Kind::Gate).join(", ")
-            )));
-        }
-    }
-    if params.kura.enabled {
-        let k = &params.kura.template;
-        if catalog
-            .get(k)
-            .is_none_or(|t| t.kind != Kind::Kura || t.is_abstract)
-        {
-            return Err(BuildError::Config(format!(
-                "kura.template names `{k}`, which is not a kura template (kura templates: {})",
-                catalog.names_of(Kind::Kura).join(", ")
-            )));
-        }
-    }
-    names::check_billboards(&catalog, params)?;
-    names::check_halls_and_ground(&catalog, params)?;
-    let mixes = std::iter::once(("type_mix".to_string(), &params.type_mix)).chain(
-        params
-            .district
-            .iter()
-            .filter_map(|(id, d)| Some((format!("district.{id}.type_mix"), d.type_mix.as_ref()?))),
-    );
-    for (key, name) in mixes.flat_map(|(key, mix)| mix.keys().map(move |n| (key.clone(), n))) {
-        if catalog.machiya(name).is_none() {
-            return Err(BuildError::Config(format!(
-                "{key} names `{name}`, which has no machiya template (known types: {})",
-                catalog.names_of(Kind::Machiya).join(", ")
-            )));
-        }
-    }
-    Ok(catalog)
 }
 
 /// Reads and analyses the input: the part of a build every tile depends on. Returns the

@@ -1,10 +1,77 @@
 //! Names a parameter file gives that the catalog and the texture library must hold, checked
-//! before anything is read: hall templates, ground materials, the billboards' templates and
-//! textures (moved out of build.rs, which had grown past 800 lines).
+//! before anything is read: the machiya, fence, gate and kura templates, hall templates,
+//! ground materials, the billboards' templates and textures (moved out of build.rs, which
+//! had grown past 800 lines).
+
+use std::path::{Path, PathBuf};
 
 use super::BuildError;
 use crate::params::Params;
 use crate::templates::{Catalog, Kind};
+
+/// Loads the machiya types and checks `type_mix` against them.
+pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog, BuildError> {
+    let dir = templates.map(Path::to_path_buf).or_else(|| {
+        (!params.machiya.templates.is_empty()).then(|| PathBuf::from(&params.machiya.templates))
+    });
+    let mut catalog = Catalog::load(dir.as_deref())?;
+    catalog.configure(&params.template, &params.district_templates())?;
+    if params.fence.enabled {
+        let f = &params.fence;
+        let named = f.types.values().chain([&f.default_type]);
+        for name in named {
+            if catalog
+                .get(name)
+                .is_none_or(|t| t.kind != Kind::Fence || t.is_abstract)
+            {
+                return Err(BuildError::Config(format!(
+                    "fence.types / fence.default_type name `{name}`, which is not a fence template \
+                     (fence templates: {})",
+                    catalog.names_of(Kind::Fence).join(", ")
+                )));
+            }
+        }
+        let g = &f.gate_template;
+        if catalog
+            .get(g)
+            .is_none_or(|t| t.kind != Kind::Gate || t.is_abstract)
+        {
+            return Err(BuildError::Config(format!(
+                "fence.gate_template names `{g}`, which is not a gate template (gate templates: {})",
+                catalog.names_of(Kind::Gate).join(", ")
+            )));
+        }
+    }
+    if params.kura.enabled {
+        let k = &params.kura.template;
+        if catalog
+            .get(k)
+            .is_none_or(|t| t.kind != Kind::Kura || t.is_abstract)
+        {
+            return Err(BuildError::Config(format!(
+                "kura.template names `{k}`, which is not a kura template (kura templates: {})",
+                catalog.names_of(Kind::Kura).join(", ")
+            )));
+        }
+    }
+    check_billboards(&catalog, params)?;
+    check_halls_and_ground(&catalog, params)?;
+    let mixes = std::iter::once(("type_mix".to_string(), &params.type_mix)).chain(
+        params
+            .district
+            .iter()
+            .filter_map(|(id, d)| Some((format!("district.{id}.type_mix"), d.type_mix.as_ref()?))),
+    );
+    for (key, name) in mixes.flat_map(|(key, mix)| mix.keys().map(move |n| (key.clone(), n))) {
+        if catalog.machiya(name).is_none() {
+            return Err(BuildError::Config(format!(
+                "{key} names `{name}`, which has no machiya template (known types: {})",
+                catalog.names_of(Kind::Machiya).join(", ")
+            )));
+        }
+    }
+    Ok(catalog)
+}
 
 /// `halls.uses` names hall templates, and `ground.materials` library materials.
 pub(super) fn check_halls_and_ground(catalog: &Catalog, params: &Params) -> Result<(), BuildError> {
