@@ -16,11 +16,8 @@ use geo_types::{Coord, Polygon};
 use rand::RngExt;
 use rand_distr::{Distribution, Poisson};
 use rayon::prelude::*;
-use rstar::primitives::GeomWithData;
-use rstar::RTree;
 
 use super::obstacles::{boundary_distance, Obstacles};
-use crate::geom::segment::Segment;
 use crate::model::tile::tile_id;
 use crate::model::{
     sane, BillboardKind, Dataset, Plan, PlannedBillboard, PointFeature, Skipped, FAR,
@@ -29,98 +26,15 @@ use crate::params::Params;
 use crate::rng::feature_rng;
 use crate::templates::Catalog;
 use kind::Kind;
+use surroundings::Surroundings;
 use thinning::{cap_tiles, keep_spaced, thin};
 
 mod kind;
+mod surroundings;
 mod thinning;
 
 /// Streets are cut into pieces no longer than this, each a source of its own.
 const PIECE: f64 = 20.0;
-
-/// Where a point is and what it stands on: the district and ground of the nearest lot (the
-/// DEM's ground when there is one), the direction of the nearest street.
-struct Surroundings<'a> {
-    lots: RTree<GeomWithData<[f64; 2], usize>>,
-    info: Vec<(Option<&'a str>, f64)>,
-    streets: RTree<Segment>,
-    dem: Option<&'a crate::model::dem::Dem>,
-}
-
-impl<'a> Surroundings<'a> {
-    fn new(data: &'a Dataset) -> Surroundings<'a> {
-        let mut points = Vec::new();
-        let mut info = Vec::new();
-        let lots = data
-            .lots
-            .iter()
-            .map(|l| (&l.outline, &l.district, l.ground));
-        let fps = data
-            .footprints
-            .iter()
-            .map(|f| (&f.outline, &f.district, f.ground));
-        for (outline, district, ground) in lots.chain(fps) {
-            if let Some(c) = outline
-                .centroid()
-                .filter(|c| c.x().is_finite() && c.y().is_finite())
-            {
-                points.push(GeomWithData::new([c.x(), c.y()], info.len()));
-                info.push((district.as_deref(), ground));
-            }
-        }
-        // People face along their street: the centrelines, else the block edges (which run
-        // along the streets too).
-        let mut segs: Vec<Segment> = data
-            .streets
-            .iter()
-            .flat_map(|s| s.line.lines())
-            .map(|l| segment(l.start, l.end))
-            .collect();
-        if segs.is_empty() {
-            segs = data
-                .blocks
-                .iter()
-                .flat_map(|b| b.exterior().lines())
-                .map(|l| segment(l.start, l.end))
-                .collect();
-        }
-        segs.retain(|s| sane(s.a.into()) && sane(s.b.into()) && s.a != s.b);
-        Surroundings {
-            lots: RTree::bulk_load(points),
-            info,
-            streets: RTree::bulk_load(segs),
-            dem: data.dem.as_ref(),
-        }
-    }
-
-    /// District and ground at `p`.
-    fn at(&self, p: Coord<f64>, ground: Option<f64>) -> (Option<String>, f64) {
-        let near = self
-            .lots
-            .nearest_neighbor(&[p.x, p.y])
-            .map(|g| self.info[g.data]);
-        let district = near.and_then(|n| n.0).map(str::to_string);
-        let ground = match self.dem {
-            Some(dem) => dem.sample(p).z,
-            None => ground.or(near.map(|n| n.1)).unwrap_or(0.0),
-        };
-        (district, ground)
-    }
-
-    /// Direction of the street nearest `p`, radians.
-    fn street_angle(&self, p: Coord<f64>) -> f64 {
-        self.streets
-            .nearest_neighbor(&[p.x, p.y])
-            .map_or(0.0, |s| (s.b[1] - s.a[1]).atan2(s.b[0] - s.a[0]))
-    }
-}
-
-fn segment(a: Coord<f64>, b: Coord<f64>) -> Segment {
-    Segment {
-        a: [a.x, a.y],
-        b: [b.x, b.y],
-        value: 0.0,
-    }
-}
 
 /// A source of generated points: a street piece or a lot.
 struct Source<'a> {
@@ -302,10 +216,7 @@ fn street_sources<'a>(data: &'a Dataset, near: &Surroundings<'a>, p: &Params) ->
                     at((j + 1) as f64 / pieces as f64),
                 );
                 let mid = at((j as f64 + 0.5) / pieces as f64);
-                let district = near
-                    .lots
-                    .nearest_neighbor(&[mid.x, mid.y])
-                    .and_then(|g| near.info[g.data].0);
+                let district = near.district(mid);
                 let density =
                     p.district_density(district, |d| d.people_per_100m, p.people.per_100m);
                 out.push(Source {

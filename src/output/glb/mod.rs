@@ -8,6 +8,7 @@
 use serde_json::{json, Value};
 
 pub mod buffer;
+pub mod container;
 pub mod metadata;
 
 use buffer::Buffer;

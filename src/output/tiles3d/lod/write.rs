@@ -11,11 +11,12 @@ use std::collections::{BTreeMap, HashMap};
 use serde_json::{json, Value};
 
 use super::{Content, Part};
-use crate::output::glb::buffer::{self, Buffer};
+use crate::output::glb::buffer::Buffer;
+use crate::output::glb::container;
 use crate::output::glb::metadata;
 
 /// The GLB of `content` named `name`, compressed with meshopt when `meshopt`.
-pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> buffer::Glb {
+pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> container::Glb {
     let mut solid = content.solid.clone();
     let flat = level > 1;
     let hidden = super::hidden::hidden_walls(&content.masses, flat);
@@ -118,7 +119,7 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
         doc["accessors"] = json!(buf.accessors);
         crate::output::glb::add_images(&mut doc, images, textures);
     }
-    buffer::glb(&doc, buf.bin)
+    container::glb(&doc, buf.bin)
 }
 
 /// The triangles of `part` by the kind of their feature (the metadata row of their first
