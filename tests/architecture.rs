@@ -215,6 +215,42 @@ fn modules_depend_only_on_what_architecture_md_allows() {
     );
 }
 
+/// ARCHITECTURE.md: no file in src/ over 600 lines (issue 58: a file a newcomer can read
+/// whole; split by what its parts decide, as `generate/instance/` and `gltf/primitive.rs`).
+#[test]
+fn no_source_file_is_over_600_lines() {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    walk(&src(), &mut files);
+    assert!(
+        files.len() > 100,
+        "the walk found the sources: {}",
+        files.len()
+    );
+    let mut long: Vec<String> = files
+        .iter()
+        .filter_map(|f| {
+            let n = std::fs::read_to_string(f).unwrap().lines().count();
+            (n > 600).then(|| format!("{}: {n} lines", f.display()))
+        })
+        .collect();
+    long.sort();
+    assert!(
+        long.is_empty(),
+        "files over 600 lines:\n{}",
+        long.join("\n")
+    );
+}
+
 #[test]
 fn only_the_readers_writers_and_the_cli_touch_the_file_system() {
     let mut wrong = Vec::new();
