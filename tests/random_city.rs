@@ -275,12 +275,13 @@ proptest! {
         let plan = edo_city::analyse::analyse(&data, &params, &catalog, "lots.shp", &|_| {});
         check_billboards(&plan, &data)?;
         let files = edo_city::generate::LayerFiles::default();
+        let variants = edo_city::generate::variant::Variants::of(&params);
         let mut built = std::collections::BTreeSet::new();
         let mut skipped: std::collections::BTreeSet<String> =
             plan.skipped.iter().map(|s| s.id.clone()).collect();
         for id in &plan.tiles {
             let tile = edo_city::generate::TilePlan::of(&plan, id);
-            let t = edo_city::generate::generate_tile(&tile, &catalog, &params, plan.origin, &files);
+            let t = edo_city::generate::generate_tile(&tile, &catalog, &params, &variants, plan.origin, &files);
             for s in &t.stats.skipped {
                 prop_assert!(!s.reason.is_empty() && !s.id.is_empty());
                 skipped.insert(s.id.clone());

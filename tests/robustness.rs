@@ -147,10 +147,11 @@ mod random_geometry {
             let catalog = edo_city::templates::Catalog::load(None).unwrap();
             let plan = edo_city::analyse::analyse(&data, &params, &catalog, "lots.shp", &|_| {});
             let files = edo_city::generate::LayerFiles::default();
+            let variants = edo_city::generate::variant::Variants::of(&params);
             let mut houses = 0;
             for lots in plan.houses.values() {
                 let tile = edo_city::generate::TilePlan { lots, ..Default::default() };
-                let t = edo_city::generate::generate_tile(&tile, &catalog, &params, plan.origin, &files);
+                let t = edo_city::generate::generate_tile(&tile, &catalog, &params, &variants, plan.origin, &files);
                 for s in &t.stats.skipped {
                     prop_assert!(!s.reason.is_empty());
                 }

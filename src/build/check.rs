@@ -30,6 +30,7 @@ pub fn check(
     let catalog = load_catalog(params, templates)?;
     let (data, plan, _, _) = read_and_analyse(input, params, &catalog, &NoProgress)?;
     let files = layer_files(input, params);
+    let variants = generate::variant::Variants::of(params);
     // Generate every tile (to find the houses that cannot be built), write nothing.
     let tiles: Vec<report::ManifestTile> = plan
         .tiles
@@ -40,7 +41,8 @@ pub fn check(
                 surface: None,
                 ..generate::TilePlan::of(&plan, id)
             };
-            let meshes = generate::generate_tile(&tile, &catalog, params, plan.origin, &files);
+            let meshes =
+                generate::generate_tile(&tile, &catalog, params, &variants, plan.origin, &files);
             report::ManifestTile {
                 id: id.clone(),
                 obj: None,

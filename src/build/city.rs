@@ -42,6 +42,8 @@ pub(super) struct CityWriter<'a> {
     files: generate::LayerFiles,
     textures: Vec<report::ManifestFile>,
     species: Vec<report::ManifestFile>,
+    /// The tree variants, grown once for `species/` and every tile.
+    variants: generate::variant::Variants,
     /// Nanoseconds generating and writing, summed over threads (`--timings`' CPU figures).
     generate_ns: AtomicU64,
     write_ns: AtomicU64,
@@ -83,8 +85,12 @@ impl<'a> CityWriter<'a> {
         textures.extend(
             output::write_model_textures(&opts.out, &plan.model_textures).map_err(texture_err)?,
         );
-        let species = output::species::write_species(&opts.out, plan, catalog, params, alone)
-            .map_err(|e| write_err(&opts.out.join("species"), e))?;
+        let variants = generate::variant::Variants::of(params);
+        let trees = generate::species::planted_trees(plan);
+        let models = generate::species::species_models(&trees, catalog, params, &variants);
+        let species =
+            output::species::write_species(&opts.out, plan, &trees, &models, catalog, alone)
+                .map_err(|e| write_err(&opts.out.join("species"), e))?;
         Ok(CityWriter {
             opts,
             catalog,
@@ -99,6 +105,7 @@ impl<'a> CityWriter<'a> {
             files: super::layer_files(&opts.input, params),
             textures,
             species,
+            variants,
             generate_ns: AtomicU64::new(0),
             write_ns: AtomicU64::new(0),
         })
@@ -149,8 +156,14 @@ impl<'a> CityWriter<'a> {
     ) -> Result<(report::ManifestTile, Vec<String>), BuildError> {
         let (params, out) = (&self.opts.params, &self.opts.out);
         let t = Instant::now();
-        let mut meshes =
-            generate::generate_tile(tile, self.catalog, params, plan.origin, &self.files);
+        let mut meshes = generate::generate_tile(
+            tile,
+            self.catalog,
+            params,
+            &self.variants,
+            plan.origin,
+            &self.files,
+        );
         self.generate_ns
             .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
         let t = Instant::now();

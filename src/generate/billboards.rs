@@ -23,22 +23,24 @@ pub struct Built {
 /// the walkers for formats that animate. A billboard whose template fails is skipped with
 /// the reason.
 pub fn build(
-    billboards: &[PlannedBillboard],
-    walks: &[crate::model::Walk],
+    tile: &super::TilePlan,
     catalog: &Catalog,
     params: &Params,
+    variants: &super::variant::Variants,
     frame: Frame,
     files: &super::LayerFiles,
     stats: &mut TileStats,
 ) -> Built {
+    let (billboards, walks) = (tile.billboards, tile.walks);
     let mut out = Vec::new();
     let walkers: std::collections::HashSet<&str> = walks.iter().map(|w| w.id.as_str()).collect();
     let grown: Vec<&PlannedBillboard> = billboards
         .iter()
         .filter(|b| b.tree.as_ref().is_some_and(|t| t.grown))
         .collect();
-    let planted = (!grown.is_empty())
-        .then(|| super::planted::build(grown, catalog, params, frame, &files.trees, stats));
+    let planted = (!grown.is_empty()).then(|| {
+        super::planted::build(grown, catalog, params, variants, frame, &files.trees, stats)
+    });
     let left: std::collections::HashSet<*const PlannedBillboard> = planted
         .iter()
         .flat_map(|p| p.billboards.iter().map(|b| *b as *const PlannedBillboard))

@@ -18,6 +18,7 @@ pub mod landmarks;
 pub mod machiya;
 pub mod mesh;
 pub mod planted;
+pub mod species;
 pub mod terrain;
 pub mod tree;
 pub mod variant;
@@ -112,6 +113,7 @@ pub fn generate_tile(
     tile: &TilePlan,
     catalog: &Catalog,
     params: &Params,
+    variants: &variant::Variants,
     origin: [f64; 2],
     files: &LayerFiles,
 ) -> TileMeshes {
@@ -211,10 +213,10 @@ pub fn generate_tile(
     build_halls(tile.halls, catalog, params, frame, files, &mut out);
     build_fences(tile.fences, catalog, params, frame, files, &mut out);
     let people_and_trees = billboards::build(
-        tile.billboards,
-        tile.walks,
+        tile,
         catalog,
         params,
+        variants,
         frame,
         files,
         &mut out.stats,

@@ -3,8 +3,8 @@
 //! fit is drawn as its species' billboard. All grown trees of a tile are one object,
 //! `trees_grown`.
 //!
-//! A tree is one of its species' `trees.variants`: the variant is grown once per tile at the
-//! species' nominal height from its own key and meshed ([`variant::variant_model`]), and every
+//! A tree is one of its species' `trees.variants`: the variant is grown once per build at the
+//! species' nominal height from its own key and meshed ([`Variants`]), and every
 //! tree of it is a copy scaled to the tree's height (its crown narrowed by the squeeze),
 //! turned and moved ([`variant::place_copy`]). The OBJ gets the copies (`trees_grown`); formats
 //! that instance (GLB) get each variant once with where its trees stand ([`Instanced`]).
@@ -18,9 +18,11 @@
 //! `max_tile_bytes` of grown trees. A tree whose species' trees met so far in the tile say
 //! it would not fit is not grown (the most bytes per square metre of height seen).
 
+use std::sync::Arc;
+
 use super::mesh::{Frame, Mesh};
 use super::tree::{self, Lod, Look, Placement};
-use super::variant::{self, Stance};
+use super::variant::{self, Stance, Variants};
 use crate::model::{PlannedBillboard, Skipped, TileStats};
 use crate::params::Params;
 use crate::templates::Catalog;
@@ -30,8 +32,8 @@ use crate::templates::Catalog;
 #[derive(Debug, Clone)]
 pub struct Instanced {
     /// The variant at its species' nominal height ([`variant::variant_model`]), named
-    /// `<species>_<k>`, its foot at the origin.
-    pub model: Mesh,
+    /// `<species>_<k>`, its foot at the origin: the build's one model of it ([`Variants`]).
+    pub model: Arc<Mesh>,
     /// Its trees, in the order they were meshed into `trees_grown`.
     pub trees: Vec<InstancedTree>,
 }
@@ -65,6 +67,7 @@ pub fn build<'a>(
     trees: Vec<&'a PlannedBillboard>,
     catalog: &Catalog,
     params: &Params,
+    grown: &Variants,
     frame: Frame,
     file: &str,
     stats: &mut TileStats,
@@ -114,13 +117,7 @@ pub fn build<'a>(
                 let at = match variants.iter().position(|(v, _)| *v == key) {
                     Some(i) => i,
                     None => {
-                        let model = variant::variant_model(
-                            species,
-                            params.seed_for("trees"),
-                            k,
-                            &params.trees.season,
-                        )
-                        .map(|model| Instanced {
+                        let model = grown.model(species, k).map(|model| Instanced {
                             model,
                             trees: Vec::new(),
                         });

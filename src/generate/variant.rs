@@ -3,6 +3,9 @@
 //! tree a copy of its variant scaled to its height, narrowed, turned and moved, which a GLB
 //! draws by instancing and an OBJ holds as copies (docs/trees.md).
 
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
 use geo_types::Coord;
 
 use super::mesh::{Frame, Mesh};
@@ -58,6 +61,56 @@ pub fn variant_model(species: &Species, seed: u64, k: u32, season: &str) -> Resu
         &mut mesh,
     );
     Ok(mesh.finish())
+}
+
+/// A model of [`Variants`], or why its variant cannot be grown.
+type Grown = Result<Arc<Mesh>, String>;
+
+/// Per (species, variant), the cell its model is grown into once.
+type Cells = BTreeMap<(String, u32), Arc<OnceLock<Grown>>>;
+
+/// The tree variants of one build, each grown and meshed once ([`variant_model`]) by the
+/// first tile that plants a tree of it and shared by every other tile and by `species/`: a
+/// variant is the same model in any tile (its key is the build's, not the tile's), and
+/// growing it again for each of a city's tiles was a twelfth of an every-feature build.
+/// Grown on first use, not up front, so a rebuild of one tile grows only its own variants.
+/// Tiles are made on rayon's threads: a thread asking for a variant another is growing
+/// waits for it, which is safe because growing never enters rayon itself (a thread waiting
+/// in rayon could otherwise pick up a tile that waits on the variant it is growing).
+#[derive(Debug)]
+pub struct Variants {
+    seed: u64,
+    season: String,
+    /// Per (species, variant), the model once grown.
+    grown: Mutex<Cells>,
+}
+
+impl Variants {
+    /// The variants of a build with the trees' seed `seed` in `season`; none grown yet.
+    pub fn new(seed: u64, season: &str) -> Variants {
+        Variants {
+            seed,
+            season: season.to_string(),
+            grown: Mutex::new(BTreeMap::new()),
+        }
+    }
+
+    /// The variants of a build with `params`.
+    pub fn of(params: &crate::params::Params) -> Variants {
+        Variants::new(params.seed_for("trees"), &params.trees.season)
+    }
+
+    /// Variant `k` of `species` at its nominal height ([`variant_model`]), grown on the first
+    /// call and shared after it; the same error every time when it cannot be grown.
+    pub fn model(&self, species: &Species, k: u32) -> Grown {
+        let cell = {
+            let mut grown = self.grown.lock().unwrap_or_else(|e| e.into_inner());
+            let key = (species.name.clone(), k);
+            Arc::clone(grown.entry(key).or_default())
+        };
+        cell.get_or_init(|| variant_model(species, self.seed, k, &self.season).map(Arc::new))
+            .clone()
+    }
 }
 
 /// How a copy of a model stands: its foot at `place`, `scale` times as tall and
@@ -118,6 +171,27 @@ mod tests {
             assert!((10..=100).contains(&n), "variant {k}: {n} of 400");
         }
         assert_eq!(variant_of(1, "7", 8), variant_of(1, "7", 8));
+    }
+
+    /// A variant is grown once and shared: the same model whoever asks, equal to growing it
+    /// directly, and a species that cannot grow gives its error each time.
+    #[test]
+    fn a_variant_is_grown_once_and_is_the_model_grown_directly() {
+        let catalog = crate::templates::Catalog::load(None).unwrap();
+        let species = catalog.species.values().next().unwrap();
+        let variants = Variants::new(5, "summer");
+        let first = variants.model(species, 2).unwrap();
+        let again = variants.model(species, 2).unwrap();
+        assert!(Arc::ptr_eq(&first, &again), "grown once");
+        let direct = variant_model(species, 5, 2, "summer").unwrap();
+        assert_eq!(first.positions, direct.positions);
+        assert_eq!(first.faces.len(), direct.faces.len());
+        let other = variants.model(species, 3).unwrap();
+        assert!(!Arc::ptr_eq(&first, &other));
+        assert_ne!(
+            first.positions, other.positions,
+            "another variant, another tree"
+        );
     }
 
     #[test]

@@ -15,28 +15,23 @@ use std::path::Path;
 
 use super::report::ManifestFile;
 use super::{atomic, obj};
-use crate::generate::{tree, variant};
-use crate::model::Plan;
-use crate::params::Params;
+use crate::generate::species::SpeciesModels;
+use crate::model::{Plan, PlannedBillboard, TreeForm};
 use crate::templates::Catalog;
 
-/// Writes the species directory (or removes an earlier build's when no tree has a species);
-/// returns its files for the manifest. `alone`: whether this run holds the directory alone
-/// (not a shard beside others), so it may sweep a killed run's temporaries.
+/// Writes the species directory (or removes an earlier build's when no tree has a species):
+/// `models` ([`crate::generate::species::species_models`]) of the `trees` of `plan`. Returns
+/// its files for the manifest. `alone`: whether this run holds the directory alone (not a
+/// shard beside others), so it may sweep a killed run's temporaries.
 pub fn write_species(
     out: &Path,
     plan: &Plan,
+    trees: &[(&PlannedBillboard, &TreeForm)],
+    models: &SpeciesModels,
     catalog: &Catalog,
-    params: &Params,
     alone: bool,
 ) -> std::io::Result<Vec<ManifestFile>> {
     let dir = out.join("species");
-    let trees: Vec<_> = plan
-        .billboards
-        .values()
-        .flatten()
-        .filter_map(|b| b.tree.as_ref().map(|t| (b, t)))
-        .collect();
     if trees.is_empty() {
         if dir.is_dir() {
             std::fs::remove_dir_all(&dir)?;
@@ -56,56 +51,25 @@ pub fn write_species(
         )?);
         Ok(())
     };
-    let used: BTreeMap<&str, ()> = trees
-        .iter()
-        .map(|(_, t)| (t.species.as_str(), ()))
-        .collect();
+    let mtl = obj::mtl::mtl_text_at("../tiles/textures/");
     let mut heights = BTreeMap::new();
-    for name in used.keys() {
-        let Some(s) = catalog.species.get(*name) else {
-            continue;
-        };
-        let Ok((mesh, _)) = tree::sample_lod0(s, &params.trees.season) else {
-            continue;
-        };
+    for s in &models.samples {
         let mut buf = Vec::new();
-        obj::write_tile(&mut buf, &s.name, [0.0, 0.0], [&mesh]);
+        obj::write_tile(&mut buf, &s.name, [0.0, 0.0], [&s.mesh]);
         put(format!("{}.obj", s.name), &buf)?;
-        put(
-            format!("{}.mtl", s.name),
-            obj::mtl::mtl_text_at("../tiles/textures/").as_bytes(),
-        )?;
-        heights.insert(s.name.clone(), s.nominal_height());
+        put(format!("{}.mtl", s.name), mtl.as_bytes())?;
+        heights.insert(s.name.as_str(), s.height);
     }
-    let variant = |b: &crate::model::PlannedBillboard, t: &crate::model::TreeForm| {
-        t.grown
-            .then(|| variant::variant_of(params.seed_for("trees"), &b.id, params.trees.variants))
-            .flatten()
-    };
     // Every variant a grown tree is, at LOD1 and the species' nominal height.
-    let variants: BTreeMap<(&str, u32), ()> = trees
-        .iter()
-        .filter_map(|(b, t)| Some(((t.species.as_str(), variant(b, t)?), ())))
-        .collect();
-    for &(name, k) in variants.keys() {
-        let Some(s) = catalog.species.get(name) else {
-            continue;
-        };
-        let Ok(mesh) = variant::variant_model(s, params.seed_for("trees"), k, &params.trees.season)
-        else {
-            continue;
-        };
+    for (name, k, mesh) in &models.variants {
         let mut buf = Vec::new();
-        obj::write_tile(&mut buf, &format!("{name}_{k}"), [0.0, 0.0], [&mesh]);
+        obj::write_tile(&mut buf, &format!("{name}_{k}"), [0.0, 0.0], [&**mesh]);
         put(format!("{name}_{k}.obj"), &buf)?;
-        put(
-            format!("{name}_{k}.mtl"),
-            obj::mtl::mtl_text_at("../tiles/textures/").as_bytes(),
-        )?;
+        put(format!("{name}_{k}.mtl"), mtl.as_bytes())?;
     }
     let mut csv = String::from("id,tile,species,lot,x,y,z,rotation,scale,squeeze,style,variant\n");
-    for (b, t) in &trees {
-        let Some(h) = heights.get(&t.species) else {
+    for (b, t) in trees {
+        let Some(h) = heights.get(t.species.as_str()) else {
             continue;
         };
         let _ = writeln!(
@@ -125,7 +89,9 @@ pub fn write_species(
                 Some(s) if t.grown => s.method,
                 _ => "billboard",
             },
-            variant(b, t).map_or(String::new(), |k| k.to_string()),
+            models
+                .variant_of(b, t)
+                .map_or(String::new(), |k| k.to_string()),
         );
     }
     put("placements.csv".into(), csv.as_bytes())?;
