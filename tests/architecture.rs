@@ -102,18 +102,20 @@ fn src() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
 }
 
-/// The `.rs` files of each crate-level module (`src/x.rs` and everything under `src/x/`).
-fn modules() -> BTreeMap<String, Vec<PathBuf>> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-        for e in std::fs::read_dir(dir).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                walk(&p, out);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                out.push(p);
-            }
+/// Every `.rs` file under `dir`, into `out`.
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            walk(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
         }
     }
+}
+
+/// The `.rs` files of each crate-level module (`src/x.rs` and everything under `src/x/`).
+fn modules() -> BTreeMap<String, Vec<PathBuf>> {
     let mut out: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
     for e in std::fs::read_dir(src()).unwrap().flatten() {
         let p = e.path();
@@ -219,16 +221,6 @@ fn modules_depend_only_on_what_architecture_md_allows() {
 /// whole; split by what its parts decide, as `generate/instance/` and `gltf/primitive.rs`).
 #[test]
 fn no_source_file_is_over_600_lines() {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-        for e in std::fs::read_dir(dir).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                walk(&p, out);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                out.push(p);
-            }
-        }
-    }
     let mut files = Vec::new();
     walk(&src(), &mut files);
     assert!(
@@ -348,16 +340,6 @@ fn siblings_named(text: &str, parent: &str, direct: bool) -> BTreeSet<String> {
 
 /// Every module's children and which of them each one names, from the files under `src/`.
 fn sibling_edges() -> BTreeMap<String, BTreeMap<String, BTreeSet<String>>> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-        for e in std::fs::read_dir(dir).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                walk(&p, out);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                out.push(p);
-            }
-        }
-    }
     let mut files = Vec::new();
     walk(&src(), &mut files);
     // parent module path -> child -> the siblings it names
