@@ -20,39 +20,20 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
         let f = &params.fence;
         let named = f.types.values().chain([&f.default_type]);
         for name in named {
-            if catalog
-                .get(name)
-                .is_none_or(|t| t.kind != Kind::Fence || t.is_abstract)
-            {
-                return Err(BuildError::Config(format!(
-                    "fence.types / fence.default_type name `{name}`, which is not a fence template \
-                     (fence templates: {})",
-                    catalog.names_of(Kind::Fence).join(", ")
-                )));
-            }
+            template_of(
+                &catalog,
+                name,
+                Kind::Fence,
+                "fence",
+                "fence.types / fence.default_type name",
+            )?;
         }
         let g = &f.gate_template;
-        if catalog
-            .get(g)
-            .is_none_or(|t| t.kind != Kind::Gate || t.is_abstract)
-        {
-            return Err(BuildError::Config(format!(
-                "fence.gate_template names `{g}`, which is not a gate template (gate templates: {})",
-                catalog.names_of(Kind::Gate).join(", ")
-            )));
-        }
+        template_of(&catalog, g, Kind::Gate, "gate", "fence.gate_template names")?;
     }
     if params.kura.enabled {
         let k = &params.kura.template;
-        if catalog
-            .get(k)
-            .is_none_or(|t| t.kind != Kind::Kura || t.is_abstract)
-        {
-            return Err(BuildError::Config(format!(
-                "kura.template names `{k}`, which is not a kura template (kura templates: {})",
-                catalog.names_of(Kind::Kura).join(", ")
-            )));
-        }
+        template_of(&catalog, k, Kind::Kura, "kura", "kura.template names")?;
     }
     check_billboards(&catalog, params)?;
     check_halls_and_ground(&catalog, params)?;
@@ -73,21 +54,34 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
     Ok(catalog)
 }
 
+/// `name` (which `key_says`, e.g. "kura.template names") is a template of `kind` that can be
+/// built (not abstract); else the error listing the `what` templates there are.
+fn template_of(
+    catalog: &Catalog,
+    name: &str,
+    kind: Kind,
+    what: &str,
+    key_says: &str,
+) -> Result<(), BuildError> {
+    match catalog
+        .get(name)
+        .is_some_and(|t| t.kind == kind && !t.is_abstract)
+    {
+        true => Ok(()),
+        false => Err(BuildError::Config(format!(
+            "{key_says} `{name}`, which is not a {what} template ({what} templates: {})",
+            catalog.names_of(kind).join(", ")
+        ))),
+    }
+}
+
 /// `halls.uses` names hall templates, and `ground.materials` library materials.
 pub(super) fn check_halls_and_ground(catalog: &Catalog, params: &Params) -> Result<(), BuildError> {
     if params.halls.enabled {
         for (u, names) in &params.halls.uses {
             for name in names {
-                if catalog
-                    .get(name)
-                    .is_none_or(|t| t.kind != Kind::Hall || t.is_abstract)
-                {
-                    return Err(BuildError::Config(format!(
-                        "halls.uses.{u} names `{name}`, which is not a hall template (hall \
-                         templates: {})",
-                        catalog.names_of(Kind::Hall).join(", ")
-                    )));
-                }
+                let says = format!("halls.uses.{u} names");
+                template_of(catalog, name, Kind::Hall, "hall", &says)?;
             }
         }
     }
@@ -136,4 +130,47 @@ pub(super) fn check_billboards(catalog: &Catalog, params: &Params) -> Result<(),
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A parameter naming a template of another kind, or none, is refused with the key, the
+    /// name and the templates of the kind asked for.
+    #[test]
+    fn a_template_of_the_wrong_kind_is_named_with_the_ones_there_are() {
+        let refused = |toml: &str| match load_catalog(
+            &Params::from_toml_str(toml, "p.toml").unwrap(),
+            None,
+        ) {
+            Err(BuildError::Config(m)) => m,
+            other => panic!("{toml}: {:?}", other.map(|_| ())),
+        };
+        let m = refused("[fence]\ngate_template = \"nope\"\n");
+        assert!(
+            m.starts_with(
+                "fence.gate_template names `nope`, which is not a gate template (gate templates: "
+            ),
+            "{m}"
+        );
+        let m = refused("[fence]\ndefault_type = \"nope\"\n");
+        assert!(
+            m.starts_with(
+                "fence.types / fence.default_type name `nope`, which is not a fence template"
+            ),
+            "{m}"
+        );
+        let kura = refused("[kura]\ntemplate = \"nope\"\n");
+        assert!(
+            kura.contains("which is not a kura template (kura templates: "),
+            "{kura}"
+        );
+        let halls = refused("[halls.uses]\njisha = [\"nope\"]\n");
+        assert!(
+            halls.starts_with("halls.uses.jisha names `nope`, which is not a hall template"),
+            "{halls}"
+        );
+        assert!(load_catalog(&Params::default(), None).is_ok());
+    }
 }
