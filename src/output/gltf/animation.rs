@@ -20,10 +20,9 @@ use std::collections::BTreeMap;
 
 use serde_json::{json, Value};
 
-use super::{Primitive, Slot};
+use super::{Primitive, Scene, Slot};
 use crate::generate::crowd::Crowd;
 use crate::model::WalkKey;
-use crate::output::glb::buffer::Buffer;
 
 /// The largest distance (metres) between a walker and where its kept keys put it.
 pub const TOLERANCE: f64 = 0.02;
@@ -48,24 +47,26 @@ pub(super) struct Animated {
     pub skins: Vec<Value>,
 }
 
-/// Adds the walkers (appended to `meshes` and `nodes`) and returns the clip and skins.
+/// Adds the walkers (appended to the scene's meshes and nodes) and returns the clip and skins.
 /// Each walker is a joint node, `person_<id>`, under one `crowd` node; the figures of up to
 /// [`SKIN_JOINTS`] walkers are one skinned mesh, each figure's vertices following its
 /// walker's joint wholly (a node per walker drew each walker in a call of its own: +263
 /// draw calls at the 30,052-lot town's central crossing). `feature` is the people row the
 /// figures' vertices carry; `origin` and `shift` as for the tile's other nodes.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn add(
     crowd: &Crowd,
     atlas: Option<&crate::output::atlas::Atlas>,
     origin: [f64; 2],
     shift: [i64; 3],
     feature: u32,
-    buf: &mut Buffer,
-    used: &mut Vec<u16>,
-    meshes: &mut Vec<Value>,
-    nodes: &mut Vec<Value>,
+    scene: &mut Scene,
 ) -> Option<Animated> {
+    let Scene {
+        buf,
+        used,
+        meshes,
+        nodes,
+    } = scene;
     let walkers: Vec<&crate::generate::crowd::Walker> = crowd
         .walkers
         .iter()

@@ -9,29 +9,31 @@
 //! The OBJ draws the same trees as copies (`trees_grown`, made by `variant::place_copy` with the
 //! same numbers), so both formats show the same branches; the GLB leaves that mesh out.
 
-use serde_json::{json, Value};
+use serde_json::json;
 
 use super::models::Model;
+use super::Scene;
 use crate::generate::planted::Instanced;
-use crate::output::glb::buffer::Buffer;
 
-/// The mesh and the node of each variant, appended to `meshes` and `nodes` (the node's mesh
-/// is its index there). `models` are the variants' shared models, in the order of `groups`
+/// The mesh and the node of each variant, appended to the scene's (the node's mesh is its
+/// index there). `models` are the variants' shared models, in the order of `groups`
 /// (one per group with trees); `origin` is the dataset origin (map metres) and `shift` the
 /// tile centre (output millimetres) the translations are taken around; `first_feature` is
-/// the metadata row of the first tree; `used` the tile's materials in first-use order.
-#[allow(clippy::too_many_arguments)]
+/// the metadata row of the first tree.
 pub(super) fn add(
     groups: &[Instanced],
     models: &[&Model],
     origin: [f64; 2],
     shift: [i64; 3],
     first_feature: usize,
-    buf: &mut Buffer,
-    used: &mut Vec<u16>,
-    meshes: &mut Vec<Value>,
-    nodes: &mut Vec<Value>,
+    scene: &mut Scene,
 ) {
+    let Scene {
+        buf,
+        used,
+        meshes,
+        nodes,
+    } = scene;
     let mut feature = first_feature;
     let planted = groups.iter().filter(|g| !g.trees.is_empty());
     for (g, model) in planted.zip(models) {

@@ -29,6 +29,19 @@ use crate::output::glb::{add_images, declare_extensions, linear, metadata};
 use crate::output::palette::{mime_type, Palette};
 use primitive::{material_index, primitive_json, Primitive, Slot};
 
+/// What a tile's GLB is assembled into, in the order it is written: the BIN chunk with its
+/// views and accessors, the materials in first-use order, and the meshes and the nodes
+/// drawing them (a node names its mesh by its index).
+pub(super) struct Scene {
+    pub(super) buf: Buffer,
+    pub(super) used: Vec<u16>,
+    pub(super) meshes: Vec<Value>,
+    pub(super) nodes: Vec<Value>,
+}
+
+/// A tile's primitives: per node kind in order of first appearance, per material by id.
+type Kinds<'a> = Vec<(&'a str, std::collections::BTreeMap<u16, Primitive>)>;
+
 /// The GLB bytes of one tile. `shift` (millimetres, output frame) is the tile centre the
 /// positions are taken around; `features` has one entry per mesh. Grown trees come
 /// instanced when the tile has `instanced` variants (their copies in `trees_grown` are left
@@ -40,16 +53,59 @@ pub fn tile_glb(
     atlas: Option<&Atlas>,
     models: &[&models::Model],
 ) -> crate::output::glb::container::Glb {
-    let (meshes, features, shift, palette) =
-        (tile.meshes, tile.features, tile.centre, tile.palette);
-    let instanced = !tile.instanced.is_empty();
     // Walkers come animated: their standing copies are left out, their figures carry the
     // copies' row.
     let walking =
-        (tile.crowd).and_then(|_| (meshes.iter()).position(|m| m.kind == ObjectKind::Walkers));
-    // Node per kind, in order of first appearance; primitive per material, by material id.
-    let mut kinds: Vec<(&str, std::collections::BTreeMap<u16, Primitive>)> = Vec::new();
-    for (i, (mesh, f)) in meshes.iter().zip(features).enumerate() {
+        (tile.crowd).and_then(|_| (tile.meshes.iter()).position(|m| m.kind == ObjectKind::Walkers));
+    let kinds = primitives(tile, atlas, walking);
+    let mut buf = Buffer::new(meshopt);
+    // The vertex data's bytes (and each view's padding), reserved once: grown by doubling,
+    // the buffer was copied again and again.
+    let vertex_bytes: usize = (kinds.iter().flat_map(|(_, p)| p.values()))
+        .map(|p| {
+            4 * (p.positions.len() + p.normals.len() / 3 + p.uvs.len() + p.ids.len())
+                + 4 * p.indices.len()
+                + 40
+        })
+        .sum();
+    buf.bin.reserve(vertex_bytes);
+    let mut scene = Scene {
+        buf,
+        used: Vec::new(),
+        meshes: Vec::new(),
+        nodes: Vec::new(),
+    };
+    kind_nodes(&kinds, &mut scene);
+    let (origin, shift) = (tile.origin, tile.centre);
+    let first_tree = tile.features.len();
+    instances::add(
+        tile.instanced,
+        models,
+        origin,
+        shift,
+        first_tree,
+        &mut scene,
+    );
+    let animated = match (tile.crowd, walking) {
+        (Some(crowd), Some(row)) => {
+            animation::add(crowd, atlas, origin, shift, row as u32, &mut scene)
+        }
+        _ => None,
+    };
+    document(tile, scene, animated, atlas)
+}
+
+/// The tile's meshes as primitives by kind and material, ordered for the GPU: every mesh
+/// but the grown trees' copies when the tile instances them and the walkers' standing
+/// copies (the mesh `walking`) when they walk.
+fn primitives<'a>(
+    tile: &crate::output::sink::TileContent<'a>,
+    atlas: Option<&Atlas>,
+    walking: Option<usize>,
+) -> Kinds<'a> {
+    let instanced = !tile.instanced.is_empty();
+    let mut kinds: Kinds = Vec::new();
+    for (i, (mesh, f)) in tile.meshes.iter().zip(tile.features).enumerate() {
         if (instanced && mesh.kind == ObjectKind::GrownTrees) || walking == Some(i) {
             continue;
         }
@@ -66,7 +122,7 @@ pub fn tile_glb(
                 i as u32,
                 mesh,
                 &face.corners,
-                shift,
+                tile.centre,
                 slot,
             );
         }
@@ -74,24 +130,15 @@ pub fn tile_glb(
     for p in kinds.iter_mut().flat_map(|(_, p)| p.values_mut()) {
         p.reorder();
     }
-    let mut buf = Buffer::new(meshopt);
-    // The vertex data's bytes (and each view's padding), reserved once: grown by doubling,
-    // the buffer was copied again and again.
-    let vertex_bytes: usize = (kinds.iter().flat_map(|(_, p)| p.values()))
-        .map(|p| {
-            4 * (p.positions.len() + p.normals.len() / 3 + p.uvs.len() + p.ids.len())
-                + 4 * p.indices.len()
-                + 40
-        })
-        .sum();
-    buf.bin.reserve(vertex_bytes);
-    let mut used: Vec<u16> = Vec::new();
-    let mut meshes_json = Vec::new();
-    let mut nodes = Vec::new();
+    kinds
+}
+
+/// A node and a mesh per kind with faces, its positions shorts on one grid for the tile.
+fn kind_nodes(kinds: &Kinds, scene: &mut Scene) {
     let grid = quantize::Grid::over(
         (kinds.iter().flat_map(|(_, p)| p.values())).flat_map(|p| p.positions.iter().copied()),
     );
-    for (kind, prims) in &kinds {
+    for (kind, prims) in kinds {
         let mut primitives = Vec::new();
         for (&material, p) in prims {
             if p.indices.is_empty() {
@@ -102,47 +149,40 @@ pub fn tile_glb(
                 material,
                 true,
                 Some(&grid),
-                &mut buf,
-                &mut used,
+                &mut scene.buf,
+                &mut scene.used,
             ));
         }
         if primitives.is_empty() {
             continue;
         }
         // The kind in `extras` too: three.js copies it into the object's userData.
-        let mut node = json!({"name": kind, "mesh": meshes_json.len(), "extras": {"kind": kind}});
+        let mut node = json!({"name": kind, "mesh": scene.meshes.len(), "extras": {"kind": kind}});
         if let (Some(n), Some(t)) = (node.as_object_mut(), grid.node_transform().as_object()) {
             n.extend(t.clone());
         }
-        nodes.push(node);
-        meshes_json.push(json!({"name": kind, "primitives": primitives}));
+        scene.nodes.push(node);
+        scene
+            .meshes
+            .push(json!({"name": kind, "primitives": primitives}));
     }
-    instances::add(
-        tile.instanced,
-        models,
-        tile.origin,
-        shift,
-        features.len(),
-        &mut buf,
-        &mut used,
-        &mut meshes_json,
-        &mut nodes,
-    );
-    let animated = match (tile.crowd, walking) {
-        (Some(crowd), Some(row)) => animation::add(
-            crowd,
-            atlas,
-            tile.origin,
-            shift,
-            row as u32,
-            &mut buf,
-            &mut used,
-            &mut meshes_json,
-            &mut nodes,
-        ),
-        _ => None,
-    };
-    let (materials, images, textures) = materials(&used, palette, atlas);
+}
+
+/// The glTF document of `scene` with its metadata table (the meshes' rows, then the
+/// instanced trees'), extensions, materials and the walkers' clip, in the GLB container.
+fn document(
+    tile: &crate::output::sink::TileContent,
+    scene: Scene,
+    animated: Option<animation::Animated>,
+    atlas: Option<&Atlas>,
+) -> crate::output::glb::container::Glb {
+    let Scene {
+        mut buf,
+        used,
+        meshes,
+        nodes,
+    } = scene;
+    let (materials, images, textures) = materials(&used, tile.palette, atlas);
     let mut doc = json!({
         "asset": {
             "version": "2.0",
@@ -153,14 +193,13 @@ pub fn tile_glb(
         "scenes": [{"name": tile.id}],
     });
     if !nodes.is_empty() {
-        let rows: Vec<Feature> = features
-            .iter()
+        let rows: Vec<Feature> = (tile.features.iter())
             .chain(tile.instance_features)
             .cloned()
             .collect();
         let metadata = metadata::structural_metadata(&rows, &mut buf);
         declare_extensions(&mut doc, &buf);
-        if instanced {
+        if !tile.instanced.is_empty() {
             for (list, name) in [
                 ("extensionsUsed", "EXT_mesh_gpu_instancing"),
                 ("extensionsUsed", "EXT_instance_features"),
@@ -182,7 +221,7 @@ pub fn tile_glb(
             .filter(|n| !children.contains(n))
             .collect::<Vec<_>>());
         doc["nodes"] = json!(nodes);
-        doc["meshes"] = json!(meshes_json);
+        doc["meshes"] = json!(meshes);
         doc["materials"] = json!(materials);
         doc["buffers"] = buf.buffers_json();
         doc["bufferViews"] = json!(buf.views);
