@@ -9,14 +9,15 @@
 //! alone gets the same trees. The species is drawn from its own stream,
 //! `feature_rng(seed, "trees/species", id)`, so the billboards' draws stay as they were.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 use geo_types::Coord;
 use rand::RngExt;
 
 use super::obstacles::{boundary_distance, Obstacles};
 use crate::model::{
-    BillboardKind, Dataset, Plan, Skipped, TreeForm, Warning, WarningClass, MIN_SQUEEZE,
+    BillboardKind, Dataset, Plan, PlannedBillboard, Skipped, TreeForm, Warning, WarningClass,
+    MIN_SQUEEZE,
 };
 use crate::params::Params;
 use crate::rng::feature_rng;
@@ -37,167 +38,218 @@ pub fn plant(
     if !params.trees.enabled || plan.billboards.is_empty() {
         return;
     }
-    let lots = super::lot_index::LotIndex::new(data);
-    let mut crowns = Crowns::default();
-    let given: HashMap<&str, bool> = data
-        .trees
-        .iter()
-        .flatten()
-        .map(|p| (p.id.as_str(), p.height.is_some()))
-        .collect();
-    let file = params.layers.trees.file.clone();
-    let [tlo, thi] = params.trees.height;
-    let mut no_room = 0usize;
-    let mut warned: BTreeMap<String, ()> = BTreeMap::new();
-    let mut warnings = Vec::new();
-    let mut skipped = Vec::new();
+    let mut planting = Planting {
+        data,
+        obstacles,
+        catalog,
+        params,
+        lots: super::lot_index::LotIndex::new(data),
+        crowns: Crowns::default(),
+        given: (data.trees.iter().flatten())
+            .map(|p| (p.id.as_str(), p.height.is_some()))
+            .collect(),
+        file: params.layers.trees.file.clone(),
+        no_room: 0,
+        warned: BTreeSet::new(),
+        warnings: Vec::new(),
+        skipped: Vec::new(),
+    };
     for list in plan.billboards.values_mut() {
-        list.retain_mut(|b| {
-            if b.kind != BillboardKind::Tree {
-                return true;
-            }
-            let district = b.district.as_deref();
-            let style = params.trees_style(district);
-            let lot = lots.containing(b.at);
-            let lot_use = lot.map_or("", |l| data.lots[l].lot_use.name());
-            let named = b.tree.take().map(|t| t.species);
-            let species: Option<&Species> =
-                match &named {
-                    Some(name) => match catalog.species.get(name) {
-                        Some(s) => Some(s),
-                        None => {
-                            warnings.push(Warning::feature(
-                                "trees",
-                                &file,
-                                &b.id,
-                                format!(
-                                "{file}: trees {}: species `{name}` is not in templates/trees/ \
-                                 ({}); one was drawn",
-                                b.id,
-                                catalog.species.keys().cloned().collect::<Vec<_>>().join(", ")
-                            ),
-                            ));
-                            None
-                        }
-                    },
-                    None => None,
-                };
-            let species = match species {
-                Some(s) => s,
-                None if style == "billboard" => return true,
-                None => match draw(
-                    catalog,
-                    params,
-                    district,
-                    lot_use,
-                    style,
-                    params.seed_for("trees"),
-                    &b.id,
-                ) {
-                    Ok(s) => s,
-                    Err(key) => {
-                        if warned.insert(key.clone(), ()).is_none() {
-                            warnings.push(
-                                Warning::new(
-                                    WarningClass::Billboards,
-                                    format!(
-                                        "`{key}` names no species of method \"{style}\"; those \
-                                         trees stay billboards (see `edo-city tree`)"
-                                    ),
-                                )
-                                .for_key(&key),
-                            );
-                        }
-                        return true;
-                    }
-                },
-            };
-            // A named species is grown by its own method whatever the style asks, unless the
-            // style is billboards.
-            let grown = style != "billboard";
-            if !given.get(b.id.as_str()).copied().unwrap_or(false) {
-                // The drawn height, moved from the trees' range into the species' own.
-                let t = if thi > tlo {
-                    ((b.height - tlo) / (thi - tlo)).clamp(0.0, 1.0)
-                } else {
-                    0.5
-                };
-                b.height = species.height[0] + t * (species.height[1] - species.height[0]);
-            }
-            let ratio = match crowns.ratio(species) {
-                Ok(r) => r,
-                Err(e) => {
-                    if warned.insert(species.name.clone(), ()).is_none() {
-                        warnings.push(Warning::new(WarningClass::Billboards, e));
-                    }
-                    return true;
-                }
-            };
-            let mut crown = ratio * b.height;
-            let mut squeeze = 1.0;
-            if grown {
-                let edge = lot.map_or(f64::INFINITY, |l| {
-                    boundary_distance(b.at, &data.lots[l].outline)
-                });
-                let room = (edge - params.trees.clearance).min(obstacle_room(
-                    obstacles,
-                    b.at,
-                    crown,
-                    params.trees.clearance,
-                ));
-                if crown > room && room >= crown * MIN_SQUEEZE {
-                    squeeze = room / crown;
-                    crown = room;
-                } else if crown > room {
-                    squeeze = MIN_SQUEEZE;
-                    let fitted = b.height * room.max(0.0) / (crown * MIN_SQUEEZE);
-                    if fitted < MIN_HEIGHT {
-                        if given.contains_key(b.id.as_str()) {
-                            skipped.push(Skipped {
-                                layer: "trees".into(),
-                                file: file.clone(),
-                                id: b.id.clone(),
-                                record: None,
-                                reason: format!(
-                                    "no room for the crown of a {}: {:.1} m to the nearest \
-                                     building, fence or lot edge",
-                                    species.name,
-                                    room.max(0.0) + params.trees.clearance
-                                ),
-                            });
-                        } else {
-                            no_room += 1;
-                        }
-                        return false;
-                    }
-                    b.height = fitted;
-                    crown = room;
-                }
-            }
-            b.texture = crate::materials::MATERIALS[species.billboard as usize]
-                .name
-                .to_string();
-            b.tree = Some(TreeForm {
-                species: species.name.clone(),
-                grown,
-                lot: lot.map(|l| data.lots[l].id.clone()),
-                crown,
-                squeeze,
-            });
-            true
-        });
+        list.retain_mut(|b| b.kind != BillboardKind::Tree || planting.tree(b));
     }
-    if no_room > 0 {
-        warnings.push(Warning::new(
+    if planting.no_room > 0 {
+        planting.warnings.push(Warning::new(
             WarningClass::Billboards,
             format!(
-                "{no_room} generated tree(s) had no room for a crown at least {MIN_HEIGHT} m \
-                 tall and were left out (`trees.clearance`, `trees.min_spacing`)"
+                "{} generated tree(s) had no room for a crown at least {MIN_HEIGHT} m \
+                 tall and were left out (`trees.clearance`, `trees.min_spacing`)",
+                planting.no_room
             ),
         ));
     }
-    plan.warnings.extend(warnings);
-    plan.skipped.extend(skipped);
+    plan.warnings.extend(planting.warnings);
+    plan.skipped.extend(planting.skipped);
+}
+
+/// What planting the city's trees reads and what it has noticed so far.
+struct Planting<'a> {
+    data: &'a Dataset,
+    obstacles: &'a Obstacles,
+    catalog: &'a Catalog,
+    params: &'a Params,
+    lots: super::lot_index::LotIndex<'a>,
+    crowns: Crowns,
+    /// The trees of the points layer, with whether the layer gives their height.
+    given: HashMap<&'a str, bool>,
+    file: String,
+    /// Generated trees left out for want of room (one warning for all).
+    no_room: usize,
+    /// The keys and species already warned of.
+    warned: BTreeSet<String>,
+    warnings: Vec<Warning>,
+    skipped: Vec<Skipped>,
+}
+
+impl<'a> Planting<'a> {
+    /// Plants tree `b`: its species, height and crown; `false` when it is left out (no room).
+    /// A tree that stays a billboard is kept as it is.
+    fn tree(&mut self, b: &mut PlannedBillboard) -> bool {
+        let (params, data) = (self.params, self.data);
+        let district = b.district.as_deref();
+        let style = params.trees_style(district);
+        let lot = self.lots.containing(b.at);
+        let lot_use = lot.map_or("", |l| data.lots[l].lot_use.name());
+        let named = b.tree.take().map(|t| t.species);
+        let species = match self.named(b, named.as_deref()) {
+            Some(s) => s,
+            None if style == "billboard" => return true,
+            None => match draw(
+                self.catalog,
+                params,
+                district,
+                lot_use,
+                style,
+                params.seed_for("trees"),
+                &b.id,
+            ) {
+                Ok(s) => s,
+                Err(key) => {
+                    let warning = Warning::new(
+                        WarningClass::Billboards,
+                        format!(
+                            "`{key}` names no species of method \"{style}\"; those trees stay \
+                             billboards (see `edo-city tree`)"
+                        ),
+                    )
+                    .for_key(&key);
+                    self.warn_once(key, warning);
+                    return true;
+                }
+            },
+        };
+        // A named species is grown by its own method whatever the style asks, unless the
+        // style is billboards.
+        let grown = style != "billboard";
+        if !self.given.get(b.id.as_str()).copied().unwrap_or(false) {
+            b.height = in_species_range(b.height, params.trees.height, species);
+        }
+        let ratio = match self.crowns.ratio(species) {
+            Ok(r) => r,
+            Err(e) => {
+                let warning = Warning::new(WarningClass::Billboards, e);
+                self.warn_once(species.name.clone(), warning);
+                return true;
+            }
+        };
+        let (mut crown, mut squeeze) = (ratio * b.height, 1.0);
+        if grown {
+            match self.fit(b, species, lot, crown) {
+                Some(fitted) => (crown, squeeze) = fitted,
+                None => return false,
+            }
+        }
+        b.texture = crate::materials::MATERIALS[species.billboard as usize]
+            .name
+            .to_string();
+        b.tree = Some(TreeForm {
+            species: species.name.clone(),
+            grown,
+            lot: lot.map(|l| data.lots[l].id.clone()),
+            crown,
+            squeeze,
+        });
+        true
+    }
+
+    /// The species the points layer names for `b`, if it names one the catalog has (else a
+    /// warning, and one is drawn).
+    fn named(&mut self, b: &PlannedBillboard, named: Option<&str>) -> Option<&'a Species> {
+        let name = named?;
+        let found = self.catalog.species.get(name);
+        if found.is_none() {
+            let file = &self.file;
+            self.warnings.push(Warning::feature(
+                "trees",
+                file,
+                &b.id,
+                format!(
+                    "{file}: trees {}: species `{name}` is not in templates/trees/ ({}); one \
+                     was drawn",
+                    b.id,
+                    (self.catalog.species.keys().cloned())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+        found
+    }
+
+    /// `warning`, the first time `key` has one.
+    fn warn_once(&mut self, key: String, warning: Warning) {
+        if self.warned.insert(key) {
+            self.warnings.push(warning);
+        }
+    }
+
+    /// A grown tree's crown fitted to its room (the lot's edge, buildings, kura and fences
+    /// by the clearance): narrowed first, then the tree made smaller (`b.height`). The crown
+    /// and squeeze, or `None` when the tree would stand under [`MIN_HEIGHT`] (a tree of the
+    /// points layer is then skipped with the reason, a generated one counted).
+    fn fit(
+        &mut self,
+        b: &mut PlannedBillboard,
+        species: &Species,
+        lot: Option<usize>,
+        crown: f64,
+    ) -> Option<(f64, f64)> {
+        let clearance = self.params.trees.clearance;
+        let edge = lot.map_or(f64::INFINITY, |l| {
+            boundary_distance(b.at, &self.data.lots[l].outline)
+        });
+        let room = (edge - clearance).min(obstacle_room(self.obstacles, b.at, crown, clearance));
+        // (Not `crown <= room`: a room that is not a number leaves the crown as it is.)
+        let too_wide = crown > room;
+        if !too_wide {
+            return Some((crown, 1.0));
+        }
+        if room >= crown * MIN_SQUEEZE {
+            return Some((room, room / crown));
+        }
+        let fitted = b.height * room.max(0.0) / (crown * MIN_SQUEEZE);
+        if fitted < MIN_HEIGHT {
+            if self.given.contains_key(b.id.as_str()) {
+                self.skipped.push(Skipped {
+                    layer: "trees".into(),
+                    file: self.file.clone(),
+                    id: b.id.clone(),
+                    record: None,
+                    reason: format!(
+                        "no room for the crown of a {}: {:.1} m to the nearest building, \
+                         fence or lot edge",
+                        species.name,
+                        room.max(0.0) + clearance
+                    ),
+                });
+            } else {
+                self.no_room += 1;
+            }
+            return None;
+        }
+        b.height = fitted;
+        Some((room, MIN_SQUEEZE))
+    }
+}
+
+/// A drawn height moved from the trees' range `range` into the species' own.
+fn in_species_range(height: f64, range: [f64; 2], species: &Species) -> f64 {
+    let [lo, hi] = range;
+    let t = if hi > lo {
+        ((height - lo) / (hi - lo)).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    species.height[0] + t * (species.height[1] - species.height[0])
 }
 
 /// A species for a tree of `lot_use` in `district`, by weight among those of method `style`;
