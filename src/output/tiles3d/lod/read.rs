@@ -106,13 +106,7 @@ pub fn leaf(
     let place = |p: [f32; 3]| transform.apply([p[0] as f64, -p[2] as f64, p[1] as f64]);
     for node in g.document.nodes() {
         let Some(mesh) = node.mesh() else { continue };
-        // Walkers are people: a tile's skinned crowd (its figures at the origin, placed by
-        // the joints its clip moves), or a walker's own node as tiles had it before.
-        let walker = node.skin().is_some()
-            || node.extras().as_ref().is_some_and(|e| {
-                serde_json::from_str::<serde_json::Value>(e.get())
-                    .is_ok_and(|v| v.get("person").is_some())
-            });
+        let walker = is_walker(&node);
         let kind = if walker {
             "people"
         } else {
@@ -155,22 +149,17 @@ pub fn leaf(
                 }
             };
             if LEFT_OUT.contains(&kind) {
-                let scale = f64::from(node.transform().decomposed().2[1]);
-                // The size of the largest figure (a card or a mesh of its own), not of the
-                // crowd: a tile's people are one object.
+                // A walker's figure is 1 m tall, drawn at its node's scale.
+                let scale = match walker {
+                    true => f64::from(node.transform().decomposed().2[1]),
+                    false => 1.0,
+                };
                 let indices: Vec<u32> = reader
                     .read_indices()
                     .map(|i| i.into_u32().collect())
                     .unwrap_or_default();
-                if indices.iter().all(|&i| (i as usize) < positions.len()) {
-                    for part in super::components(&indices, positions.len()) {
-                        let p: Vec<[f64; 3]> =
-                            part.iter().map(|&v| positions[v as usize]).collect();
-                        // A walker's figure is 1 m tall, drawn at its node's scale.
-                        let size = extent(&p) * if walker { scale } else { 1.0 };
-                        content.dropped = content.dropped.max(size);
-                    }
-                }
+                let size = largest_figure(&positions, &indices) * scale;
+                content.dropped = content.dropped.max(size);
                 continue;
             }
             let ids: Vec<u32> = match (ids, prim.get(&Semantic::Extras("FEATURE_ID_0".into()))) {
@@ -191,37 +180,14 @@ pub fn leaf(
                 return Err(format!("{shown}: a primitive's accessors disagree"));
             }
             let material = prim.material();
-            let texture = material
-                .pbr_metallic_roughness()
-                .base_color_texture()
-                .and_then(|t| match t.texture().source().source() {
-                    gltf::image::Source::Uri { uri, .. } => Some(uri.to_string()),
-                    _ => None,
-                });
-            let part = if material.alpha_mode() == gltf::material::AlphaMode::Mask {
-                let Some(uri) = texture else { continue };
-                let name = material.name().unwrap_or("cutout").to_string();
-                let uvs = reader
+            let uvs = || {
+                reader
                     .read_tex_coords(0)
                     .map(|t| t.into_f32().collect::<Vec<_>>())
-                    .unwrap_or_else(|| vec![[0.0; 2]; positions.len()]);
-                let c = content.cutouts.entry(name).or_insert_with(|| Cutout {
-                    uri: uri.clone(),
-                    part: Part::default(),
-                });
-                c.part.uvs.extend(uvs);
-                &mut c.part
-            } else {
-                let colour = match &texture {
-                    Some(uri) => textures.mean(uri),
-                    None => material.pbr_metallic_roughness().base_color_factor(),
-                };
-                let c = colour.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8);
-                content
-                    .solid
-                    .colours
-                    .extend(std::iter::repeat_n(c, positions.len()));
-                &mut content.solid
+            };
+            let Some(part) = part_of(&mut content, &material, textures, positions.len(), uvs)
+            else {
+                continue;
             };
             let base = part.positions.len() as u32;
             part.positions.extend(positions);
@@ -230,6 +196,77 @@ pub fn leaf(
         }
     }
     Ok(content)
+}
+
+/// Whether `node` draws walkers, who are people: a tile's skinned crowd (its figures at the
+/// origin, placed by the joints its clip moves), or a walker's own node as tiles had it
+/// before.
+fn is_walker(node: &gltf::Node) -> bool {
+    node.skin().is_some()
+        || node.extras().as_ref().is_some_and(|e| {
+            serde_json::from_str::<serde_json::Value>(e.get())
+                .is_ok_and(|v| v.get("person").is_some())
+        })
+}
+
+/// The size of the largest figure (a card or a mesh of its own: a part joined by its
+/// triangles) of a primitive left out, not of the whole object (a tile's people are one);
+/// 0 when its indices do not fit its positions.
+fn largest_figure(positions: &[[f64; 3]], indices: &[u32]) -> f64 {
+    if indices.iter().any(|&i| (i as usize) >= positions.len()) {
+        return 0.0;
+    }
+    super::components(indices, positions.len())
+        .iter()
+        .map(|part| {
+            extent(
+                &part
+                    .iter()
+                    .map(|&v| positions[v as usize])
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Where a primitive of `material` goes in `content`: the cut-outs of its texture (with its
+/// `vertices`' uvs, zeros when it has none), or the solid part with its colour (its
+/// texture's mean, else its own) for each vertex. `None` for a cut-out with no texture.
+fn part_of<'c>(
+    content: &'c mut Content,
+    material: &gltf::Material,
+    textures: &TextureColours,
+    vertices: usize,
+    uvs: impl FnOnce() -> Option<Vec<[f32; 2]>>,
+) -> Option<&'c mut Part> {
+    let texture = material
+        .pbr_metallic_roughness()
+        .base_color_texture()
+        .and_then(|t| match t.texture().source().source() {
+            gltf::image::Source::Uri { uri, .. } => Some(uri.to_string()),
+            _ => None,
+        });
+    if material.alpha_mode() == gltf::material::AlphaMode::Mask {
+        let uri = texture?;
+        let name = material.name().unwrap_or("cutout").to_string();
+        let uvs = uvs().unwrap_or_else(|| vec![[0.0; 2]; vertices]);
+        let c = content.cutouts.entry(name).or_insert_with(|| Cutout {
+            uri: uri.clone(),
+            part: Part::default(),
+        });
+        c.part.uvs.extend(uvs);
+        return Some(&mut c.part);
+    }
+    let colour = match &texture {
+        Some(uri) => textures.mean(uri),
+        None => material.pbr_metallic_roughness().base_color_factor(),
+    };
+    let c = colour.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8);
+    content
+        .solid
+        .colours
+        .extend(std::iter::repeat_n(c, vertices));
+    Some(&mut content.solid)
 }
 
 /// One copy of an instanced node (`EXT_mesh_gpu_instancing`): scale, then rotation, then
