@@ -27,7 +27,8 @@ pub struct Sample {
 
 /// Everything `species/` shows of a build's trees.
 pub struct SpeciesModels {
-    /// The planted species that grow, by name.
+    /// A sample of every species the plan plants (grown or billboard), by name; none for a
+    /// species the catalog lacks or that cannot grow.
     pub samples: Vec<Sample>,
     /// Every variant a grown tree is, by (species, variant).
     pub variants: Vec<(String, u32, Arc<Mesh>)>,
