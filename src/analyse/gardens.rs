@@ -22,8 +22,10 @@ use super::obstacles::{boundary_distance, Obstacles};
 use crate::growers::garden::ga::{self, Candidate, GaParams};
 use crate::growers::garden::{Layout, Settings};
 use crate::model::design::Design;
+use super::product::{ByTile, Gardens, Halls};
 use crate::model::{
-    tile::tile_id, Dataset, FenceKind, GardenArea, GardenStat, Lot, Plan, PlannedGarden, Skipped,
+    tile::tile_id, Dataset, FenceKind, GardenArea, GardenStat, Lot, PlannedFence, PlannedGarden,
+    Skipped,
 };
 use crate::params::Params;
 
@@ -46,31 +48,39 @@ struct Site<'a> {
     ground: f64,
 }
 
-/// Plans every garden into `plan.gardens` and reports each lot in `plan.garden_reports`;
-/// a gardens-layer polygon that gets none is also in `plan.skipped`, with the reason.
-pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, params: &Params) {
+/// Plans every garden and reports each lot; a gardens-layer polygon that gets none is also
+/// skipped, with the reason. A lot's main hall among `halls`, else its first gate among
+/// `fences`, is its viewpoint.
+pub fn plan_gardens(
+    data: &Dataset,
+    fences: &ByTile<PlannedFence>,
+    halls: &Halls,
+    obstacles: &Obstacles,
+    params: &Params,
+) -> Gardens {
     let g = &params.garden;
+    let mut out = Gardens::default();
     if !g.enabled {
-        return;
+        return out;
     }
     // A lot's viewpoint: the middle of its first hall (a temple's main hall, whose veranda
     // a garden is seen from, as Ryoanji's from its hojo), else its first gate.
     let mut gates: HashMap<&str, Coord<f64>> = HashMap::new();
     // The main hall is the first its lot's use lists, when it was placed.
     let mut main: HashMap<&str, &str> = HashMap::new();
-    for r in &plan.hall_reports {
+    for r in &halls.reports {
         main.entry(r.lot.as_str())
             .or_insert(if r.placed { r.template.as_str() } else { "" });
     }
-    let main_halls = plan
-        .halls
+    let main_halls = halls
+        .by_tile
         .values()
         .flatten()
         .filter(|h| main.get(h.lot.as_str()) == Some(&h.template.as_str()));
     for h in main_halls {
         gates.entry(h.lot.as_str()).or_insert(h.centre());
     }
-    for f in plan.fences.values().flatten() {
+    for f in fences.values().flatten() {
         if f.kind == FenceKind::Gate {
             gates.entry(f.id.as_str()).or_insert(Coord {
                 x: (f.a.x + f.b.x) / 2.0,
@@ -139,10 +149,10 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, para
             stat.kept = false;
         }
     }
-    refuse_designs(data, &sites, &refused, &mut plan.skipped);
+    refuse_designs(data, &sites, &refused, &mut out.skipped);
     for ((stat, garden), site) in results.into_iter().zip(&sites) {
         if let (false, Some((id, record))) = (stat.placed, &site.area) {
-            plan.skipped.push(Skipped {
+            out.skipped.push(Skipped {
                 layer: "gardens".into(),
                 file: layer_file.clone(),
                 id: id.clone(),
@@ -150,12 +160,12 @@ pub fn plan_gardens(data: &Dataset, plan: &mut Plan, obstacles: &Obstacles, para
                 reason: stat.reason.clone(),
             });
         }
-        plan.garden_reports.push(stat);
+        out.reports.push(stat);
         if let Some(gd) = garden {
-            plan.tiles.insert(gd.tile.clone());
-            plan.gardens.entry(gd.tile.clone()).or_default().push(gd);
+            out.by_tile.entry(gd.tile.clone()).or_default().push(gd);
         }
     }
+    out
 }
 
 /// Lists as skipped each kept design that was not placed: refused by its site (`refused`,

@@ -5,6 +5,8 @@
 //! tiles of a town put together are one continuous ground. Generation does the cutting, tile
 //! by tile (`generate::ground`).
 
+use std::collections::BTreeSet;
+
 use geo::algorithm::buffer::{BufferStyle, LineCap, LineJoin};
 use geo::{BoundingRect, Buffer, Centroid};
 use geo_types::Polygon;
@@ -13,7 +15,8 @@ use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
 use crate::model::tile::tile_bounds;
-use crate::model::{sane, Dataset, GroundHeight, Plan, PlannedGround};
+use super::product::Grounds;
+use crate::model::{sane, Dataset, GroundHeight, PlannedGround, TileId};
 use crate::params::Params;
 
 /// The most tiles one lot may add (a lot larger than this many tiles is damaged data).
@@ -95,11 +98,12 @@ pub fn tiles_touched(data: &Dataset, params: &Params, cap: usize) -> usize {
     seen.len()
 }
 
-/// Fills `plan.grounds` for every tile to write, adding the tiles the lots touch.
-pub fn plan_ground(data: &Dataset, plan: &mut Plan, params: &Params) {
+/// The ground of every tile to write: those `built`, and the tiles the lots touch.
+pub fn plan_ground(data: &Dataset, built: &BTreeSet<TileId>, params: &Params) -> Grounds {
     let g = &params.ground;
+    let mut out = Grounds::default();
     if !g.enabled {
-        return;
+        return out;
     }
     let (size, origin) = (params.tile_size, params.tile_origin);
     for lot in &data.lots {
@@ -108,7 +112,10 @@ pub fn plan_ground(data: &Dataset, plan: &mut Plan, params: &Params) {
         };
         for c in cols {
             for rr in rows.clone() {
-                plan.tiles.insert(format!("{c}_{rr}"));
+                let id = format!("{c}_{rr}");
+                if !built.contains(&id) {
+                    out.tiles.insert(id);
+                }
             }
         }
     }
@@ -149,7 +156,7 @@ pub fn plan_ground(data: &Dataset, plan: &mut Plan, params: &Params) {
             .map(|(i, (c, _))| GeomWithData::new(*c, i))
             .collect(),
     );
-    let tiles: Vec<String> = plan.tiles.iter().cloned().collect();
+    let tiles: Vec<&TileId> = built.union(&out.tiles).collect();
     let grounds: Vec<(String, PlannedGround)> = tiles
         .par_iter()
         .filter_map(|id| {
@@ -194,10 +201,11 @@ pub fn plan_ground(data: &Dataset, plan: &mut Plan, params: &Params) {
                     .collect(),
                 height,
             };
-            Some((id.clone(), ground))
+            Some(((*id).clone(), ground))
         })
         .collect();
-    plan.grounds = grounds.into_iter().collect();
+    out.by_tile = grounds.into_iter().collect();
+    out
 }
 
 /// The lots' (and footprints') centres and elevations, on the DEM where there is one.

@@ -16,7 +16,8 @@ use rayon::prelude::*;
 
 use super::obstacles::{boundary_distance, Obstacles};
 use super::street::StreetEdges;
-use crate::model::{tile::tile_id, Dataset, FenceKind, HallStat, Lot, Plan, PlannedHall};
+use super::product::{ByTile, Halls};
+use crate::model::{tile::tile_id, Dataset, FenceKind, HallStat, Lot, PlannedFence, PlannedHall};
 use crate::params::Params;
 use crate::templates::{Catalog, Kind, Template};
 
@@ -27,22 +28,24 @@ const MAX_LOT: f64 = 5000.0;
 /// The most positions tried across a lot, each way, for one plot size.
 const MAX_STEPS: f64 = 150.0;
 
-/// Plans the halls of every lot into `plan.halls` and reports each in `plan.hall_reports`.
+/// Plans the halls of every lot and reports each; a lot's first gate among `fences` faces
+/// its halls.
 pub fn plan_halls(
     data: &Dataset,
-    plan: &mut Plan,
+    fences: &ByTile<PlannedFence>,
     edges: &StreetEdges,
     obstacles: &Obstacles,
     catalog: &Catalog,
     params: &Params,
-) {
+) -> Halls {
     let h = &params.halls;
+    let mut out = Halls::default();
     if !h.enabled || h.uses.values().all(Vec::is_empty) {
-        return;
+        return out;
     }
     // A lot's first gate (its wall segment) faces the hall.
     let mut gates: HashMap<&str, (Coord<f64>, Coord<f64>)> = HashMap::new();
-    for f in plan.fences.values().flatten() {
+    for f in fences.values().flatten() {
         if f.kind == FenceKind::Gate {
             gates.entry(f.id.as_str()).or_insert((f.a, f.b));
         }
@@ -73,12 +76,12 @@ pub fn plan_halls(
         })
         .collect();
     for (stat, hall) in results.into_iter().flatten() {
-        plan.hall_reports.push(stat);
+        out.reports.push(stat);
         if let Some(hl) = hall {
-            plan.tiles.insert(hl.tile.clone());
-            plan.halls.entry(hl.tile.clone()).or_default().push(hl);
+            out.by_tile.entry(hl.tile.clone()).or_default().push(hl);
         }
     }
+    out
 }
 
 /// The halls of one lot, in the order its use lists them.

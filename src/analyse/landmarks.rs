@@ -15,21 +15,33 @@ use super::lot_index::LotIndex;
 use crate::model::landmark::{
     z_up, Displaced, LandmarkReport, PaletteEntry, PlacedLandmark, SkippedLandmark,
 };
-use crate::model::{Dataset, KuraDecision, LandmarkRecord, Model, Plan, PlannedLandmark, Skipped};
+use super::product::{ByTile, Landmarks};
+use crate::model::{
+    Dataset, KuraDecision, LandmarkRecord, Model, PlannedFence, PlannedHouse, PlannedLandmark,
+    Skipped,
+};
 use crate::params::{Params, MAX_OFFSET, MAX_SIZE, MIN_SIZE};
 
 /// How many library ids materials may take in all (mesh faces hold a `u16`).
 const MAX_MATERIAL_IDS: usize = u16::MAX as usize;
 
-/// Places every landmark read, displaces what its footprint covers, and fills the palette.
-pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library: usize) {
+/// Places every landmark read, takes what its footprint covers out of `houses` and `fences`,
+/// and makes the palette.
+pub fn plan_landmarks(
+    data: &Dataset,
+    houses: &mut ByTile<PlannedHouse>,
+    fences: &mut ByTile<PlannedFence>,
+    params: &Params,
+    library: usize,
+) -> Landmarks {
     let file = data
         .layers
         .iter()
         .find(|l| l.role == "landmarks")
         .map(|l| l.file.clone())
         .unwrap_or_default();
-    let mut report = std::mem::take(&mut plan.landmark_report);
+    let mut out = Landmarks::default();
+    let report = &mut out.report;
     // What reading skipped (a model that cannot be used), for the report too.
     for s in data.skipped.iter().filter(|s| s.layer == "landmarks") {
         report.skipped.push(SkippedLandmark {
@@ -47,7 +59,7 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
         };
         match place(r, model, data, &lots, params) {
             Ok(p) => placed.push(p),
-            Err(reason) => skip(&mut report, plan, &file, (&r.id, r.record), reason),
+            Err(reason) => skip(report, &mut out.skipped, &file, (&r.id, r.record), reason),
         }
     }
     // Budgets before the palette, so a skipped model's textures are not written.
@@ -56,7 +68,7 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
     for p in placed {
         match budget.take(&p.tile, p.model.triangles.len()) {
             Ok(()) => kept.push(p),
-            Err(reason) => skip(&mut report, plan, &file, (&p.id, p.record), reason),
+            Err(reason) => skip(report, &mut out.skipped, &file, (&p.id, p.record), reason),
         }
     }
     let placed = kept;
@@ -68,12 +80,17 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
                  {MAX_MATERIAL_IDS}; merge materials in {}",
                 p.model.file
             );
-            skip(&mut report, plan, &file, (&p.id, p.record), reason);
+            skip(report, &mut out.skipped, &file, (&p.id, p.record), reason);
             continue;
         };
         p.material_base = base;
         if params.landmarks.displace {
-            displace(&p, data, plan, &mut report.displaced);
+            let built = Built {
+                houses: &mut *houses,
+                fences: &mut *fences,
+                skipped: &mut out.skipped,
+            };
+            displace(&p, data, built, &mut report.displaced);
         }
         report.placed.push(PlacedLandmark {
             id: p.id.clone(),
@@ -82,12 +99,11 @@ pub fn plan_landmarks(data: &Dataset, plan: &mut Plan, params: &Params, library:
             bounds: p.bounds,
             triangles: p.model.triangles.len(),
         });
-        plan.tiles.insert(p.tile.clone());
-        plan.landmarks.entry(p.tile.clone()).or_default().push(p);
+        out.by_tile.entry(p.tile.clone()).or_default().push(p);
     }
-    plan.palette = palette;
-    plan.model_textures = textures;
-    plan.landmark_report = report;
+    out.palette = palette;
+    out.textures = textures;
+    out
 }
 
 /// Landmark triangles one tile may hold: one model at the model limit fills a tile (its GLB
@@ -132,7 +148,7 @@ impl Budget {
 /// (so the ledger counts it).
 fn skip(
     report: &mut LandmarkReport,
-    plan: &mut Plan,
+    skipped: &mut Vec<Skipped>,
     file: &str,
     (id, record): (&str, usize),
     reason: String,
@@ -142,7 +158,7 @@ fn skip(
         record,
         reason: reason.clone(),
     });
-    plan.skipped.push(Skipped {
+    skipped.push(Skipped {
         layer: "landmarks".into(),
         file: file.to_string(),
         id: id.to_string(),
@@ -357,8 +373,15 @@ fn safe(name: &str) -> String {
         .collect()
 }
 
+/// What a landmark can displace, and where the houses it takes out are listed.
+struct Built<'a> {
+    houses: &'a mut ByTile<PlannedHouse>,
+    fences: &'a mut ByTile<PlannedFence>,
+    skipped: &'a mut Vec<Skipped>,
+}
+
 /// Takes out of the plan the houses, kura, walls and gates under `p`'s footprint.
-fn displace(p: &PlannedLandmark, data: &Dataset, plan: &mut Plan, out: &mut Vec<Displaced>) {
+fn displace(p: &PlannedLandmark, data: &Dataset, built: Built, out: &mut Vec<Displaced>) {
     let fp = &p.footprint;
     let Some(fp_box) = geo::BoundingRect::bounding_rect(fp) else {
         return;
@@ -378,7 +401,7 @@ fn displace(p: &PlannedLandmark, data: &Dataset, plan: &mut Plan, out: &mut Vec<
         "displaced by landmark {} ({}): its footprint covers it",
         p.id, p.model.file
     );
-    for houses in plan.houses.values_mut() {
+    for houses in built.houses.values_mut() {
         let mut kept = Vec::with_capacity(houses.len());
         for mut h in houses.drain(..) {
             if near(&h.outline) {
@@ -392,7 +415,7 @@ fn displace(p: &PlannedLandmark, data: &Dataset, plan: &mut Plan, out: &mut Vec<
                     id: h.id.clone(),
                     reason: "the house's outline overlaps the landmark's footprint".into(),
                 });
-                plan.skipped.push(Skipped {
+                built.skipped.push(Skipped {
                     layer: role.into(),
                     file: file_of(role),
                     id: h.id.clone(),
@@ -422,7 +445,7 @@ fn displace(p: &PlannedLandmark, data: &Dataset, plan: &mut Plan, out: &mut Vec<
         }
         *houses = kept;
     }
-    for fences in plan.fences.values_mut() {
+    for fences in built.fences.values_mut() {
         fences.retain(|f| {
             let line = geo_types::Line::new(f.a, f.b);
             if !line.intersects(fp) {

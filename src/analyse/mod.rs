@@ -13,6 +13,7 @@ pub mod kura;
 pub mod landmarks;
 pub mod lot_index;
 pub mod obstacles;
+pub mod product;
 pub mod room;
 pub mod street;
 pub mod terrain;
@@ -38,6 +39,18 @@ pub(crate) fn concat<T>(parts: Vec<Vec<T>>) -> Vec<T> {
     for p in parts {
         out.extend(p);
     }
+    out
+}
+
+/// Runs `f`, noting how long it took under `name` (for `--timings`).
+fn timed<T>(
+    times: &mut Vec<(&'static str, std::time::Duration)>,
+    name: &'static str,
+    f: impl FnOnce() -> T,
+) -> T {
+    let t = std::time::Instant::now();
+    let out = f();
+    times.push((name, t.elapsed()));
     out
 }
 
@@ -157,35 +170,39 @@ pub fn analyse(
         }
     }
     if params.landmarks.enabled {
-        landmarks::plan_landmarks(data, &mut plan, params, crate::materials::MATERIALS.len());
+        let library = crate::materials::MATERIALS.len();
+        landmarks::plan_landmarks(data, &mut plan.houses, &mut plan.fences, params, library)
+            .file(&mut plan);
     }
     let t = std::time::Instant::now();
-    let step = |name: &'static str, plan: &mut Plan, f: &dyn Fn(&mut Plan)| {
-        let t = std::time::Instant::now();
-        f(plan);
-        plan.step_times.push((name, t.elapsed()));
-    };
+    let mut times = Vec::new();
     // What people, trees, gardens and halls keep out of: built once (houses, kura, fences,
     // landmarks), then each step's halls and gardens added for the steps after it.
     let mut obstacles = obstacles::Obstacles::of_plan(&plan, catalog, params);
-    plan.step_times.push(("obstacles", t.elapsed()));
-    step("halls", &mut plan, &|p| {
-        halls::plan_halls(data, p, &edges, &obstacles, catalog, params)
+    times.push(("obstacles", t.elapsed()));
+    let halls = timed(&mut times, "halls", || {
+        halls::plan_halls(data, &plan.fences, &edges, &obstacles, catalog, params)
     });
-    obstacles.add_areas(plan.halls.values().flatten().map(|h| h.outline()));
-    step("gardens", &mut plan, &|p| {
-        gardens::plan_gardens(data, p, &obstacles, params)
+    obstacles.add_areas(halls.by_tile.values().flatten().map(|h| h.outline()));
+    let gardens = timed(&mut times, "gardens", || {
+        gardens::plan_gardens(data, &plan.fences, &halls, &obstacles, params)
     });
-    obstacles.add_areas(plan.gardens.values().flatten().map(|g| g.outline()));
-    step("people and billboard trees", &mut plan, &|p| {
-        billboards::plan_billboards(data, p, &obstacles, catalog, params)
+    obstacles.add_areas(gardens.by_tile.values().flatten().map(|g| g.outline()));
+    halls.file(&mut plan);
+    gardens.file(&mut plan);
+    let mut billboards = timed(&mut times, "people and billboard trees", || {
+        billboards::plan_billboards(data, &plan.tiles, &plan.houses, &obstacles, catalog, params)
     });
-    step("grown trees", &mut plan, &|p| {
-        trees::plant(data, p, &obstacles, catalog, params)
+    let planted = timed(&mut times, "grown trees", || {
+        trees::plant(data, &mut billboards.by_tile, &obstacles, catalog, params)
     });
-    step("ground", &mut plan, &|p| {
-        ground::plan_ground(data, p, params)
+    billboards.file(&mut plan);
+    planted.file(&mut plan);
+    let grounds = timed(&mut times, "ground", || {
+        ground::plan_ground(data, &plan.tiles, params)
     });
+    grounds.file(&mut plan);
+    plan.step_times.extend(times);
     plan.billboards_time = t.elapsed();
     if off_dem > 0 {
         if let Some(dem) = &data.dem {

@@ -5,7 +5,7 @@
 //! to [`MIN_SQUEEZE`] of its width, as a gardener prunes a tree in a narrow yard), then the
 //! whole tree made smaller; one that would stand under [`MIN_HEIGHT`] is left out.
 //!
-//! Runs after `billboards::plan_billboards` on the whole city's plan, so a tile regenerated
+//! Runs after `billboards::plan_billboards` on the whole city's billboards, so a tile regenerated
 //! alone gets the same trees. The species is drawn from its own stream,
 //! `feature_rng(seed, "trees/species", id)`, so the billboards' draws stay as they were.
 
@@ -15,8 +15,9 @@ use geo_types::Coord;
 use rand::RngExt;
 
 use super::obstacles::{boundary_distance, Obstacles};
+use super::product::{ByTile, Notes};
 use crate::model::{
-    BillboardKind, Dataset, Plan, PlannedBillboard, Skipped, TreeForm, Warning, WarningClass,
+    BillboardKind, Dataset, PlannedBillboard, Skipped, TreeForm, Warning, WarningClass,
     MIN_SQUEEZE,
 };
 use crate::params::Params;
@@ -27,16 +28,17 @@ use crate::templates::{Catalog, Species};
 /// A grown tree fitted below this height, metres, is left out: there is no room for it.
 pub const MIN_HEIGHT: f64 = 1.5;
 
-/// Gives every tree of the plan its species, height and crown (see the module's doc).
+/// Gives every tree among `billboards` its species, height and crown, or leaves it out
+/// (see the module's doc).
 pub fn plant(
     data: &Dataset,
-    plan: &mut Plan,
+    billboards: &mut ByTile<PlannedBillboard>,
     obstacles: &Obstacles,
     catalog: &Catalog,
     params: &Params,
-) {
-    if !params.trees.enabled || plan.billboards.is_empty() {
-        return;
+) -> Notes {
+    if !params.trees.enabled || billboards.is_empty() {
+        return Notes::default();
     }
     let mut planting = Planting {
         data,
@@ -54,7 +56,7 @@ pub fn plant(
         warnings: Vec::new(),
         skipped: Vec::new(),
     };
-    for list in plan.billboards.values_mut() {
+    for list in billboards.values_mut() {
         list.retain_mut(|b| b.kind != BillboardKind::Tree || planting.tree(b));
     }
     if planting.no_room > 0 {
@@ -67,8 +69,10 @@ pub fn plant(
             ),
         ));
     }
-    plan.warnings.extend(planting.warnings);
-    plan.skipped.extend(planting.skipped);
+    Notes {
+        warnings: planting.warnings,
+        skipped: planting.skipped,
+    }
 }
 
 /// What planting the city's trees reads and what it has noticed so far.

@@ -9,7 +9,7 @@
 //! when no kept point lies within `min_spacing`. Neither step depends on input order or on
 //! the thread count.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 use geo::{Area, BoundingRect, Centroid, Contains};
 use geo_types::{Coord, Polygon};
@@ -18,9 +18,11 @@ use rand_distr::{Distribution, Poisson};
 use rayon::prelude::*;
 
 use super::obstacles::{boundary_distance, Obstacles};
+use super::product::{Billboards, ByTile, Notes};
 use crate::model::tile::tile_id;
 use crate::model::{
-    sane, BillboardKind, Dataset, Plan, PlannedBillboard, PointFeature, Skipped, FAR,
+    sane, BillboardKind, Dataset, PlannedBillboard, PlannedHouse, PointFeature, Skipped, TileId,
+    FAR,
 };
 use crate::params::Params;
 use crate::rng::feature_rng;
@@ -95,19 +97,22 @@ struct Candidate {
     b: PlannedBillboard,
 }
 
-/// Plans the people and trees of the whole city into `plan.billboards`: from the point
-/// layers when the data has them, else generated.
+/// Plans the people and trees of the whole city: from the point layers when the data has
+/// them, else generated, the generated ones only in the tiles `built` (houses, fences, halls
+/// and gardens; trees behind the `houses`).
 pub fn plan_billboards(
     data: &Dataset,
-    plan: &mut Plan,
+    built: &BTreeSet<TileId>,
+    houses: &ByTile<PlannedHouse>,
     obstacles: &Obstacles,
     catalog: &Catalog,
     params: &Params,
-) {
+) -> Billboards {
     let people = &params.people;
     let trees = &params.trees;
+    let mut out = Billboards::default();
     if !people.enabled && !trees.enabled {
-        return;
+        return out;
     }
     let near = Surroundings::new(data);
     let mut all = Vec::new();
@@ -128,16 +133,16 @@ pub fn plan_billboards(
         // Given points are all kept; generated ones are thinned to the minimum spacing.
         let spacing = if given.is_some() { 0.0 } else { k.min_spacing };
         let candidates = match given {
-            Some(points) => from_points(points, &k, &near, obstacles, params, plan),
+            Some(points) => from_points(points, &k, &near, obstacles, params, &mut out.notes),
             None => {
                 let mut sources = match kind {
                     BillboardKind::Person => street_sources(data, &near, params),
-                    BillboardKind::Tree => lot_sources(data, plan, catalog, params),
+                    BillboardKind::Tree => lot_sources(data, houses, catalog, params),
                 };
                 // Generated billboards dress the built city: a tile with no house, kura or
                 // fence gets none (streets often run on past the lots).
-                sources.retain(|s| s.tiles(params).iter().any(|t| plan.tiles.contains(&t.0)));
-                let scale = budget(&sources, &k, params, &mut plan.warnings);
+                sources.retain(|s| s.tiles(params).iter().any(|t| built.contains(&t.0)));
+                let scale = budget(&sources, &k, params, &mut out.notes.warnings);
                 let drawn: Vec<Vec<Candidate>> = sources
                     .par_iter()
                     .map(|s| {
@@ -167,35 +172,40 @@ pub fn plan_billboards(
                 obstacles.hit(c, k.clearance)
             });
             kept = keep_spaced(walked.people, spacing);
-            plan.crowds = walked.stats;
-            plan.warnings.extend(walked.warnings);
+            out.crowds = walked.stats;
+            out.notes.warnings.extend(walked.warnings);
             clips = walked.walks;
         }
-        let capped = cap_tiles(kept, &k, &mut plan.warnings);
+        let capped = cap_tiles(kept, &k, &mut out.notes.warnings);
         all.extend(capped.into_iter().map(|b| (b, given.is_some())));
     }
     for (b, given) in all {
+        // Built before, or by a point of the layers met earlier in this loop.
+        let is_built = built.contains(&b.tile) || out.tiles.contains(&b.tile);
         if let Some(w) = clips.remove(&b.id) {
-            if given || plan.tiles.contains(&b.tile) {
+            if given || is_built {
                 *placed
                     .entry(w.street.clone())
                     .or_default()
                     .entry(b.district.clone().unwrap_or_default())
                     .or_default() += 1;
-                plan.walks.entry(b.tile.clone()).or_default().push(w);
+                out.walks.entry(b.tile.clone()).or_default().push(w);
             }
         }
         if given {
-            plan.tiles.insert(b.tile.clone());
-        } else if !plan.tiles.contains(&b.tile) {
+            if !is_built {
+                out.tiles.insert(b.tile.clone());
+            }
+        } else if !is_built {
             continue; // strayed over a tile border into a tile with nothing built
         }
-        plan.billboards.entry(b.tile.clone()).or_default().push(b);
+        out.by_tile.entry(b.tile.clone()).or_default().push(b);
     }
-    for stat in &mut plan.crowds {
+    for stat in &mut out.crowds {
         stat.districts = placed.remove(&stat.street).unwrap_or_default();
         stat.agents = stat.districts.values().sum();
     }
+    out
 }
 
 /// People along every street centreline, in pieces of at most [`PIECE`] metres.
@@ -240,14 +250,14 @@ fn street_sources<'a>(data: &'a Dataset, near: &Surroundings<'a>, p: &Params) ->
 /// house (the obstacles keep them out of the house and its kura).
 fn lot_sources<'a>(
     data: &'a Dataset,
-    plan: &Plan,
+    houses: &ByTile<PlannedHouse>,
     catalog: &Catalog,
     p: &Params,
 ) -> Vec<Source<'a>> {
     let t = &p.trees;
     // How deep each planned town lot's house is, as a share of the lot's depth.
     let mut built: HashMap<&str, f64> = HashMap::new();
-    for m in plan.houses.values().flatten().filter(|m| !m.is_footprint()) {
+    for m in houses.values().flatten().filter(|m| !m.is_footprint()) {
         let f = super::house::frame_of(m);
         let depth = super::house::local_ring(m, f)
             .iter()
@@ -431,13 +441,13 @@ fn from_points(
     near: &Surroundings,
     obstacles: &Obstacles,
     p: &Params,
-    plan: &mut Plan,
+    notes: &mut Notes,
 ) -> Vec<Candidate> {
     let tile_of = |c: Coord<f64>| tile_id(c, p.tile_size, p.tile_origin);
     let mut out = Vec::new();
     for f in points {
         if !sane(f.at) {
-            plan.skipped.push(Skipped {
+            notes.skipped.push(Skipped {
                 layer: k.layer.into(),
                 file: k.file.into(),
                 id: f.id.clone(),
@@ -447,7 +457,7 @@ fn from_points(
             continue;
         }
         if obstacles.hit(f.at, 0.0) {
-            plan.skipped.push(Skipped {
+            notes.skipped.push(Skipped {
                 layer: k.layer.into(),
                 file: k.file.into(),
                 id: f.id.clone(),
@@ -482,7 +492,7 @@ fn from_points(
         if let Some(t) = &f.texture {
             match texture_of(t, k.textures) {
                 Some(name) => c.b.texture = name,
-                None => plan.warnings.push(crate::model::Warning::feature(
+                None => notes.warnings.push(crate::model::Warning::feature(
                     k.layer,
                     k.file,
                     &f.id,
