@@ -14,20 +14,20 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
-use thiserror::Error;
 
 use crate::analyse;
 use crate::generate;
-use crate::input::{self, InputError};
+use crate::input;
 use crate::model::{Dataset, LotUse, Plan};
 use crate::output::{self, report};
-use crate::params::{Params, ParamsError};
-use crate::templates::{Catalog, TemplateError};
+use crate::params::Params;
+use crate::templates::Catalog;
 
 pub mod cache;
 mod check;
 mod city;
 mod clock;
+mod error;
 pub mod merge;
 mod names;
 mod plan_files;
@@ -37,8 +37,10 @@ mod writing;
 
 pub use check::check;
 pub use clock::{StageClock, StageTime};
-pub use names::load_catalog;
-pub use plan_files::{draw_plan_from, draw_plan_of, merge_plan_files};
+use error::write_err;
+pub use error::{BuildError, OptionsError};
+pub use names::{load_catalog, NameError};
+pub use plan_files::{draw_plan_from, draw_plan_of, merge_plan_files, ReplayError};
 
 /// Progress of the long stages; the CLI draws bars, tests pass [`NoProgress`].
 pub trait Progress: Sync {
@@ -57,35 +59,6 @@ impl Progress for NoProgress {
     fn start(&self, _: &str, _: u64) {}
     fn inc(&self, _: u64) {}
     fn finish(&self) {}
-}
-
-/// Why a build did not finish (exit code 2); each names the file, key or directory.
-#[derive(Debug, Error)]
-pub enum BuildError {
-    /// The parameter file is wrong.
-    #[error(transparent)]
-    Params(#[from] ParamsError),
-    /// A template file is wrong.
-    #[error(transparent)]
-    Templates(#[from] TemplateError),
-    /// The input cannot be read.
-    #[error(transparent)]
-    Input(#[from] InputError),
-    /// The options or the output directory do not allow the build (the message says why).
-    #[error("{0}")]
-    Config(String),
-    // The io::Error is in the message, not a `source`: the CLI prints the chain, and it
-    // would say it twice.
-    /// A file could not be written (a full disk says what to do).
-    #[error("cannot write {path}: {cause}{hint}")]
-    Write {
-        /// The file or directory that could not be written.
-        path: String,
-        /// What the operating system said.
-        cause: std::io::Error,
-        /// What to do, when there is something to say.
-        hint: &'static str,
-    },
 }
 
 /// Which tiles a run writes.
@@ -207,11 +180,7 @@ pub fn read_and_analyse(
     let read = t.elapsed();
     let touched = analyse::ground::tiles_touched(&data, params, MAX_TILES);
     if touched > MAX_TILES {
-        return Err(BuildError::Config(format!(
-            "`tile_size` = {} m cuts this city into more than {MAX_TILES} tiles (files of each \
-             format, and a tileset node, each): raise `tile_size` (the default is 250 m)",
-            params.tile_size
-        )));
+        return Err(OptionsError::TooManyTiles(params.tile_size).into());
     }
     let t = Instant::now();
     let lots_file = input.join(&params.layers.lots.file).display().to_string();
@@ -253,15 +222,12 @@ pub const MAX_THREADS: usize = 1024;
 pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcome, BuildError> {
     let t0 = Instant::now();
     if opts.threads > MAX_THREADS {
-        return Err(BuildError::Config(format!(
-            "-j {}: at most {MAX_THREADS} worker threads (0 = one per core, which is fastest)",
-            opts.threads
-        )));
+        return Err(OptionsError::Threads(opts.threads).into());
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .build()
-        .map_err(|e| BuildError::Config(format!("cannot start worker threads: {e}")))?;
+        .map_err(OptionsError::Pool)?;
     pool.install(|| {
         // Two independent loads side by side (a tenth of a `--tiles` run each); a broken
         // template is still the error named first.
@@ -275,7 +241,7 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcom
             },
         );
         let catalog = catalog?;
-        let (textures, atlas, no_atlas) = textures.map_err(BuildError::Config)?;
+        let (textures, atlas, no_atlas) = textures.map_err(BuildError::Textures)?;
         let library = Library {
             textures: &textures,
             atlas: atlas.as_ref(),
@@ -289,21 +255,6 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcom
 fn gpkg_err(e: output::gpkg::GpkgError) -> BuildError {
     let (path, cause) = e.into_io();
     write_err(&path, cause)
-}
-
-fn write_err(path: &Path, cause: std::io::Error) -> BuildError {
-    let full = cause.raw_os_error() == Some(28) || cause.kind() == std::io::ErrorKind::StorageFull;
-    let hint = if full {
-        ". Every file written is whole (temporaries are removed); free some space or build \
-         into another --out, and run the same command again"
-    } else {
-        ""
-    };
-    BuildError::Write {
-        path: path.display().to_string(),
-        cause,
-        hint,
-    }
 }
 
 /// The textures a build writes, and the cut-out atlas among them for the GLB tiles.
@@ -378,7 +329,7 @@ fn run(
         if !existed {
             let _ = std::fs::remove_dir(&opts.out);
         }
-        BuildError::Config(e.to_string())
+        BuildError::Lock(e)
     })?;
     // The plan is cached while the tiles are written (it is the input's, whatever happens
     // to the writing), once the directory is known to be this build's.

@@ -364,20 +364,71 @@ pub fn write_gpkg(
     dir_a: &Path,
     dir_b: &Path,
     path: &Path,
-) -> Result<usize, BuildError> {
+) -> Result<usize, CompareError> {
     let reads = [(dir_a, "build A"), (dir_b, "build B")];
-    crate::output::target::check(path, crate::output::target::Kind::GeoPackage, &reads)
-        .map_err(|e| BuildError::Config(e.to_string()))?;
+    crate::output::target::check(path, crate::output::target::Kind::GeoPackage, &reads)?;
     let t = &c.tiles;
     crate::output::gpkg::write_diff(dir_a, dir_b, &t.differ, &t.only_a, &t.only_b, path).map_err(
         |e| match e {
             crate::output::gpkg::DiffError::Write(w) => {
                 let (file, cause) = w.into_io();
-                BuildError::Config(format!("cannot write {}: {cause}", file.display()))
+                CompareError::Write {
+                    file: file.display().to_string(),
+                    cause,
+                }
             }
-            other => BuildError::Config(other.to_string()),
+            other => CompareError::Diff(other),
         },
     )
+}
+
+/// Why two builds cannot be compared so, or their comparison not written.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    /// A build cannot be read.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// The GeoPackage would be written over a build.
+    #[error(transparent)]
+    Target(#[from] crate::output::target::Refused),
+    /// The differing tiles' GeoPackage cannot be written.
+    #[error("cannot write {file}: {cause}")]
+    Write {
+        /// The file.
+        file: String,
+        /// What the operating system said.
+        cause: std::io::Error,
+    },
+    /// A build's tiles cannot be read for the GeoPackage.
+    #[error(transparent)]
+    Diff(crate::output::gpkg::DiffError),
+    /// The builds cut the city on other grids.
+    #[error(
+        "no difference map: {0}, so their tiles are not the same places; compare the \
+         counts (without --plan), or build both with one grid"
+    )]
+    OtherGrids(String),
+    /// No tile on the grid.
+    #[error("no tiles on the grid to draw")]
+    NoTiles,
+    /// The tiles span too many cells.
+    #[error(
+        "no difference map: the tiles span {cols} x {rows} cells of the grid, more than \
+         {MAX_MAP_CELLS} a side (tiles far apart, or ids given in the data); compare the \
+         counts (without --plan)"
+    )]
+    MapTooWide {
+        /// Columns spanned.
+        cols: i64,
+        /// Rows spanned.
+        rows: i64,
+    },
+    /// The picture cannot be made.
+    #[error("map too large")]
+    MapTooLarge,
+    /// The picture cannot be encoded.
+    #[error("cannot encode the map: {0}")]
+    Encode(String),
 }
 
 /// The widest difference map, in tiles a side (8 pixels each at most: 12,000 pixels).
@@ -385,15 +436,12 @@ const MAX_MAP_CELLS: i64 = 1500;
 
 /// A map of the tile grid: unchanged tiles grey, changed orange, only in A blue, only in B
 /// green, with their ids. Tiles named in the data (not `col_row`) are left out.
-pub fn difference_map(c: &Comparison, dir_a: &Path) -> Result<Vec<u8>, BuildError> {
+pub fn difference_map(c: &Comparison, dir_a: &Path) -> Result<Vec<u8>, CompareError> {
     let m = shards::previous_manifest(dir_a, "`edo-city compare --plan` maps two finished builds")?;
     let (size, origin) = (m.params.tile_size, m.params.tile_origin);
     // One grid for both builds, or the map would draw tiles of two grids as one.
     if let Some(why) = &c.grids_differ {
-        return Err(BuildError::Config(format!(
-            "no difference map: {why}, so their tiles are not the same places; compare the \
-             counts (without --plan), or build both with one grid"
-        )));
+        return Err(CompareError::OtherGrids(why.clone()));
     }
     let mut cells: Vec<(i64, i64, &String, [u8; 3])> = Vec::new();
     let same: Vec<String> = m
@@ -415,7 +463,7 @@ pub fn difference_map(c: &Comparison, dir_a: &Path) -> Result<Vec<u8>, BuildErro
         }
     }
     if cells.is_empty() {
-        return Err(BuildError::Config("no tiles on the grid to draw".into()));
+        return Err(CompareError::NoTiles);
     }
     let (c0, c1) = (
         cells.iter().map(|x| x.0).min().unwrap_or(0),
@@ -427,18 +475,14 @@ pub fn difference_map(c: &Comparison, dir_a: &Path) -> Result<Vec<u8>, BuildErro
     );
     let (cols, rows) = (c1 - c0 + 1, r1 - r0 + 1);
     if cols.max(rows) > MAX_MAP_CELLS {
-        return Err(BuildError::Config(format!(
-            "no difference map: the tiles span {cols} x {rows} cells of the grid, more than \
-             {MAX_MAP_CELLS} a side (tiles far apart, or ids given in the data); compare the \
-             counts (without --plan)"
-        )));
+        return Err(CompareError::MapTooWide { cols, rows });
     }
     let cell = (1200 / (cols.max(rows)) as u32).clamp(8, 200);
     let (w, h) = (
         ((c1 - c0 + 1) as u32) * cell,
         ((r1 - r0 + 1) as u32) * cell + 40,
     );
-    let mut pm = Pixmap::new(w, h).ok_or_else(|| BuildError::Config("map too large".into()))?;
+    let mut pm = Pixmap::new(w, h).ok_or(CompareError::MapTooLarge)?;
     pm.fill(Color::from_rgba8(250, 248, 242, 255));
     for (col, row, id, colour) in &cells {
         let x = ((col - c0) as u32 * cell) as f32;
@@ -458,5 +502,5 @@ pub fn difference_map(c: &Comparison, dir_a: &Path) -> Result<Vec<u8>, BuildErro
     );
     draw_text(&mut pm, 4.0, 4.0, &caption, 1, [30, 30, 30]);
     pm.encode_png()
-        .map_err(|e| BuildError::Config(format!("cannot encode the map: {e}")))
+        .map_err(|e| CompareError::Encode(e.to_string()))
 }

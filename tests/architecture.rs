@@ -243,6 +243,75 @@ fn no_source_file_is_over_600_lines() {
     );
 }
 
+/// Whether `line` holds `word` not followed by more of a name (`&mut Plan`, not
+/// `&mut PlannedHouse`).
+fn holds_word(line: &str, word: &str) -> bool {
+    line.match_indices(word).any(|(i, _)| {
+        !line[i + word.len()..]
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_alphanumeric() || c == '_')
+    })
+}
+
+/// The lines of `files` (outside unit tests and comments) holding `word`.
+fn lines_holding(files: &[PathBuf], word: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    for f in files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let body = text.split("#[cfg(test)]").next().unwrap_or("");
+        for (n, line) in body.lines().enumerate() {
+            if holds_word(code(line), word) {
+                found.push(format!("{}:{}: {}", f.display(), n + 1, line.trim()));
+            }
+        }
+    }
+    found
+}
+
+/// Each analysis step takes what it reads and returns its product (`analyse/product.rs`);
+/// only `analyse::analyse` files the products into the plan, so what a step depends on is
+/// in its signature.
+#[test]
+fn no_analysis_step_writes_into_the_plan() {
+    let mut files = Vec::new();
+    walk(&src().join("analyse"), &mut files);
+    assert!(files.len() > 10, "the walk found analyse/: {}", files.len());
+    let steps: Vec<PathBuf> = files
+        .into_iter()
+        .filter(|f| !f.ends_with("analyse/mod.rs") && !f.ends_with("analyse/product.rs"))
+        .collect();
+    let wrong = lines_holding(&steps, "&mut Plan");
+    assert!(
+        wrong.is_empty(),
+        "analysis steps taking the plan to write into:\n{}",
+        wrong.join("\n")
+    );
+    // The check sees one.
+    let dir = std::env::temp_dir().join(format!("arch-plan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("step.rs");
+    let text =
+        "pub fn step(plan: &mut Plan) {}\n// plan: &mut Plan\nfn h(m: &mut PlannedHouse) {}\n";
+    std::fs::write(&f, text).unwrap();
+    assert_eq!(
+        lines_holding(std::slice::from_ref(&f), "&mut Plan").len(),
+        1
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A build's errors are typed where they are made: no catch-all string variant.
+#[test]
+fn build_errors_have_no_catch_all_string() {
+    let mut files = Vec::new();
+    walk(&src(), &mut files);
+    let wrong = lines_holding(&files, "BuildError::Config");
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    let error = std::fs::read_to_string(src().join("build/error.rs")).unwrap();
+    assert!(!error.contains("Config(String)"), "build/error.rs");
+}
+
 #[test]
 fn only_the_readers_writers_and_the_cli_touch_the_file_system() {
     let mut wrong = Vec::new();

@@ -19,10 +19,10 @@ use geo_types::{Coord, Polygon};
 use rayon::prelude::*;
 
 use super::obstacles::{boundary_distance, Obstacles};
+use super::product::{ByTile, Gardens, Halls};
 use crate::growers::garden::ga::{self, Candidate, GaParams};
 use crate::growers::garden::{Layout, Settings};
 use crate::model::design::Design;
-use super::product::{ByTile, Gardens, Halls};
 use crate::model::{
     tile::tile_id, Dataset, FenceKind, GardenArea, GardenStat, Lot, PlannedFence, PlannedGarden,
     Skipped,

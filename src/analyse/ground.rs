@@ -14,8 +14,8 @@ use rayon::prelude::*;
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
-use crate::model::tile::tile_bounds;
 use super::product::Grounds;
+use crate::model::tile::tile_bounds;
 use crate::model::{sane, Dataset, GroundHeight, PlannedGround, TileId};
 use crate::params::Params;
 

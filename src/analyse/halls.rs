@@ -15,8 +15,8 @@ use geo_types::{Coord, Polygon};
 use rayon::prelude::*;
 
 use super::obstacles::{boundary_distance, Obstacles};
-use super::street::StreetEdges;
 use super::product::{ByTile, Halls};
+use super::street::StreetEdges;
 use crate::model::{tile::tile_id, Dataset, FenceKind, HallStat, Lot, PlannedFence, PlannedHall};
 use crate::params::Params;
 use crate::templates::{Catalog, Kind, Template};

@@ -12,10 +12,10 @@ use geo::{ConvexHull, Distance, Euclidean, Intersects};
 use geo_types::{Coord, MultiPoint, Point, Polygon};
 
 use super::lot_index::LotIndex;
+use super::product::{ByTile, Landmarks};
 use crate::model::landmark::{
     z_up, Displaced, LandmarkReport, PaletteEntry, PlacedLandmark, SkippedLandmark,
 };
-use super::product::{ByTile, Landmarks};
 use crate::model::{
     Dataset, KuraDecision, LandmarkRecord, Model, PlannedFence, PlannedHouse, PlannedLandmark,
     Skipped,

@@ -17,8 +17,7 @@ use rand::RngExt;
 use super::obstacles::{boundary_distance, Obstacles};
 use super::product::{ByTile, Notes};
 use crate::model::{
-    BillboardKind, Dataset, PlannedBillboard, Skipped, TreeForm, Warning, WarningClass,
-    MIN_SQUEEZE,
+    BillboardKind, Dataset, PlannedBillboard, Skipped, TreeForm, Warning, WarningClass, MIN_SQUEEZE,
 };
 use crate::params::Params;
 use crate::rng::feature_rng;

@@ -24,8 +24,7 @@ pub fn check(
     if let Some(path) = gpkg {
         let mut reads = vec![(input, "the input directory")];
         reads.extend(templates.map(|t| (t, "the templates directory")));
-        output::target::check(path, output::target::Kind::GeoPackage, &reads)
-            .map_err(|e| BuildError::Config(e.to_string()))?;
+        output::target::check(path, output::target::Kind::GeoPackage, &reads)?;
     }
     let catalog = load_catalog(params, templates)?;
     let (data, plan, _, _) = read_and_analyse(input, params, &catalog, &NoProgress)?;

@@ -12,14 +12,97 @@ use super::shards::{
 use super::{write_err, BuildError};
 use crate::output::report::{self, Manifest, Report};
 
+/// Why shard outputs cannot be merged; each names the manifest or file and what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    /// No directory given.
+    #[error("merge needs at least one directory")]
+    NoDirectory,
+    /// No shard manifest in the directories (comma-separated).
+    #[error("no shard manifests (manifest.shard-I-of-N.json) in {0}")]
+    NoShards(String),
+    /// The first shard's count is out of range.
+    #[error(
+        "{path}: a shard count of {count} is not within 1..={}; the manifest is damaged: run \
+         the shards again",
+        super::MAX_SHARDS
+    )]
+    Count {
+        /// The manifest.
+        path: String,
+        /// The count it gives.
+        count: usize,
+    },
+    /// A shard of another build (count, program, parameters, input or origin).
+    #[error("{path} belongs to another build than {first} ({why}): merge the shards of one build")]
+    OtherBuild {
+        /// Its manifest.
+        path: String,
+        /// The first shard's manifest.
+        first: String,
+        /// The first difference.
+        why: String,
+    },
+    /// A shard's number is out of range.
+    #[error(
+        "{path}: its shard number is not within 1..={count}; the manifest is damaged: \
+         run that shard again"
+    )]
+    Number {
+        /// Its manifest.
+        path: String,
+        /// The shard count.
+        count: usize,
+    },
+    /// Shards without a manifest (`I/N`, comma-separated).
+    #[error("shard(s) {0} have not finished (no manifest): run them, then merge again")]
+    Unfinished(String),
+    /// A file a shard lists is missing, truncated or other.
+    #[error("shard {shard}'s manifest {manifest} {cause}: run that shard again, then merge")]
+    Unlisted {
+        /// The shard, `I/N`.
+        shard: String,
+        /// Its manifest.
+        manifest: String,
+        /// What is wrong with the file.
+        cause: crate::output::listed::Unlisted,
+    },
+    /// Two shards list one shared file with other bytes.
+    #[error(
+        "shards {} and {} disagree on `{file}` ({} and {} list other \
+         bytes): they were built by other programs or parameters; run the \
+         shards of one build again, then merge",
+        shards[0], shards[1], manifests[0], manifests[1]
+    )]
+    Disagree {
+        /// The two shards, `I/N`.
+        shards: [String; 2],
+        /// The file.
+        file: String,
+        /// Their manifests.
+        manifests: [String; 2],
+    },
+    /// Two shards list one tile with other files.
+    #[error(
+        "tile {tile} is listed by two shards with other files (the second is \
+         shard {shard}, {manifest}): run the shards of one build again, then merge"
+    )]
+    TileTwice {
+        /// The tile.
+        tile: String,
+        /// The second shard, `I/N`.
+        shard: String,
+        /// Its manifest.
+        manifest: String,
+    },
+}
+
 /// Merges the shard outputs in `dirs` into the first: tiles of the others are copied over,
 /// then `manifest.json`, `report.json`, `plan.gpkg` (when the formats name it) and (with
 /// `draw_plan`) `plan.png` are written for the whole city, byte-identical to a full build's, and the shard manifests are removed.
 pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     let Some(target) = dirs.first() else {
-        return Err(BuildError::Config(
-            "merge needs at least one directory".into(),
-        ));
+        return Err(MergeError::NoDirectory.into());
     };
     let mut shards: Vec<(PathBuf, PathBuf, Manifest)> = Vec::new();
     for dir in dirs {
@@ -31,40 +114,29 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
         }
     }
     let Some((_, _, first)) = shards.first() else {
-        return Err(BuildError::Config(format!(
-            "no shard manifests (manifest.shard-I-of-N.json) in {}",
-            dirs.iter()
-                .map(|d| d.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
+        let dirs = dirs.iter().map(|d| d.display().to_string());
+        return Err(MergeError::NoShards(dirs.collect::<Vec<_>>().join(", ")).into());
     };
     let count = first.shard.map(|s| s[1]).unwrap_or(0);
     if count == 0 || count > super::MAX_SHARDS {
-        return Err(BuildError::Config(format!(
-            "{}: a shard count of {count} is not within 1..={}; the manifest is damaged: run \
-             the shards again",
-            shards[0].1.display(),
-            super::MAX_SHARDS
-        )));
+        let path = shards[0].1.display().to_string();
+        return Err(MergeError::Count { path, count }.into());
     }
     let mut seen = vec![false; count];
     for (_, path, m) in &shards {
         if let Some(why) = difference(first, m) {
-            return Err(BuildError::Config(format!(
-                "{} belongs to another build than {} ({why}): merge the shards of one build",
-                path.display(),
-                shards[0].1.display()
-            )));
+            return Err(MergeError::OtherBuild {
+                path: path.display().to_string(),
+                first: shards[0].1.display().to_string(),
+                why,
+            }
+            .into());
         }
         match m.shard {
             Some([i, _]) if (1..=count).contains(&i) => seen[i - 1] = true,
             _ => {
-                return Err(BuildError::Config(format!(
-                    "{}: its shard number is not within 1..={count}; the manifest is damaged: \
-                     run that shard again",
-                    path.display()
-                )))
+                let path = path.display().to_string();
+                return Err(MergeError::Number { path, count }.into());
             }
         }
     }
@@ -73,13 +145,9 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
         .map(|i| format!("{i}/{count}"))
         .collect();
     if !missing.is_empty() {
-        return Err(BuildError::Config(format!(
-            "shard(s) {} have not finished (no manifest): run them, then merge again",
-            missing.join(", ")
-        )));
+        return Err(MergeError::Unfinished(missing.join(", ")).into());
     }
-    let _lock = crate::output::lock::OutLock::acquire(target)
-        .map_err(|e| BuildError::Config(e.to_string()))?;
+    let _lock = crate::output::lock::OutLock::acquire(target)?;
     let (tiles, files) = gather(&shards)?;
     // Every file is copied under a temporary name and checked against its shard's manifest
     // as it streams by (a file of the target itself is checked in place); only when all are
@@ -87,11 +155,10 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
     // target as it was, and no file is held in memory.
     let mut staged = Vec::new();
     for (f, (dir, shard, manifest)) in files.values() {
-        let listed = |e: crate::output::listed::Unlisted| {
-            BuildError::Config(format!(
-                "shard {shard}'s manifest {} {e}: run that shard again, then merge",
-                manifest.display()
-            ))
+        let listed = |cause| MergeError::Unlisted {
+            shard: shard.clone(),
+            manifest: manifest.display().to_string(),
+            cause,
         };
         match *dir == target {
             true => crate::output::listed::check(dir, f).map_err(listed)?,
@@ -147,14 +214,12 @@ fn gather<'a>(
         for f in m.tiles.iter().flat_map(|t| t.files()).chain(links) {
             if let Some((g, (_, other, other_path))) = files.get(f.path.as_str()) {
                 if g.sha256 != f.sha256 || g.bytes != f.bytes {
-                    return Err(BuildError::Config(format!(
-                        "shards {other} and {shard} disagree on `{}` ({} and {} list other \
-                         bytes): they were built by other programs or parameters; run the \
-                         shards of one build again, then merge",
-                        f.path,
-                        other_path.display(),
-                        path.display()
-                    )));
+                    return Err(MergeError::Disagree {
+                        shards: [other.clone(), shard],
+                        file: f.path.clone(),
+                        manifests: [other_path.display().to_string(), path.display().to_string()],
+                    }
+                    .into());
                 }
                 continue;
             }
@@ -163,12 +228,12 @@ fn gather<'a>(
         for t in &m.tiles {
             if let Some(before) = tiles.insert(t.id.clone(), t.clone()) {
                 if before != *t {
-                    return Err(BuildError::Config(format!(
-                        "tile {} is listed by two shards with other files (the second is \
-                         shard {shard}, {}): run the shards of one build again, then merge",
-                        t.id,
-                        path.display()
-                    )));
+                    return Err(MergeError::TileTwice {
+                        tile: t.id.clone(),
+                        shard,
+                        manifest: path.display().to_string(),
+                    }
+                    .into());
                 }
             }
         }

@@ -9,6 +9,65 @@ use super::BuildError;
 use crate::params::Params;
 use crate::templates::{Catalog, Kind};
 
+/// A name a parameter gives that the catalog or the texture library does not hold; each
+/// says the key, the name and the names there are.
+#[derive(Debug, thiserror::Error)]
+pub enum NameError {
+    /// Not a template of the kind the key asks for (none of that name, another kind, or an
+    /// abstract one).
+    #[error("{key_says} `{name}`, which is not a {kind} template ({kind} templates: {})", known.join(", "))]
+    NotATemplate {
+        /// What the key does, e.g. "kura.template names".
+        key_says: String,
+        /// The name given.
+        name: String,
+        /// The kind asked for, e.g. "gate".
+        kind: String,
+        /// The buildable templates of that kind.
+        known: Vec<String>,
+    },
+    /// A type mix names a type that has no machiya template.
+    #[error("{key} names `{name}`, which has no machiya template (known types: {})", known.join(", "))]
+    NoMachiya {
+        /// `type_mix` or `district.<id>.type_mix`.
+        key: String,
+        /// The type named.
+        name: String,
+        /// The machiya types there are.
+        known: Vec<String>,
+    },
+    /// Not a material of the library.
+    #[error(
+        "{key} names `{name}`, which is not a library material (e.g. ground, gravel, street, \
+         water, moss, stone)"
+    )]
+    NotAMaterial {
+        /// E.g. `ground.materials.street`.
+        key: String,
+        /// The name given.
+        name: String,
+    },
+    /// Not a texture of the library.
+    #[error("{key} names `{name}`, which is not in the texture library ({})", library.join(", "))]
+    NotATexture {
+        /// E.g. `people.textures`.
+        key: String,
+        /// The name given.
+        name: String,
+        /// The library's textures.
+        library: Vec<String>,
+    },
+}
+
+/// The buildable templates of `kind`, owned for an error.
+fn known(catalog: &Catalog, kind: Kind) -> Vec<String> {
+    catalog
+        .names_of(kind)
+        .into_iter()
+        .map(String::from)
+        .collect()
+}
+
 /// Loads the machiya types and checks `type_mix` against them.
 pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog, BuildError> {
     let dir = templates.map(Path::to_path_buf).or_else(|| {
@@ -45,10 +104,12 @@ pub fn load_catalog(params: &Params, templates: Option<&Path>) -> Result<Catalog
     );
     for (key, name) in mixes.flat_map(|(key, mix)| mix.keys().map(move |n| (key.clone(), n))) {
         if catalog.machiya(name).is_none() {
-            return Err(BuildError::Config(format!(
-                "{key} names `{name}`, which has no machiya template (known types: {})",
-                catalog.names_of(Kind::Machiya).join(", ")
-            )));
+            return Err(NameError::NoMachiya {
+                key,
+                name: name.clone(),
+                known: known(&catalog, Kind::Machiya),
+            }
+            .into());
         }
     }
     Ok(catalog)
@@ -68,10 +129,13 @@ fn template_of(
         .is_some_and(|t| t.kind == kind && !t.is_abstract)
     {
         true => Ok(()),
-        false => Err(BuildError::Config(format!(
-            "{key_says} `{name}`, which is not a {what} template ({what} templates: {})",
-            catalog.names_of(kind).join(", ")
-        ))),
+        false => Err(NameError::NotATemplate {
+            key_says: key_says.to_string(),
+            name: name.to_string(),
+            kind: what.to_string(),
+            known: known(catalog, kind),
+        }
+        .into()),
     }
 }
 
@@ -87,10 +151,11 @@ pub(super) fn check_halls_and_ground(catalog: &Catalog, params: &Params) -> Resu
     }
     for (u, m) in &params.ground.materials {
         if crate::materials::find(m).is_none() {
-            return Err(BuildError::Config(format!(
-                "ground.materials.{u} names `{m}`, which is not a library material (e.g. \
-                 ground, gravel, street, water, moss, stone)"
-            )));
+            return Err(NameError::NotAMaterial {
+                key: format!("ground.materials.{u}"),
+                name: m.clone(),
+            }
+            .into());
         }
     }
     Ok(())
@@ -108,25 +173,21 @@ pub(super) fn check_billboards(catalog: &Catalog, params: &Params) -> Result<(),
         if !enabled {
             continue;
         }
-        if catalog
-            .get(template)
-            .is_none_or(|t| t.kind != kind || t.is_abstract)
-        {
-            return Err(BuildError::Config(format!(
-                "{table}.template names `{template}`, which is not a {} template ({} templates: {})",
-                kind.name(),
-                kind.name(),
-                catalog.names_of(kind).join(", ")
-            )));
-        }
+        let says = format!("{table}.template names");
+        template_of(catalog, template, kind, kind.name(), &says)?;
         if let Some(bad) = textures
             .iter()
             .find(|n| crate::materials::find(n).is_none())
         {
-            return Err(BuildError::Config(format!(
-                "{table}.textures names `{bad}`, which is not in the texture library ({})",
-                crate::materials::names().join(", ")
-            )));
+            return Err(NameError::NotATexture {
+                key: format!("{table}.textures"),
+                name: bad.clone(),
+                library: crate::materials::names()
+                    .into_iter()
+                    .map(String::from)
+                    .collect(),
+            }
+            .into());
         }
     }
     Ok(())
@@ -144,7 +205,7 @@ mod tests {
             &Params::from_toml_str(toml, "p.toml").unwrap(),
             None,
         ) {
-            Err(BuildError::Config(m)) => m,
+            Err(BuildError::Name(e)) => e.to_string(),
             other => panic!("{toml}: {:?}", other.map(|_| ())),
         };
         let m = refused("[fence]\ngate_template = \"nope\"\n");

@@ -13,6 +13,55 @@ use crate::model::{Dataset, Plan};
 use crate::output::{self, report};
 use crate::params::Params;
 
+/// Why the build a published manifest describes cannot be read again (to draw its plan).
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// The manifest does not say where the input is.
+    #[error(
+        "give the input directory with --input (the build read `{0}`; its manifest, \
+         published with the city, does not say where it is)"
+    )]
+    WhereInput(String),
+    /// The directory given is not the build's input (its fingerprint differs).
+    #[error(
+        "{given} is not the input of the build in {out} (it read `{read}`): give that directory"
+    )]
+    OtherInput {
+        /// The directory given.
+        given: String,
+        /// The build's directory.
+        out: String,
+        /// The input the build read.
+        read: String,
+    },
+    /// The manifest does not say where the templates are.
+    #[error(
+        "give the template directory the build used with --templates (it used `{0}`; \
+         its manifest does not say where it is)"
+    )]
+    WhereTemplates(String),
+    /// A parameter's path was left out of the published manifest.
+    #[error(
+        "the build's parameter `{0}` names a path outside the input, which its \
+         published manifest leaves out: give the build's parameter file with --params"
+    )]
+    PathLeftOut(String),
+    /// The parameter file given is not the build's.
+    #[error("--params is not the parameter file of this build: `{0}` differs")]
+    OtherParams(String),
+    /// No such tile.
+    #[error("no tile {tile} in this build; `edo-city tiles {input}` lists them")]
+    NoTile {
+        /// The tile asked for.
+        tile: String,
+        /// The input directory.
+        input: String,
+    },
+    /// Nothing to draw.
+    #[error("nothing to draw: no lots or footprints")]
+    NothingToDraw,
+}
+
 /// Draws the plan of an earlier build from its parameters and the input read again: `input`
 /// (and `templates`) as given, else those an older manifest recorded by their paths (a
 /// published manifest names them alone, so they must be given); with `tile`, only that tile
@@ -30,22 +79,16 @@ pub fn draw_plan_of(
     let input = match input {
         Some(i) => i.to_path_buf(),
         None if recorded.is_absolute() && recorded.is_dir() => recorded,
-        None => {
-            return Err(BuildError::Config(format!(
-                "give the input directory with --input (the build read `{}`; its manifest, \
-                 published with the city, does not say where it is)",
-                manifest.input.input
-            )))
-        }
+        None => return Err(ReplayError::WhereInput(manifest.input.input.clone()).into()),
     };
     let id = report::input_id(&absolute(&input));
     if !manifest.input.input_id.is_empty() && manifest.input.input_id != id {
-        return Err(BuildError::Config(format!(
-            "{} is not the input of the build in {} (it read `{}`): give that directory",
-            input.display(),
-            out.display(),
-            manifest.input.input
-        )));
+        return Err(ReplayError::OtherInput {
+            given: input.display().to_string(),
+            out: out.display().to_string(),
+            read: manifest.input.input.clone(),
+        }
+        .into());
     }
     let templates = match (templates, &manifest.input.templates) {
         (Some(t), _) => Some(t.to_path_buf()),
@@ -53,12 +96,7 @@ pub fn draw_plan_of(
         (None, Some(t)) if Path::new(t).is_absolute() && Path::new(t).is_dir() => {
             Some(PathBuf::from(t))
         }
-        (None, Some(t)) => {
-            return Err(BuildError::Config(format!(
-                "give the template directory the build used with --templates (it used `{t}`; \
-                 its manifest does not say where it is)"
-            )))
-        }
+        (None, Some(t)) => return Err(ReplayError::WhereTemplates(t.clone()).into()),
     };
     draw_plan_from(&manifest, tile, &input, templates.as_deref())
 }
@@ -73,10 +111,7 @@ fn plan_params(recorded: &Params, given: Option<&Params>) -> Result<Params, Buil
     let Some(given) = given else {
         return match left_out.first() {
             None => Ok(recorded.clone()),
-            Some(key) => Err(BuildError::Config(format!(
-                "the build's parameter `{key}` names a path outside the input, which its \
-                 published manifest leaves out: give the build's parameter file with --params"
-            ))),
+            Some(key) => Err(ReplayError::PathLeftOut(key.to_string()).into()),
         };
     };
     let mut theirs = serde_json::to_value(given).expect("parameters serialise");
@@ -85,9 +120,7 @@ fn plan_params(recorded: &Params, given: Option<&Params>) -> Result<Params, Buil
     report::publish_paths(&mut ours);
     match shards::first_difference(&ours, &theirs, "") {
         None => Ok(given.clone()),
-        Some(key) => Err(BuildError::Config(format!(
-            "--params is not the parameter file of this build: `{key}` differs"
-        ))),
+        Some(key) => Err(ReplayError::OtherParams(key).into()),
     }
 }
 
@@ -117,19 +150,20 @@ fn draw_analysed(
         None => None,
         Some(id) => {
             let tiles = shards::list_tiles(plan, params.tile_size, params.tile_origin);
-            let t = tiles.iter().find(|t| t.id == id).ok_or_else(|| {
-                BuildError::Config(format!(
-                    "no tile {id} in this build; `edo-city tiles {}` lists them",
-                    input.display()
-                ))
-            })?;
+            let t = tiles
+                .iter()
+                .find(|t| t.id == id)
+                .ok_or_else(|| ReplayError::NoTile {
+                    tile: id.to_string(),
+                    input: input.display().to_string(),
+                })?;
             Some(t.bounds)
         }
     };
     let grid = (params.tile_size, params.tile_origin);
     output::plan::View::fit(data, bounds)
         .and_then(|view| output::plan::draw_plan(data, plan, &view, grid, kura_view(params)))
-        .ok_or_else(|| BuildError::Config("nothing to draw: no lots or footprints".into()))
+        .ok_or_else(|| ReplayError::NothingToDraw.into())
 }
 
 /// What `merge` writes from the input read again, as a full build writes it beside its

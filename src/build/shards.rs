@@ -31,22 +31,130 @@ pub(super) fn manifests_in(out: &Path) -> Vec<PathBuf> {
     found
 }
 
+/// Why the output directory does not allow the run; each names the directory or the file.
+#[derive(Debug, thiserror::Error)]
+pub enum OutDirError {
+    /// A manifest there cannot be read (a FIFO, a device, too large, unreadable).
+    #[error("{path} {cause}")]
+    Unreadable {
+        /// The manifest.
+        path: String,
+        /// Why.
+        cause: crate::bounded::Refusal,
+    },
+    /// A manifest there is not one this version writes.
+    #[error(
+        "{path} is not a manifest of this edo-city version ({cause}); use another --out or --force"
+    )]
+    NotAManifest {
+        /// The manifest.
+        path: String,
+        /// What the JSON reader said.
+        cause: serde_json::Error,
+    },
+    /// It holds a build of other parameters or another input.
+    #[error(
+        "{out} holds another build ({why} in {manifest}): give --force to replace it, or \
+         build this hypothesis into another --out"
+    )]
+    Another {
+        /// The output directory.
+        out: String,
+        /// The first difference.
+        why: String,
+        /// The manifest's file name.
+        manifest: String,
+    },
+    /// As [`OutDirError::Another`], for `--tiles`, which `--force` does not let through.
+    #[error(
+        "{out} holds another build ({why} in {manifest}): --tiles only rewrites tiles of \
+         a build with the same input and parameters, even with --force; build the \
+         whole city (without --tiles) to replace it"
+    )]
+    AnotherForTiles {
+        /// The output directory.
+        out: String,
+        /// The first difference.
+        why: String,
+        /// The manifest's file name.
+        manifest: String,
+    },
+    /// Nothing was read, and an earlier build is there: it is left as it was.
+    #[error(
+        "nothing to build (no lots or footprints were read), and {out} holds an earlier build \
+         ({manifest}): it was left as it was; check the input and `layers.*.file`, or build into \
+         another --out"
+    )]
+    NothingOverEarlier {
+        /// The output directory.
+        out: String,
+        /// The manifest found.
+        manifest: String,
+    },
+    /// A run that needs a finished build finds none.
+    #[error("{needs}, but {out} holds no finished build (no manifest.json): {hint}")]
+    Unfinished {
+        /// What wants it, e.g. "--tiles rewrites tiles of an earlier full build".
+        needs: String,
+        /// The output directory.
+        out: String,
+        /// What to do.
+        hint: &'static str,
+    },
+}
+
+/// Why `--tiles` or `--shard` cannot select tiles.
+#[derive(Debug, thiserror::Error)]
+pub enum SelectionError {
+    /// A tile id is empty.
+    #[error(
+        "--tiles {0}: a tile id is empty (two commas in a row, or one at an end); \
+         give ids such as 1108_760,1109_760"
+    )]
+    EmptyId(String),
+    /// No feature falls in these tiles.
+    #[error("no feature falls in tile(s) {unknown}; `edo-city tiles <input>` lists the {tiles} tiles of this input")]
+    NoFeature {
+        /// The tiles asked for with nothing in them, comma-separated.
+        unknown: String,
+        /// How many tiles the input has.
+        tiles: usize,
+    },
+    /// I/N out of range.
+    #[error(
+        "--shard {index}/{count}: give I/N with 1 <= I <= N <= {}",
+        super::MAX_SHARDS
+    )]
+    Shard {
+        /// I.
+        index: usize,
+        /// N.
+        count: usize,
+    },
+}
+
 /// The largest manifest read (a million lots' is tens of MB; its skips can make it more).
 pub const MAX_MANIFEST_BYTES: u64 = 2 << 30;
 
 /// The bytes of a manifest, through `bounded` (a FIFO or device named so is refused).
 pub(crate) fn manifest_bytes(path: &Path) -> Result<Vec<u8>, BuildError> {
-    crate::bounded::read(path, MAX_MANIFEST_BYTES)
-        .map_err(|e| BuildError::Config(format!("{} {e}", path.display())))
+    crate::bounded::read(path, MAX_MANIFEST_BYTES).map_err(|cause| {
+        OutDirError::Unreadable {
+            path: path.display().to_string(),
+            cause,
+        }
+        .into()
+    })
 }
 
 pub(super) fn read_manifest(path: &Path) -> Result<Manifest, BuildError> {
     let bytes = manifest_bytes(path)?;
-    serde_json::from_slice(&bytes).map_err(|e| {
-        BuildError::Config(format!(
-            "{} is not a manifest of this edo-city version ({e}); use another --out or --force",
-            path.display()
-        ))
+    serde_json::from_slice(&bytes).map_err(|cause| {
+        OutDirError::NotAManifest {
+            path: path.display().to_string(),
+            cause,
+        }
+        .into()
     })
 }
 
@@ -115,19 +223,12 @@ pub fn check_out_dir(opts: &BuildOptions) -> Result<(), BuildError> {
             });
         if let Some(why) = diff {
             let name = path.file_name().unwrap_or_default().to_string_lossy();
-            return Err(BuildError::Config(match tiles {
-                false => format!(
-                    "{} holds another build ({why} in {name}): give --force to replace it, or \
-                     build this hypothesis into another --out",
-                    opts.out.display(),
-                ),
-                true => format!(
-                    "{} holds another build ({why} in {name}): --tiles only rewrites tiles of \
-                     a build with the same input and parameters, even with --force; build the \
-                     whole city (without --tiles) to replace it",
-                    opts.out.display(),
-                ),
-            }));
+            let (out, manifest) = (opts.out.display().to_string(), name.to_string());
+            return Err(match tiles {
+                false => OutDirError::Another { out, why, manifest },
+                true => OutDirError::AnotherForTiles { out, why, manifest },
+            }
+            .into());
         }
     }
     Ok(())
@@ -140,13 +241,15 @@ pub fn refuse_empty(opts: &BuildOptions, plan: &Plan) -> Result<(), BuildError> 
         return Ok(());
     }
     match manifests_in(&opts.out).first() {
-        Some(found) => Err(BuildError::Config(format!(
-            "nothing to build (no lots or footprints were read), and {} holds an earlier build \
-             ({}): it was left as it was; check the input and `layers.*.file`, or build into \
-             another --out",
-            opts.out.display(),
-            found.file_name().unwrap_or_default().to_string_lossy()
-        ))),
+        Some(found) => Err(OutDirError::NothingOverEarlier {
+            out: opts.out.display().to_string(),
+            manifest: found
+                .file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into(),
+        }
+        .into()),
         None => Ok(()),
     }
 }
@@ -158,13 +261,15 @@ pub fn previous_manifest(out: &Path, needs: &str) -> Result<Manifest, BuildError
     let path = out.join("manifest.json");
     if !path.exists() {
         let hint = match manifests_in(out).is_empty() {
-            true => "build the whole city into it first".to_string(),
-            false => "it holds shard outputs: run `edo-city merge` on them first".to_string(),
+            true => "build the whole city into it first",
+            false => "it holds shard outputs: run `edo-city merge` on them first",
         };
-        return Err(BuildError::Config(format!(
-            "{needs}, but {} holds no finished build (no manifest.json): {hint}",
-            out.display()
-        )));
+        return Err(OutDirError::Unfinished {
+            needs: needs.to_string(),
+            out: out.display().to_string(),
+            hint,
+        }
+        .into());
     }
     read_manifest(&path)
 }
@@ -203,28 +308,29 @@ pub fn select(plan: &Plan, selection: &Selection) -> Result<HashSet<String>, Bui
         Selection::All => Ok(plan.tiles.iter().cloned().collect()),
         Selection::Tiles(ids) => {
             if ids.is_empty() || ids.iter().any(|id| id.trim().is_empty()) {
-                return Err(BuildError::Config(format!(
-                    "--tiles {}: a tile id is empty (two commas in a row, or one at an end); \
-                     give ids such as 1108_760,1109_760",
-                    ids.join(",")
-                )));
+                return Err(SelectionError::EmptyId(ids.join(",")).into());
             }
             let unknown: Vec<&String> = ids.iter().filter(|id| !plan.tiles.contains(*id)).collect();
             if !unknown.is_empty() {
-                return Err(BuildError::Config(format!(
-                    "no feature falls in tile(s) {}; `edo-city tiles <input>` lists the {} tiles of this input",
-                    unknown.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", "),
-                    plan.tiles.len()
-                )));
+                return Err(SelectionError::NoFeature {
+                    unknown: unknown
+                        .iter()
+                        .map(|s| s.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    tiles: plan.tiles.len(),
+                }
+                .into());
             }
             Ok(ids.iter().cloned().collect())
         }
         Selection::Shard { index, count } => {
             if *count == 0 || *index == 0 || index > count || *count > super::MAX_SHARDS {
-                return Err(BuildError::Config(format!(
-                    "--shard {index}/{count}: give I/N with 1 <= I <= N <= {}",
-                    super::MAX_SHARDS
-                )));
+                return Err(SelectionError::Shard {
+                    index: *index,
+                    count: *count,
+                }
+                .into());
             }
             Ok(shard_of_tiles(plan, *count)
                 .into_iter()

@@ -29,11 +29,11 @@ pub fn begin(opts: &BuildOptions) -> Result<(), BuildError> {
     let marker = opts.out.join(MARKER);
     if matches!(opts.selection, Selection::Tiles(_)) && marker.exists() {
         if let Err(why) = agrees_with_manifest(&opts.out) {
-            return Err(BuildError::Config(format!(
-                "{} was left half-written by an earlier run that stopped (killed or failed): \
-                 {why}; build the whole city again (without --tiles)",
-                opts.out.display()
-            )));
+            return Err(super::OptionsError::HalfWritten {
+                out: opts.out.display().to_string(),
+                why,
+            }
+            .into());
         }
     }
     std::fs::write(&marker, b"").map_err(|e| super::write_err(&marker, e))
