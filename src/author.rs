@@ -9,9 +9,41 @@ use std::path::Path;
 use crate::generate::instance::{instantiate, Site};
 use crate::generate::mesh::{open_edges, Frame, Mesh};
 
+use crate::output::ModelError;
 use crate::params::Params;
 use crate::templates::template::{SiteInputs, N_INPUTS};
 use crate::templates::{Catalog, Template};
+
+/// Why a template cannot be built alone.
+#[derive(Debug, thiserror::Error)]
+pub enum AuthorError {
+    /// The site's width and depth, metres.
+    #[error("the site must be positive, got {0} x {1} m")]
+    Site(f64, f64),
+    /// `--set` names a parameter the template does not have.
+    #[error("--set {key}: {template} has no parameter `{key}` (its parameters: {known})")]
+    NoParameter {
+        /// The name given.
+        key: String,
+        /// The template.
+        template: String,
+        /// Its parameters, comma-separated.
+        known: String,
+    },
+    /// `--set` gives a value no template may take.
+    #[error("--set {key}={value}: {why}")]
+    Value {
+        /// The parameter.
+        key: String,
+        /// The value.
+        value: f64,
+        /// What is wrong with it.
+        why: String,
+    },
+    /// The template's expressions or parts fail on this site (their own message).
+    #[error("{0}")]
+    Template(String),
+}
 
 /// A template built alone.
 #[derive(Debug)]
@@ -54,11 +86,9 @@ pub fn build_alone(
     depth: f64,
     params: &Params,
     sets: &[(String, f64)],
-) -> Result<Alone, String> {
+) -> Result<Alone, AuthorError> {
     if !(width > 0.0 && depth > 0.0 && width.is_finite() && depth.is_finite()) {
-        return Err(format!(
-            "the site must be positive, got {width} x {depth} m"
-        ));
+        return Err(AuthorError::Site(width, depth));
     }
     let mut overrides = catalog.overrides(&t.name, None);
     for (k, v) in sets {
@@ -66,27 +96,29 @@ pub fn build_alone(
             .params
             .clone()
             .find(|s| t.names[*s] == *k)
-            .ok_or_else(|| {
-                format!(
-                    "--set {k}: {} has no parameter `{k}` (its parameters: {})",
-                    t.name,
-                    t.param_names().join(", ")
-                )
+            .ok_or_else(|| AuthorError::NoParameter {
+                key: k.clone(),
+                template: t.name.clone(),
+                known: t.param_names().join(", "),
             })?;
         if let Some(why) = crate::templates::file::value_problem(*v) {
-            return Err(format!("--set {k}={v}: {why}"));
+            let (key, value) = (k.clone(), *v);
+            return Err(AuthorError::Value { key, value, why });
         }
         overrides.push((slot, *v));
     }
     let site = Site::rectangle(width, depth);
-    let slots = t.evaluate(
-        &rectangle_inputs(width, depth, params),
-        &overrides,
-        &[],
-        &site,
-    )?;
+    let slots = t
+        .evaluate(
+            &rectangle_inputs(width, depth, params),
+            &overrides,
+            &[],
+            &site,
+        )
+        .map_err(AuthorError::Template)?;
     let mut mesh = Mesh::new(t.name.clone());
-    instantiate(t, &slots, &site, Frame { origin: [0.0, 0.0] }, &mut mesh)?;
+    instantiate(t, &slots, &site, Frame { origin: [0.0, 0.0] }, &mut mesh)
+        .map_err(AuthorError::Template)?;
     let parts = t
         .parts
         .iter()
@@ -103,7 +135,7 @@ pub fn build_alone(
 }
 
 /// Writes `<stem>.obj`, `<stem>.mtl` and `textures/` into the OBJ's directory.
-pub fn write(alone: &Alone, obj_path: &Path, texture_set: &str) -> Result<usize, String> {
+pub fn write(alone: &Alone, obj_path: &Path, texture_set: &str) -> Result<usize, ModelError> {
     crate::output::write_model(obj_path, std::slice::from_ref(&alone.mesh), texture_set)
 }
 

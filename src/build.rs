@@ -237,11 +237,11 @@ pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcom
                 let glb = opts.params.output.formats.iter().any(|f| f == "glb");
                 output::texture_library(&opts.params.textures)
                     .and_then(output::with_masks)
-                    .and_then(|lib| output::atlas::with_atlas(lib, glb))
+                    .and_then(|lib| Ok(output::atlas::with_atlas(lib, glb)?))
             },
         );
         let catalog = catalog?;
-        let (textures, atlas, no_atlas) = textures.map_err(BuildError::Textures)?;
+        let (textures, atlas, no_atlas) = textures?;
         let library = Library {
             textures: &textures,
             atlas: atlas.as_ref(),

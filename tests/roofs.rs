@@ -312,7 +312,8 @@ fn a_plane_that_bends_is_refused_on_the_site_naming_the_part() {
         &Params::default(),
         &[],
     )
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(err.contains("plane 1 is not flat"), "{err}");
     assert!(err.contains("bent.toml:4:"), "{err}");
 }

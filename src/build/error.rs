@@ -39,9 +39,9 @@ pub enum BuildError {
     /// The build's options do not allow it.
     #[error(transparent)]
     Options(#[from] OptionsError),
-    /// The texture set (`textures`) cannot be used; the message names the file.
-    #[error("{0}")]
-    Textures(String),
+    /// The texture set (`textures`) cannot be used.
+    #[error(transparent)]
+    Textures(#[from] crate::output::TextureError),
     /// A file to write names one the build must not write over.
     #[error(transparent)]
     Target(#[from] crate::output::target::Refused),

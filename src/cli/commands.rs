@@ -115,9 +115,8 @@ pub fn synth_command(args: SynthArgs) -> Result<()> {
         profile,
         force,
     } = args;
-    let profile = edo_city::synth::Profile::parse(&profile).map_err(anyhow::Error::msg)?;
-    let s = edo_city::synth::write_town(&dir, lots, seed, profile, force)
-        .map_err(anyhow::Error::msg)?;
+    let profile = edo_city::synth::Profile::parse(&profile)?;
+    let s = edo_city::synth::write_town(&dir, lots, seed, profile, force)?;
     say!(
         "wrote {}: {} lots ({} machiya, {} samurai estates), {} blocks, {} streets{}",
         dir.display(),
@@ -399,10 +398,8 @@ fn template_alone(
             .map_err(|_| anyhow::anyhow!("--set {s}: `{v}` is not a number"))?;
         sets.push((k.trim().to_string(), v));
     }
-    let alone = edo_city::author::build_alone(&catalog, t, width, depth, &params, &sets)
-        .map_err(anyhow::Error::msg)?;
-    let n =
-        edo_city::author::write(&alone, output, &params.textures).map_err(anyhow::Error::msg)?;
+    let alone = edo_city::author::build_alone(&catalog, t, width, depth, &params, &sets)?;
+    let n = edo_city::author::write(&alone, output, &params.textures)?;
     say!(
         "{} ({}) on a {width} x {depth} m lot: {} vertices, {} faces, parts {}",
         t.name,

@@ -105,7 +105,7 @@ pub fn garden_command(args: GardenArgs) -> Result<()> {
     let best = pop.best().clone();
     let meshes = garden_meshes(&best, &s, args.seed);
     if let Some(path) = &args.output {
-        edo_city::output::write_model(path, &meshes, "").map_err(anyhow::Error::msg)?;
+        edo_city::output::write_model(path, &meshes, "")?;
     }
     if let Some(path) = &args.png {
         let png = views(&meshes, &s, 640).context("cannot draw the garden")?;

@@ -131,7 +131,7 @@ pub fn lsystem_command(args: LsystemArgs) -> Result<()> {
         };
         let mut mesh = Mesh::new("lsystem".into());
         tree::mesh_tree(&sk, &spec, look, Lod::Full, origin(), frame(), &mut mesh);
-        edo_city::output::write_model(path, &[mesh.finish()], "").map_err(anyhow::Error::msg)?;
+        edo_city::output::write_model(path, &[mesh.finish()], "")?;
     }
     if !args.string {
         say!(
@@ -252,8 +252,7 @@ pub fn tree_command(args: TreeArgs) -> Result<()> {
         .collect();
     let chosen = &meshes[lod.number() as usize];
     if let Some(path) = &args.output {
-        edo_city::output::write_model(path, std::slice::from_ref(chosen), "")
-            .map_err(anyhow::Error::msg)?;
+        edo_city::output::write_model(path, std::slice::from_ref(chosen), "")?;
     }
     if let Some(path) = &args.png {
         let (r, top) = tree::extent(&grown.skeleton, species.mesh.leaf_size);

@@ -9,6 +9,41 @@
 use geo_types::Coord;
 use proj4rs::Proj;
 
+/// Why a CRS cannot be read or coordinates not moved.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CrsError {
+    /// The WKT is not one `proj4wkt` reads.
+    #[error("cannot read the projection WKT ({0})")]
+    Wkt(String),
+    /// `EPSG:` and no number.
+    #[error("`{0}` is not an EPSG code")]
+    NotEpsg(String),
+    /// A code the built-in list does not hold.
+    #[error("EPSG:{0} is not in the built-in list of codes")]
+    UnknownEpsg(u16),
+    /// Neither `EPSG:<code>`, a proj string nor WKT.
+    #[error("`{0}` is not a CRS: give `EPSG:<code>`, a proj string (+proj=...) or WKT")]
+    NotACrs(String),
+    /// A proj string `proj4rs` cannot use.
+    #[error("cannot use the projection `{definition}`: {cause}")]
+    Proj {
+        /// The proj string.
+        definition: String,
+        /// What proj4rs said.
+        cause: String,
+    },
+    /// A point that cannot be moved.
+    #[error("cannot reproject ({x:.6}, {y:.6}): {cause}")]
+    Reproject {
+        /// Its x (or longitude).
+        x: f64,
+        /// Its y (or latitude).
+        y: f64,
+        /// What proj4rs said.
+        cause: String,
+    },
+}
+
 /// A coordinate reference system we can transform to and from.
 pub struct Crs {
     /// The proj string, as written into the manifest.
@@ -24,14 +59,14 @@ impl std::fmt::Debug for Crs {
 
 impl Crs {
     /// From the text of a `.prj` file (ESRI or OGC WKT).
-    pub fn from_wkt(wkt: &str) -> Result<Crs, String> {
-        let def = proj4wkt::wkt_to_projstring(wkt.trim())
-            .map_err(|e| format!("cannot read the projection WKT ({e:?})"))?;
+    pub fn from_wkt(wkt: &str) -> Result<Crs, CrsError> {
+        let def =
+            proj4wkt::wkt_to_projstring(wkt.trim()).map_err(|e| CrsError::Wkt(format!("{e:?}")))?;
         Crs::from_proj_string(&def)
     }
 
     /// From the parameter file: `EPSG:6674`, a proj string (`+proj=...`) or WKT.
-    pub fn from_user(s: &str) -> Result<Crs, String> {
+    pub fn from_user(s: &str) -> Result<Crs, CrsError> {
         let t = s.trim();
         if t.starts_with("PROJCS") || t.starts_with("GEOGCS") || t.starts_with("PROJCRS") {
             return Crs::from_wkt(t);
@@ -40,22 +75,21 @@ impl Crs {
             let n: u16 = code
                 .trim()
                 .parse()
-                .map_err(|_| format!("`{t}` is not an EPSG code"))?;
-            let def = crs_definitions::from_code(n)
-                .ok_or_else(|| format!("EPSG:{n} is not in the built-in list of codes"))?;
+                .map_err(|_| CrsError::NotEpsg(t.to_string()))?;
+            let def = crs_definitions::from_code(n).ok_or(CrsError::UnknownEpsg(n))?;
             return Crs::from_proj_string(def.proj4);
         }
         if t.starts_with('+') {
             return Crs::from_proj_string(t);
         }
-        Err(format!(
-            "`{t}` is not a CRS: give `EPSG:<code>`, a proj string (+proj=...) or WKT"
-        ))
+        Err(CrsError::NotACrs(t.to_string()))
     }
 
-    fn from_proj_string(def: &str) -> Result<Crs, String> {
-        let proj = Proj::from_proj_string(def)
-            .map_err(|e| format!("cannot use the projection `{def}`: {e:?}"))?;
+    fn from_proj_string(def: &str) -> Result<Crs, CrsError> {
+        let proj = Proj::from_proj_string(def).map_err(|e| CrsError::Proj {
+            definition: def.to_string(),
+            cause: format!("{e:?}"),
+        })?;
         Ok(Crs {
             definition: def.to_string(),
             proj,
@@ -116,7 +150,7 @@ fn normalise(def: &str) -> Vec<String> {
 }
 
 /// Moves coordinates from `src` to `dst` in place. Geographic coordinates are in degrees.
-pub fn reproject(coords: &mut [Coord<f64>], src: &Crs, dst: &Crs) -> Result<(), String> {
+pub fn reproject(coords: &mut [Coord<f64>], src: &Crs, dst: &Crs) -> Result<(), CrsError> {
     if src.same_as(dst) {
         return Ok(());
     }
@@ -126,8 +160,13 @@ pub fn reproject(coords: &mut [Coord<f64>], src: &Crs, dst: &Crs) -> Result<(), 
         } else {
             (c.x, c.y, 0.0)
         };
-        proj4rs::transform::transform(&src.proj, &dst.proj, &mut p)
-            .map_err(|e| format!("cannot reproject ({:.6}, {:.6}): {e:?}", c.x, c.y))?;
+        proj4rs::transform::transform(&src.proj, &dst.proj, &mut p).map_err(|e| {
+            CrsError::Reproject {
+                x: c.x,
+                y: c.y,
+                cause: format!("{e:?}"),
+            }
+        })?;
         *c = if dst.is_geographic() {
             Coord {
                 x: p.0.to_degrees(),
@@ -232,6 +271,7 @@ mod tests {
     #[test]
     fn nonsense_is_an_error_that_says_what_to_give() {
         let e = Crs::from_user("kyoto").unwrap_err();
-        assert!(e.contains("EPSG"), "{e}");
+        assert_eq!(e, CrsError::NotACrs("kyoto".into()));
+        assert!(e.to_string().contains("EPSG"), "{e}");
     }
 }

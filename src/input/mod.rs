@@ -271,7 +271,7 @@ fn read_dem(
     if let (Ok(wkt), Some(t)) = (crate::bounded::read_text(&prj, 1 << 20), target) {
         let own = Crs::from_wkt(&wkt).map_err(|m| InputError::Layer {
             file: prj.display().to_string(),
-            message: m,
+            message: m.to_string(),
         })?;
         if !own.same_as(t) {
             return Err(InputError::Layer {

@@ -191,7 +191,9 @@ pub(super) fn to_target(
     coords: &mut [Coord<f64>],
 ) -> Result<(), String> {
     match (&o.src, target) {
-        (Some(src), Some(dst)) if o.reproject => crs::reproject(coords, src, dst),
+        (Some(src), Some(dst)) if o.reproject => {
+            crs::reproject(coords, src, dst).map_err(|e| e.to_string())
+        }
         _ => Ok(()),
     }
 }

@@ -245,7 +245,7 @@ pub type WithAtlas = (Vec<Texture>, Option<Atlas>, Option<String>);
 
 /// The library with the atlas added when `glb` tiles are written and it has cut-outs, and
 /// the atlas's layout; a library whose cut-outs do not fit gets none and the reason.
-pub fn with_atlas(mut library: Vec<Texture>, glb: bool) -> Result<WithAtlas, String> {
+pub fn with_atlas(mut library: Vec<Texture>, glb: bool) -> Result<WithAtlas, AtlasError> {
     if !glb {
         return Ok((library, None, None));
     }
@@ -253,9 +253,9 @@ pub fn with_atlas(mut library: Vec<Texture>, glb: bool) -> Result<WithAtlas, Str
         Ok(Some(a)) => a,
         Ok(None) => return Ok((library, None, None)),
         Err(e @ AtlasError::TooLarge(_)) => return Ok((library, None, Some(e.to_string()))),
-        Err(e) => return Err(e.to_string()),
+        Err(e) => return Err(e),
     };
-    let png = atlas.png(&library).map_err(|e| e.to_string())?;
+    let png = atlas.png(&library)?;
     library.push((FILE, Cow::Owned(png)));
     Ok((library, Some(atlas), None))
 }

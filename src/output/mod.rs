@@ -29,12 +29,13 @@ pub mod sketch;
 pub mod species;
 pub mod target;
 pub mod text;
+pub mod texture_set;
 pub mod tiles3d;
+
+pub use texture_set::{texture_library, with_masks, TextureError, MAX_TEXTURE_BYTES};
 
 use std::borrow::Cow;
 use std::path::Path;
-
-use rayon::prelude::*;
 
 use sha2::{Digest, Sha256};
 
@@ -113,97 +114,6 @@ pub const TEXTURE_DIR: &str = "tiles/textures";
 /// One texture file: its name in the texture directory and its PNG bytes.
 pub type Texture = (&'static str, Cow<'static, [u8]>);
 
-/// The texture library: the shipped PNGs, each replaced by the file of the same name in the
-/// directory `set` when it has one (a scan of a painting, say). "" = the shipped set.
-/// Every replacement must be a readable PNG, and every PNG in `set` must replace one.
-pub fn texture_library(set: &str) -> Result<Vec<Texture>, String> {
-    let mut lib: Vec<Texture> = TEXTURES
-        .iter()
-        .map(|(n, b)| (*n, Cow::Borrowed(*b)))
-        .collect();
-    if set.is_empty() {
-        return Ok(lib);
-    }
-    let dir = Path::new(set);
-    let entries = std::fs::read_dir(dir).map_err(|e| {
-        format!(
-            "texture set {}: cannot read the directory: {e}",
-            dir.display()
-        )
-    })?;
-    let mut names: Vec<String> = entries
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.to_lowercase().ends_with(".png"))
-        .collect();
-    names.sort();
-    for name in names {
-        let path = dir.join(&name);
-        let Some(slot) = lib.iter_mut().find(|(n, _)| *n == name) else {
-            return Err(format!(
-                "texture set {}: {name} replaces no texture of the library (its files: {})",
-                dir.display(),
-                TEXTURES.iter().map(|t| t.0).collect::<Vec<_>>().join(", ")
-            ));
-        };
-        let bytes = read_texture(&path)?;
-        image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
-            .map_err(|e| format!("{}: not a readable PNG: {e}", path.display()))?;
-        // A cut-out's transparent texels get the colour of their drawn neighbours, as the
-        // shipped ones have (`cutout::bleed`).
-        let bytes = match crate::materials::is_cut_out_texture(slot.0) {
-            true => cutout::bleed_png(&bytes)
-                .map_err(|e| format!("{}: not a readable PNG: {e}", path.display()))?,
-            false => bytes,
-        };
-        slot.1 = Cow::Owned(bytes);
-    }
-    Ok(lib)
-}
-
-/// Bytes of one texture of a texture set.
-pub const MAX_TEXTURE_BYTES: u64 = 32 << 20;
-
-/// A texture set's file, refused before it is opened when it is not a regular file (a FIFO
-/// named `x.png` blocked the build) or larger than [`MAX_TEXTURE_BYTES`].
-fn read_texture(path: &Path) -> Result<Vec<u8>, String> {
-    crate::bounded::read(path, MAX_TEXTURE_BYTES).map_err(|e| {
-        let hint = match e {
-            crate::bounded::Refusal::NotRegular => ": remove it from the set",
-            _ => "",
-        };
-        format!("{} {e}{hint}", path.display())
-    })
-}
-
-/// The library with the cut-out materials' masks added (see
-/// [`crate::materials::Material::mask`]), each derived from the texture as it is now (a
-/// replaced tree texture gets its own mask).
-pub fn with_masks(mut lib: Vec<Texture>) -> Result<Vec<Texture>, String> {
-    let mut wanted: Vec<(&'static str, &'static str, &[u8])> = Vec::new();
-    for m in crate::materials::MATERIALS {
-        let (Some(mask), Some(tex)) = (m.mask, m.texture) else {
-            continue;
-        };
-        let have_mask = lib.iter().any(|(n, _)| *n == mask) || wanted.iter().any(|w| w.0 == mask);
-        if let (false, Some((_, bytes))) = (have_mask, lib.iter().find(|(n, _)| *n == tex)) {
-            wanted.push((mask, tex, bytes));
-        }
-    }
-    // Each mask decodes and encodes a PNG: in parallel, and pushed in the materials' order.
-    let masks: Vec<Result<Texture, String>> = wanted
-        .par_iter()
-        .map(|&(mask, tex, bytes)| {
-            let png = cutout::mask_png(bytes).map_err(|e| format!("{tex}: {e}"))?;
-            Ok((mask, Cow::Owned(png)))
-        })
-        .collect();
-    for m in masks {
-        lib.push(m?);
-    }
-    Ok(lib)
-}
-
 /// Writes the texture library to `<out>/tiles/textures/` ([`TEXTURE_DIR`]).
 pub fn write_textures(out: &Path, library: &[Texture]) -> std::io::Result<Vec<ManifestFile>> {
     write_texture_files(out, library.iter().map(|(n, b)| (*n, &b[..])))
@@ -230,17 +140,43 @@ fn write_texture_files<'a>(
         .collect()
 }
 
+/// Why a model alone cannot be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    /// The path has no file name.
+    #[error("{0}: give a file name ending in .obj")]
+    NoName(String),
+    /// The texture set cannot be used.
+    #[error(transparent)]
+    Textures(#[from] TextureError),
+    /// A file cannot be written.
+    #[error("cannot write {path}: {cause}")]
+    Write {
+        /// The file.
+        path: String,
+        /// What the operating system said.
+        cause: std::io::Error,
+    },
+}
+
 /// Writes one model alone (a template, a tree): `<stem>.obj` with `meshes` as its objects,
 /// `<stem>.mtl` and the texture library in `textures/` beside it; returns the number of
 /// textures written.
-pub fn write_model(obj_path: &Path, meshes: &[Mesh], texture_set: &str) -> Result<usize, String> {
+pub fn write_model(
+    obj_path: &Path,
+    meshes: &[Mesh],
+    texture_set: &str,
+) -> Result<usize, ModelError> {
     let stem = obj_path
         .file_stem()
         .and_then(|s| s.to_str())
         .filter(|s| !s.is_empty())
-        .ok_or_else(|| format!("{}: give a file name ending in .obj", obj_path.display()))?;
+        .ok_or_else(|| ModelError::NoName(obj_path.display().to_string()))?;
     let dir = obj_path.parent().unwrap_or(Path::new(""));
-    let io = |p: &Path, e: std::io::Error| format!("cannot write {}: {e}", p.display());
+    let io = |p: &Path, cause: std::io::Error| ModelError::Write {
+        path: p.display().to_string(),
+        cause,
+    };
     let textures = with_masks(texture_library(texture_set)?)?;
     let tex_dir = dir.join("textures");
     std::fs::create_dir_all(&tex_dir).map_err(|e| io(&tex_dir, e))?;
@@ -263,31 +199,4 @@ pub fn obj_bytes<'a>(meshes: impl IntoIterator<Item = &'a Mesh>) -> usize {
     obj::write_tile(&mut buf, "x", [0.0, 0.0], meshes)
         .iter()
         .sum()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_texture_set_holding_a_pipe_or_a_huge_file_is_refused_without_reading_it() {
-        let tmp = tempfile::tempdir().unwrap();
-        let name = TEXTURES[0].0;
-        let path = tmp.path().join(name);
-        let made = std::process::Command::new("mkfifo")
-            .arg(&path)
-            .status()
-            .unwrap();
-        assert!(made.success());
-        let set = tmp.path().to_str().unwrap();
-        let e = texture_library(set).unwrap_err();
-        assert!(e.contains("not a regular file"), "{e}");
-        std::fs::remove_file(&path).unwrap();
-        std::fs::File::create(&path)
-            .unwrap()
-            .set_len(MAX_TEXTURE_BYTES + 1)
-            .unwrap();
-        let e = texture_library(set).unwrap_err();
-        assert!(e.contains("more than the"), "{e}");
-    }
 }

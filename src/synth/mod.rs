@@ -45,16 +45,58 @@ pub enum Profile {
     Kyoto,
 }
 
+/// Why a synthetic town cannot be made or written; each names the option or the file.
+#[derive(Debug, thiserror::Error)]
+pub enum SynthError {
+    /// No such profile.
+    #[error(
+        "unknown synth profile {0:?}: give grid (the first synthetic town) or kyoto \
+         (the composition of real towns: estates, kura, repeated ids)"
+    )]
+    Profile(String),
+    /// `--lots` out of range.
+    #[error("--lots must be from 1 to {MAX_LOTS}, got {0}")]
+    Lots(usize),
+    /// The directory holds files (and `--force` was not given).
+    #[error(
+        "{dir} is not empty (it holds {holds}): synth would overwrite its files, and a \
+         lots.csv there would be joined onto the synthetic lots; give an empty or \
+         new directory, or --force"
+    )]
+    NotEmpty {
+        /// The directory.
+        dir: String,
+        /// One file it holds.
+        holds: String,
+    },
+    /// The path is a file.
+    #[error("{0} is not a directory")]
+    NotADirectory(String),
+    /// The directory cannot be made.
+    #[error("cannot create {dir}: {cause}")]
+    Create {
+        /// The directory.
+        dir: String,
+        /// What the operating system said.
+        cause: std::io::Error,
+    },
+    /// A file cannot be written.
+    #[error("cannot write {path}: {cause}")]
+    Write {
+        /// The file.
+        path: String,
+        /// What the shapefile writer or the operating system said.
+        cause: String,
+    },
+}
+
 impl Profile {
     /// The profile of a name (`grid`, `kyoto`).
-    pub fn parse(name: &str) -> Result<Self, String> {
+    pub fn parse(name: &str) -> Result<Self, SynthError> {
         match name {
             "grid" => Ok(Profile::Grid),
             "kyoto" => Ok(Profile::Kyoto),
-            _ => Err(format!(
-                "unknown synth profile {name:?}: give grid (the first synthetic town) or kyoto \
-                 (the composition of real towns: estates, kura, repeated ids)"
-            )),
+            _ => Err(SynthError::Profile(name.to_string())),
         }
     }
 
@@ -131,29 +173,27 @@ pub fn write_town(
     seed: u64,
     profile: Profile,
     force: bool,
-) -> Result<SynthSummary, String> {
+) -> Result<SynthSummary, SynthError> {
     if lots_wanted == 0 || lots_wanted > MAX_LOTS {
-        return Err(format!(
-            "--lots must be from 1 to {MAX_LOTS}, got {lots_wanted}"
-        ));
+        return Err(SynthError::Lots(lots_wanted));
     }
     if !force {
         if let Ok(mut entries) = std::fs::read_dir(dir) {
             if let Some(e) = entries.next() {
                 let name = e.map(|e| e.file_name().to_string_lossy().into_owned());
-                return Err(format!(
-                    "{} is not empty (it holds {}): synth would overwrite its files, and a \
-                     lots.csv there would be joined onto the synthetic lots; give an empty or \
-                     new directory, or --force",
-                    dir.display(),
-                    name.unwrap_or_default()
-                ));
+                return Err(SynthError::NotEmpty {
+                    dir: dir.display().to_string(),
+                    holds: name.unwrap_or_default(),
+                });
             }
         } else if dir.exists() {
-            return Err(format!("{} is not a directory", dir.display()));
+            return Err(SynthError::NotADirectory(dir.display().to_string()));
         }
     }
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| SynthError::Create {
+        dir: dir.display().to_string(),
+        cause: e,
+    })?;
     let Town {
         lots,
         blocks,

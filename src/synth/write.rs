@@ -6,12 +6,23 @@ use std::path::Path;
 
 use shapefile::{Point, Polygon, PolygonRing, Polyline};
 
-use super::SynthLot;
+use super::{SynthError, SynthLot};
 
 const ZONE6_PRJ: &str = r#"PROJCS["JGD2011 / Japan Plane Rectangular CS VI",GEOGCS["JGD2011",DATUM["Japanese_Geodetic_Datum_2011",SPHEROID["GRS 1980",6378137,298.257222101]],PRIMEM["Greenwich",0],UNIT["degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],PARAMETER["latitude_of_origin",36],PARAMETER["central_meridian",136],PARAMETER["scale_factor",0.9999],PARAMETER["false_easting",0],PARAMETER["false_northing",0],UNIT["metre",1]]"#;
 
-fn shp_err(path: &Path) -> impl Fn(shapefile::Error) -> String + '_ {
-    move |e| format!("cannot write {}: {e}", path.display())
+fn shp_err(path: &Path) -> impl Fn(shapefile::Error) -> SynthError + '_ {
+    move |e| SynthError::Write {
+        path: path.display().to_string(),
+        cause: e.to_string(),
+    }
+}
+
+/// A file that could not be written, as [`SynthError::Write`].
+fn io_err(path: &Path) -> impl Fn(std::io::Error) -> SynthError + '_ {
+    move |e| SynthError::Write {
+        path: path.display().to_string(),
+        cause: e.to_string(),
+    }
 }
 
 /// The date written into every DBF header we make (bytes 1-3: years since 1900, month, day).
@@ -32,12 +43,12 @@ pub fn stamp_dbf_date(path: &Path) -> std::io::Result<()> {
     Ok(())
 }
 
-fn sidecars(path: &Path, cpg: &str) -> Result<(), String> {
+fn sidecars(path: &Path, cpg: &str) -> Result<(), SynthError> {
     let dbf = path.with_extension("dbf");
-    stamp_dbf_date(&dbf).map_err(|e| format!("cannot write {}: {e}", dbf.display()))?;
+    stamp_dbf_date(&dbf).map_err(io_err(&dbf))?;
     let w = |ext: &str, text: &str| {
-        std::fs::write(path.with_extension(ext), text)
-            .map_err(|e| format!("cannot write {}: {e}", path.with_extension(ext).display()))
+        let file = path.with_extension(ext);
+        std::fs::write(&file, text).map_err(io_err(&file))
     };
     w("cpg", cpg)?;
     w("prj", ZONE6_PRJ)
@@ -55,7 +66,7 @@ fn field(name: &str) -> dbase::FieldName {
 }
 
 /// Writes a lots layer in Shift_JIS (also used by tests to make small fixtures).
-pub fn write_lots(path: &Path, lots: &[SynthLot]) -> Result<(), String> {
+pub fn write_lots(path: &Path, lots: &[SynthLot]) -> Result<(), SynthError> {
     let table = dbase::TableWriterBuilder::with_encoding(dbase::encoding::EncodingRs::from(
         encoding_rs::SHIFT_JIS,
     ))
@@ -100,7 +111,7 @@ pub fn write_lots(path: &Path, lots: &[SynthLot]) -> Result<(), String> {
 }
 
 /// Writes the blocks layer (UTF-8, zone VI `.prj`).
-pub fn write_blocks(path: &Path, blocks: &[Vec<[f64; 2]>]) -> Result<(), String> {
+pub fn write_blocks(path: &Path, blocks: &[Vec<[f64; 2]>]) -> Result<(), SynthError> {
     let table = dbase::TableWriterBuilder::new().add_numeric_field(field("id"), 10, 0);
     let mut w = shapefile::Writer::from_path(path, table).map_err(shp_err(path))?;
     for (i, b) in blocks.iter().enumerate() {
@@ -116,7 +127,10 @@ pub fn write_blocks(path: &Path, blocks: &[Vec<[f64; 2]>]) -> Result<(), String>
     sidecars(path, "UTF-8")
 }
 
-pub(super) fn write_streets(path: &Path, streets: &[(Vec<[f64; 2]>, f64)]) -> Result<(), String> {
+pub(super) fn write_streets(
+    path: &Path,
+    streets: &[(Vec<[f64; 2]>, f64)],
+) -> Result<(), SynthError> {
     let table = dbase::TableWriterBuilder::new()
         .add_numeric_field(field("id"), 10, 0)
         .add_numeric_field(field("width"), 8, 2);

@@ -143,7 +143,7 @@ impl Globe {
         match self {
             Globe::Projected { crs, lonlat, .. } => {
                 let mut c = [geo_types::Coord { x, y }];
-                reproject(&mut c, crs, lonlat)?;
+                reproject(&mut c, crs, lonlat).map_err(|e| e.to_string())?;
                 Ok((c[0].x, c[0].y))
             }
             Globe::Placed(_) => Err("a placed city has no projection".into()),

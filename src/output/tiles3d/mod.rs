@@ -84,9 +84,10 @@ impl Aabb {
 pub fn placement(manifest: &Manifest) -> Result<Option<Globe>, String> {
     let h = manifest.params.origin_lonlat.map_or(0.0, |o| o[2]);
     if !manifest.crs.is_empty() {
-        let crs = crate::geom::crs::Crs::from_user(&manifest.crs)?;
+        let user = |s: &str| crate::geom::crs::Crs::from_user(s).map_err(|e| e.to_string());
+        let crs = user(&manifest.crs)?;
         if !crs.is_geographic() {
-            let lonlat = crate::geom::crs::Crs::from_user("+proj=longlat +datum=WGS84 +no_defs")?;
+            let lonlat = user("+proj=longlat +datum=WGS84 +no_defs")?;
             return Ok(Some(Globe::Projected {
                 crs: Box::new(crs),
                 lonlat: Box::new(lonlat),
