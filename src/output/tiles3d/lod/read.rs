@@ -481,6 +481,9 @@ pub fn read_listed(dir: &Path, path: &str) -> Result<Vec<u8>, String> {
 }
 
 /// The mean colour of each texture of the library (linear, alpha-weighted), read once.
+/// Each file is read through `bounded` (a regular file, within [`MAX_FILE_BYTES`]): the
+/// directory may hold what an earlier run or a person left there, and a FIFO named `x.png`
+/// would have held the build forever; such a file has no colour.
 pub fn texture_colours(out: &Path) -> TextureColours {
     let mut means = BTreeMap::new();
     let dir = out.join(crate::output::TEXTURE_DIR);
@@ -497,7 +500,8 @@ pub fn texture_colours(out: &Path) -> TextureColours {
     let linear: [f64; 256] =
         std::array::from_fn(|v| crate::output::glb::linear(v as f32 / 255.0) as f64);
     for name in names {
-        let Ok(img) = image::open(dir.join(&name)) else {
+        let read = crate::bounded::read(&dir.join(&name), MAX_FILE_BYTES);
+        let Some(img) = read.ok().and_then(|b| image::load_from_memory(&b).ok()) else {
             continue;
         };
         let img = img.to_rgba8();
@@ -515,4 +519,28 @@ pub fn texture_colours(out: &Path) -> TextureColours {
         }
     }
     TextureColours(means)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A FIFO among the textures is passed over, not opened (it blocked the levels of
+    /// detail forever); the PNG beside it still gives its colour.
+    #[test]
+    fn a_pipe_among_the_textures_has_no_colour_and_holds_nothing_up() {
+        let out = tempfile::tempdir().unwrap();
+        let dir = out.path().join(crate::output::TEXTURE_DIR);
+        std::fs::create_dir_all(&dir).unwrap();
+        let made = std::process::Command::new("mkfifo")
+            .arg(dir.join("a.png"))
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let red = image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 0, 0, 255]));
+        red.save(dir.join("b.png")).unwrap();
+        let TextureColours(means) = texture_colours(out.path());
+        assert_eq!(means.keys().collect::<Vec<_>>(), ["textures/b.png"]);
+        assert_eq!(means["textures/b.png"], [1.0, 0.0, 0.0, 1.0]);
+    }
 }
