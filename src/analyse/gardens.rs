@@ -18,7 +18,7 @@ use geo::{Centroid, Contains, Point};
 use geo_types::{Coord, Polygon};
 use rayon::prelude::*;
 
-use super::obstacles::{boundary_distance, Obstacles};
+use super::obstacles::{boundary_distance, grid_free, lot_box, Obstacles};
 use super::product::{ByTile, Gardens, Halls};
 use crate::growers::garden::ga::{self, Candidate, GaParams};
 use crate::growers::garden::{Layout, Settings};
@@ -417,30 +417,27 @@ fn place(site: &Site, obstacles: &Obstacles, p: &Params) -> Option<(Coord<f64>, 
     if !(u1 - u0).is_finite() || u1 - u0 > 5000.0 || v1 - v0 > 5000.0 {
         return None;
     }
+    let (lo, hi) = lot_box(outline);
+    let near = obstacles.near(lo, hi, g.clearance);
     let free = |q: Coord<f64>| {
-        outline.contains(&Point(q))
-            && boundary_distance(q, outline) >= site.edge
-            && !obstacles.hit(q, g.clearance)
+        outline.contains(&Point(q)) && boundary_distance(q, outline) >= site.edge && !near.hit(q)
     };
     let mut w = g.max_width.min(u1 - u0);
     while w * 0.4 >= g.min_size {
         let d = w * 0.4;
         let step = (w / 4.0).max(0.5);
         let (nx, ny) = ((w / 2.0).ceil() as usize + 1, (d / 2.0).ceil() as usize + 1);
-        let mut v = v0;
+        let (mut v, mut miss) = (v0, None);
         while v + d <= v1 {
             let mut u = u0;
             while u + w <= u1 {
-                let ok = (0..ny).all(|j| {
-                    (0..nx).all(|i| {
-                        let (a, b) = (
-                            u + w * i as f64 / (nx - 1) as f64,
-                            v + d * j as f64 / (ny - 1) as f64,
-                        );
-                        free(to_map(a, b))
-                    })
-                });
-                if ok {
+                let at = |i: usize, j: usize| {
+                    to_map(
+                        u + w * i as f64 / (nx - 1) as f64,
+                        v + d * j as f64 / (ny - 1) as f64,
+                    )
+                };
+                if grid_free(nx, ny, at, &free, &mut miss) {
                     return Some(orient((u, v, w, d), theta, gate, &to_map));
                 }
                 u += step;

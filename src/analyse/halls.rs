@@ -14,7 +14,7 @@ use geo::{Contains, Point};
 use geo_types::{Coord, Polygon};
 use rayon::prelude::*;
 
-use super::obstacles::{boundary_distance, Obstacles};
+use super::obstacles::{boundary_distance, grid_free, lot_box, Obstacles};
 use super::product::{ByTile, Halls};
 use super::street::StreetEdges;
 use crate::model::{tile::tile_id, Dataset, FenceKind, HallStat, Lot, PlannedFence, PlannedHall};
@@ -275,10 +275,12 @@ fn find(
     if !(u1 - u0).is_finite() || u1 - u0 > MAX_LOT || v1 - v0 > MAX_LOT {
         return None;
     }
+    let (lo, hi) = lot_box(outline);
+    let near = obstacles.near(lo, hi, clearance);
     let free = |q: Coord<f64>| {
         outline.contains(&Point(q))
             && boundary_distance(q, outline) >= clearance
-            && !obstacles.hit(q, clearance)
+            && !near.hit(q)
             && placed
                 .iter()
                 .all(|p| !p.contains(&Point(q)) && boundary_distance(q, p) >= clearance)
@@ -323,17 +325,16 @@ fn find(
                 }
             })
             .collect();
+        let mut miss = None;
         for &v in &vs {
             for &u in &us {
-                let ok = (0..ny).all(|j| {
-                    (0..nx).all(|i| {
-                        free(frame.map([
-                            u + w * i as f64 / (nx - 1) as f64,
-                            v + d * j as f64 / (ny - 1) as f64,
-                        ]))
-                    })
-                });
-                if ok {
+                let at = |i: usize, j: usize| {
+                    frame.map([
+                        u + w * i as f64 / (nx - 1) as f64,
+                        v + d * j as f64 / (ny - 1) as f64,
+                    ])
+                };
+                if grid_free(nx, ny, at, &free, &mut miss) {
                     return Some(([u, v], [w, d]));
                 }
             }

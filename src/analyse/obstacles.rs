@@ -10,7 +10,7 @@ use geo::{Contains, Distance, Euclidean};
 use geo_types::{Coord, Point, Polygon};
 use rayon::prelude::*;
 use rstar::primitives::{GeomWithData, Rectangle};
-use rstar::{RTree, AABB};
+use rstar::{Envelope, RTree, RTreeObject, AABB};
 
 use super::house::{frame_of, house_end, local_ring};
 use crate::geom::segment::segment_distance_2;
@@ -125,6 +125,85 @@ impl Obstacles {
             .locate_in_envelope_intersecting(&query)
             .any(|g| hits(&self.items[g.data], p, clearance.max(0.0)))
     }
+}
+
+/// The obstacles one area's searches can meet: those whose boxes reach within the clearance
+/// of `[lo, hi]`, taken from the tree once. A hall's or a garden's plot search asks
+/// thousands of points of one lot; walking the city-wide tree for each was most of the
+/// halls' time. A point outside the area is asked of the whole tree, so the answer is
+/// always [`Obstacles::hit`]'s.
+pub struct Near<'a> {
+    all: &'a Obstacles,
+    area: AABB<[f64; 2]>,
+    clearance: f64,
+    items: Vec<(AABB<[f64; 2]>, &'a Obstacle)>,
+}
+
+impl Obstacles {
+    /// The obstacles a point of `[lo, hi]` can hit with `clearance`.
+    pub fn near(&self, lo: Coord<f64>, hi: Coord<f64>, clearance: f64) -> Near<'_> {
+        let c = clearance.max(0.0) + WALL_HALF;
+        let query = AABB::from_corners([lo.x - c, lo.y - c], [hi.x + c, hi.y + c]);
+        let items = (self.tree.locate_in_envelope_intersecting(&query))
+            .map(|g| (g.envelope(), &self.items[g.data]))
+            .collect();
+        Near {
+            all: self,
+            area: AABB::from_corners([lo.x, lo.y], [hi.x, hi.y]),
+            clearance,
+            items,
+        }
+    }
+}
+
+impl Near<'_> {
+    /// Whether `p` lies in an obstacle or within the clearance of one.
+    pub fn hit(&self, p: Coord<f64>) -> bool {
+        if !self.area.contains_point(&[p.x, p.y]) {
+            return self.all.hit(p, self.clearance);
+        }
+        let c = self.clearance.max(0.0) + WALL_HALF;
+        let query = AABB::from_corners([p.x - c, p.y - c], [p.x + c, p.y + c]);
+        (self.items.iter())
+            .any(|(e, o)| e.intersects(&query) && hits(o, p, self.clearance.max(0.0)))
+    }
+}
+
+/// The bounding box of a lot's outline: the area its plot searches ask about (a point (0, 0)
+/// for an outline with no points; every point outside goes to the whole tree).
+pub fn lot_box(outline: &Polygon<f64>) -> (Coord<f64>, Coord<f64>) {
+    match geo::BoundingRect::bounding_rect(outline) {
+        Some(r) => (r.min(), r.max()),
+        None => (Coord::zero(), Coord::zero()),
+    }
+}
+
+/// Whether every point of a plot's sample grid (`nx` x `ny`, rows of `i` for each `j`;
+/// `at(i, j)` the point) is `free`, asking first the point that was not last time (`miss`,
+/// updated). The searches try plot after plot a step apart, and most fail at the wall or
+/// house the one before failed at: asked first, it answers in one question instead of a
+/// row of them. The answer is a conjunction, so the order never changes it.
+pub fn grid_free(
+    nx: usize,
+    ny: usize,
+    at: impl Fn(usize, usize) -> Coord<f64>,
+    free: impl Fn(Coord<f64>) -> bool,
+    miss: &mut Option<(usize, usize)>,
+) -> bool {
+    if let Some((i, j)) = *miss {
+        if i < nx && j < ny && !free(at(i, j)) {
+            return false;
+        }
+    }
+    for j in 0..ny {
+        for i in 0..nx {
+            if *miss != Some((i, j)) && !free(at(i, j)) {
+                *miss = Some((i, j));
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// A house's obstacles: its built band, and its kura when one is built.
@@ -277,5 +356,72 @@ mod tests {
         assert!(!obs.hit(Coord { x: 5.0, y: 0.6 }, 0.0));
         assert!(obs.hit(Coord { x: 5.0, y: 1.0 }, 1.0));
         assert!(!obs.hit(Coord { x: 12.0, y: 0.0 }, 1.0));
+    }
+
+    #[test]
+    fn an_area_s_obstacles_answer_as_the_whole_tree_does() {
+        let catalog = Catalog::load(None).unwrap();
+        let params = Params::default();
+        let m = house(KuraDecision::Clear([1.0, 22.0, 5.0, 27.0]));
+        let mut obs = Obstacles::new(std::iter::once(&m), std::iter::empty(), &catalog, &params);
+        obs.add_areas(std::iter::once(vec![
+            Coord { x: 9.0, y: 9.0 },
+            Coord { x: 12.0, y: 9.0 },
+            Coord { x: 12.0, y: 12.0 },
+        ]));
+        for clearance in [0.0, 0.3, 1.0] {
+            // The area covers half the house; points are asked inside it and beyond it.
+            let near = obs.near(
+                Coord { x: -1.0, y: 10.0 },
+                Coord { x: 8.0, y: 30.0 },
+                clearance,
+            );
+            let mut asked = 0;
+            for i in 0..60 {
+                for j in 0..90 {
+                    let p = Coord {
+                        x: -3.0 + 0.25 * i as f64,
+                        y: -2.0 + 0.4 * j as f64,
+                    };
+                    assert_eq!(near.hit(p), obs.hit(p, clearance), "{p:?} at {clearance}");
+                    asked += usize::from(obs.hit(p, clearance));
+                }
+            }
+            assert!(asked > 100, "the points meet the house and the kura");
+        }
+    }
+
+    #[test]
+    fn a_grid_is_free_whatever_point_is_asked_first() {
+        // A fixed scatter of blocked points (an LCG) on grids of every size up to 6 x 6.
+        let mut x: u64 = 99;
+        let mut next = || {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+            x >> 33
+        };
+        let mut failed = 0;
+        for _ in 0..400 {
+            let (nx, ny) = (1 + next() as usize % 6, 1 + next() as usize % 6);
+            let blocked: Vec<(usize, usize)> = (0..next() % 3)
+                .map(|_| (next() as usize % 7, next() as usize % 7))
+                .collect();
+            let at = |i: usize, j: usize| Coord {
+                x: i as f64,
+                y: j as f64,
+            };
+            let free = |c: Coord<f64>| !blocked.contains(&(c.x as usize, c.y as usize));
+            let plain = (0..ny).all(|j| (0..nx).all(|i| free(at(i, j))));
+            let mut miss = [None, Some((0, 0)), Some((6, 6)), Some((2, 1))][next() as usize % 4];
+            assert_eq!(grid_free(nx, ny, at, free, &mut miss), plain);
+            if !plain {
+                failed += 1;
+                let (i, j) = miss.unwrap();
+                assert!(
+                    i < nx && j < ny && blocked.contains(&(i, j)),
+                    "the miss kept"
+                );
+            }
+        }
+        assert!(failed > 50, "{failed} grids blocked");
     }
 }
