@@ -437,7 +437,7 @@ fn place(site: &Site, obstacles: &Obstacles, p: &Params) -> Option<(Coord<f64>, 
                         v + d * j as f64 / (ny - 1) as f64,
                     )
                 };
-                if grid_free(nx, ny, at, &free, &mut miss) {
+                if grid_free(nx, ny, at, free, &mut miss) {
                     return Some(orient((u, v, w, d), theta, gate, &to_map));
                 }
                 u += step;

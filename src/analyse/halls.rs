@@ -334,7 +334,7 @@ fn find(
                         v + d * j as f64 / (ny - 1) as f64,
                     ])
                 };
-                if grid_free(nx, ny, at, &free, &mut miss) {
+                if grid_free(nx, ny, at, free, &mut miss) {
                     return Some(([u, v], [w, d]));
                 }
             }
