@@ -440,44 +440,40 @@ fn write_city(
         (started, t.elapsed())
     };
     let draw = || city::draw_plan(&data, &plan, params, opts.plan_image);
+    // What follows the tiles and needs only them: the fingerprints, the manifest, links.json.
+    let settle = |results: Vec<Result<city::Made, BuildError>>| -> Result<_, BuildError> {
+        let made = results.into_iter().collect::<Result<Vec<_>, _>>()?;
+        let fingerprints = reuse.as_ref().map(|r| city::fingerprints(r, &made));
+        let written: Vec<report::ManifestTile> = made.into_iter().map(|m| m.entry).collect();
+        let counts = city::Counts::of(&written, fingerprints.as_ref().map(|(_, r)| &r[..]));
+        let mut manifest = writer.manifest(&data, &plan, written, previous);
+        writer.links(&mut manifest, &data)?;
+        Ok((fingerprints, counts, manifest))
+    };
     let clock = StageClock::start();
-    let (((image, plan_time), (gpkg, gpkg_time)), results) =
-        rayon::join(|| rayon::join(draw, start_gpkg), make_tiles);
-    progress.finish();
-    timings.stages.push(clock.stop("tiles"));
-    // Its maps of every lot and house are not needed by the levels of detail, the slowest
-    // and largest step after the tiles (1,000,000 lots: tens of MB).
+    let (((image, plan_time), (gpkg, gpkg_time)), tiles_done) = rayon::join(
+        || rayon::join(draw, start_gpkg),
+        || {
+            let results = make_tiles();
+            progress.finish();
+            timings.stages.push(clock.stop("tiles"));
+            settle(results)
+        },
+    );
+    let (fingerprints, counts, mut manifest) = tiles_done?;
+    // Its maps of every lot and house are not needed by the levels of detail (1,000,000
+    // lots: tens of MB).
     drop(directory);
     (timings.generate_cpu, timings.write_cpu) = writer.cpu();
-    let made = results.into_iter().collect::<Result<Vec<_>, _>>()?;
-    let fingerprints = reuse.map(|r| city::fingerprints(&r, &made));
-    let written: Vec<report::ManifestTile> = made.into_iter().map(|m| m.entry).collect();
-    let tiles_written = match &fingerprints {
-        Some((_, remade)) => remade.len(),
-        None => written.len(),
-    };
-    // The tiles this run made (a build that may keep tiles kept the others as they were).
-    let made_here = |t: &&report::ManifestTile| match &fingerprints {
-        Some((_, remade)) => remade.binary_search(&t.id).is_ok(),
-        None => true,
-    };
-    // Each shared model once, however many tiles draw it.
-    let models: std::collections::BTreeMap<&str, u64> = (written.iter().filter(made_here))
-        .flat_map(|t| t.models.iter().map(|f| (f.path.as_str(), f.bytes)))
-        .collect();
-    let bytes_written: u64 = (written.iter().filter(made_here))
-        .map(|t| t.bytes())
-        .sum::<u64>()
-        + models.values().sum::<u64>();
     let clock = StageClock::start();
-    let mut manifest = writer.manifest(&data, &plan, written, previous);
     let beside = city::Beside { image, gpkg };
-    let (gpkg_after, png_time) = writer.plan_files(&mut manifest, &data, beside, &sources)?;
+    let (gpkg_after, png_time) = writer.plan_files(&manifest, beside, &sources)?;
     timings.stages.push(clock.stop("manifest and plan files"));
     // Freeing the analysis's millions of small allocations takes a moment nobody waits for.
     std::thread::spawn(move || drop((data, plan)));
     let clock = StageClock::start();
-    let (report, stale_time) = writer.finish(manifest)?;
+    writer.formats(&mut manifest)?;
+    let (report, stale_time) = writer.close(manifest)?;
     timings
         .stages
         .push(clock.stop("whole-city files and report"));
@@ -489,8 +485,8 @@ fn write_city(
     Ok(BuildOutcome {
         report,
         timings,
-        bytes_written,
-        tiles_written,
+        bytes_written: counts.bytes,
+        tiles_written: counts.tiles,
         cache: cache::CacheUse::Off,
         fingerprints,
     })

@@ -8,10 +8,11 @@
 //! 3. beside the tiles, [`Beside`]: plan.png drawn and plan.gpkg's first layers written;
 //! 4. [`CityWriter::manifest`]: the manifest of what this run wrote (and, for `--tiles`, the
 //!    earlier build's other tiles);
-//! 5. [`CityWriter::plan_files`]: links.json, plan.gpkg, plan.png; then the caller lets the
-//!    analysis go;
-//! 6. [`CityWriter::finish`]: each format's whole-build files (the tileset), stale files
-//!    removed, report and manifest.
+//! 5. [`CityWriter::links`], links.json;
+//! 6. [`CityWriter::plan_files`], plan.gpkg, plan.png; then the caller lets the analysis go;
+//! 7. [`CityWriter::formats`], each format's whole-build files (the tileset and its levels of
+//!    detail);
+//! 8. [`CityWriter::close`], stale files removed, report and manifest.
 //!
 //! The steps take plain data and return it; [`Timings`] is filled by the caller from what
 //! each returns.
@@ -289,21 +290,26 @@ impl<'a> CityWriter<'a> {
         manifest
     }
 
-    /// Writes what follows the tiles and needs the analysis: links.json, plan.gpkg's last
-    /// layers and plan.png; their times. The analysis may be let go after it: the levels of
-    /// detail read the leaves back, and at a million lots it was most of what was live while
-    /// the parents were made.
+    /// Writes links.json (the build's own file, first in the manifest's list).
+    pub fn links(&self, manifest: &mut report::Manifest, data: &Dataset) -> Result<(), BuildError> {
+        let out = &self.opts.out;
+        let links = output::links::write_links(out, data, manifest.origin)
+            .map_err(|e| write_err(&out.join("links.json"), e))?;
+        manifest.files.extend(links);
+        Ok(())
+    }
+
+    /// Writes what follows the tiles and needs the analysis: plan.gpkg's last layers and
+    /// plan.png; their times. The analysis may be let go after it: the levels of detail read
+    /// the leaves back, and at a million lots it was most of what was live while the
+    /// parents were made.
     pub fn plan_files(
         &self,
-        manifest: &mut report::Manifest,
-        data: &Dataset,
+        manifest: &report::Manifest,
         beside: Beside,
         sources: &output::gpkg::PlanSources,
     ) -> Result<(Duration, Duration), BuildError> {
         let opts = self.opts;
-        let links = output::links::write_links(&opts.out, data, manifest.origin)
-            .map_err(|e| write_err(&opts.out.join("links.json"), e))?;
-        manifest.files.extend(links);
         let t = Instant::now();
         let gpkg_path = opts.out.join(output::PLAN_GPKG);
         match beside.gpkg {
@@ -323,18 +329,23 @@ impl<'a> CityWriter<'a> {
         Ok((gpkg_after, t.elapsed()))
     }
 
-    /// Writes each format's whole-build files (the tileset; a shard leaves them to `merge`),
-    /// removes the stale files of an earlier build, writes the report and the manifest
+    /// Writes each format's whole-build files: the tileset and its levels of detail, the
+    /// city model (a shard leaves them to `merge`).
+    pub fn formats(&self, manifest: &mut report::Manifest) -> Result<(), BuildError> {
+        if manifest.shard.is_none() {
+            let memory = self.opts.reuse.as_ref().map(|r| r.levels_of_detail());
+            shards::finish_formats(&self.opts.out, manifest, memory)?;
+        }
+        Ok(())
+    }
+
+    /// Removes the stale files of an earlier build, writes the report and the manifest
     /// (last); the report, and the time the stale files took.
-    pub fn finish(
+    pub fn close(
         self,
-        mut manifest: report::Manifest,
+        manifest: report::Manifest,
     ) -> Result<(report::Report, Duration), BuildError> {
         let opts = self.opts;
-        if manifest.shard.is_none() {
-            let memory = opts.reuse.as_ref().map(|r| r.levels_of_detail());
-            shards::finish_formats(&opts.out, &mut manifest, memory)?;
-        }
         let t = Instant::now();
         if opts.selection == Selection::All {
             shards::remove_stale_tiles(&opts.out, &manifest);
@@ -343,6 +354,31 @@ impl<'a> CityWriter<'a> {
         let stale = t.elapsed();
         let report = shards::write_manifest_and_report(&opts.out, &manifest)?;
         Ok((report, stale))
+    }
+}
+
+/// What a run wrote: the tiles it made (a build that may keep tiles kept the others as they
+/// were) and their bytes, each shared model once however many tiles draw it.
+pub(super) struct Counts {
+    pub tiles: usize,
+    pub bytes: u64,
+}
+
+impl Counts {
+    /// Of the entries `written`; `remade` (sorted) the tiles made when the build kept others.
+    pub fn of(written: &[report::ManifestTile], remade: Option<&[String]>) -> Counts {
+        let made_here =
+            |t: &&report::ManifestTile| remade.is_none_or(|r| r.binary_search(&t.id).is_ok());
+        let models: BTreeMap<&str, u64> = (written.iter().filter(made_here))
+            .flat_map(|t| t.models.iter().map(|f| (f.path.as_str(), f.bytes)))
+            .collect();
+        Counts {
+            tiles: remade.map_or(written.len(), <[String]>::len),
+            bytes: (written.iter().filter(made_here))
+                .map(|t| t.bytes())
+                .sum::<u64>()
+                + models.values().sum::<u64>(),
+        }
     }
 }
 
