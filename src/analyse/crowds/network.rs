@@ -212,7 +212,7 @@ fn cuts_of(
 #[derive(Default)]
 struct Nodes {
     list: Vec<Node>,
-    grid: HashMap<(i64, i64), Vec<usize>>,
+    grid: HashMap<(i64, i64), Vec<usize>, foldhash::fast::FixedState>,
 }
 
 impl Nodes {

@@ -67,7 +67,9 @@ fn covers(b: &Wall, a: &Wall) -> bool {
 pub fn hidden_walls(masses: &[Mass], flat: bool) -> Vec<[bool; 4]> {
     let all: Vec<[Wall; 4]> = masses.iter().map(|m| walls(m, flat)).collect();
     // Each wall in the cells its box touches.
-    let mut grid: HashMap<(i64, i64), Vec<(usize, usize)>> = HashMap::new();
+    // Looked up, never iterated: a fast fixed hash.
+    let mut grid: HashMap<(i64, i64), Vec<(usize, usize)>, foldhash::fast::FixedState> =
+        HashMap::default();
     for (i, ws) in all.iter().enumerate() {
         for (k, w) in ws.iter().enumerate() {
             for cell in cells(w) {

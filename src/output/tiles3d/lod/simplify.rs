@@ -22,8 +22,12 @@ pub fn simplify(part: Part, target: f64) -> (Part, f64) {
     }
     let centre = part.positions[0];
     let mut welded = Part::default();
-    let mut index: std::collections::HashMap<([i64; 3], [u8; 4], u32), u32> =
-        std::collections::HashMap::new();
+    // Looked up, never iterated: a fast fixed hash (SipHash was most of the welding).
+    let mut index: std::collections::HashMap<
+        ([i64; 3], [u8; 4], u32),
+        u32,
+        foldhash::fast::FixedState,
+    > = Default::default();
     let remap: Vec<u32> = (0..part.positions.len())
         .map(|v| {
             let p = part.positions[v];

@@ -26,7 +26,8 @@ pub fn content_glb(name: &str, content: &Content, level: u32, meshopt: bool) -> 
         } else {
             m.gable_triangles()
         };
-        let mut shared: HashMap<([u64; 3], bool), u32> = HashMap::new();
+        let mut shared: HashMap<([u64; 3], bool), u32, foldhash::fast::FixedState> =
+            HashMap::default();
         for (i, t) in tris.iter().enumerate() {
             // Wall k is triangles 2k and 2k + 1; one against a neighbour's is not drawn.
             if i < 8 && hidden[i / 2] {
