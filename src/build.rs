@@ -456,10 +456,11 @@ fn write_city(
         || {
             let results = make_tiles();
             progress.finish();
-            timings.stages.push(clock.stop("tiles"));
             settle(results)
         },
     );
+    // With what is drawn beside them: a lot's edit makes one tile, then waits for those.
+    timings.stages.push(clock.stop("tiles"));
     let (fingerprints, counts, mut manifest) = tiles_done?;
     // Its maps of every lot and house are not needed by the levels of detail (1,000,000
     // lots: tens of MB).
