@@ -32,6 +32,8 @@ pub struct Memory {
     parents: Mutex<BTreeMap<String, Remembered>>,
     /// How many parents the last tileset kept rather than made.
     kept: AtomicUsize,
+    /// The textures' mean colours, by the bytes they were measured from.
+    colours: Mutex<lod::read::KnownColours>,
 }
 
 impl Memory {
@@ -49,6 +51,16 @@ impl Memory {
     pub(super) fn put(&self, parents: BTreeMap<String, Remembered>, kept: usize) {
         *self.lock() = parents;
         self.kept.store(kept, Ordering::Relaxed);
+    }
+
+    /// The textures' colours measured before, leaving none remembered.
+    pub(super) fn take_colours(&self) -> lod::read::KnownColours {
+        std::mem::take(&mut *self.colours.lock().unwrap_or_else(|e| e.into_inner()))
+    }
+
+    /// Remembers the textures' colours measured now.
+    pub(super) fn put_colours(&self, known: lod::read::KnownColours) {
+        *self.colours.lock().unwrap_or_else(|e| e.into_inner()) = known;
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, BTreeMap<String, Remembered>> {

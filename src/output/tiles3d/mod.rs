@@ -201,6 +201,7 @@ pub fn tileset(
         size,
         meshopt,
         sources: OnceLock::new(),
+        memory,
         keys: memory.map(|_| Keys::of(manifest, &leaves, &groups, meshopt)),
         before: memory.map(Memory::take).unwrap_or_default(),
         now: Mutex::default(),
@@ -311,6 +312,8 @@ struct Tree<'a> {
     meshopt: bool,
     /// Read when the first parent is made (none may be).
     sources: OnceLock<lod::read::Sources>,
+    /// The memory the textures' colours are carried in, with the parents.
+    memory: Option<&'a Memory>,
     /// With a [`Memory`]: every node's key, the parents remembered from the build before and
     /// the ones of this build.
     keys: Option<Keys>,
@@ -374,7 +377,7 @@ impl Tree<'_> {
         let target = width / TARGET_PER_WIDTH;
         let sources = self
             .sources
-            .get_or_init(|| lod::read::Sources::of(self.out));
+            .get_or_init(|| lod::read::Sources::of(self.out, self.memory));
         let (node, file) = parent(
             self.out,
             &name,
