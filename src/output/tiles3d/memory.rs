@@ -33,7 +33,7 @@ pub struct Memory {
     /// How many parents the last tileset kept rather than made.
     kept: AtomicUsize,
     /// The textures' mean colours, by the bytes they were measured from.
-    colours: Mutex<lod::read::KnownColours>,
+    colours: Mutex<lod::colours::KnownColours>,
 }
 
 impl Memory {
@@ -53,14 +53,10 @@ impl Memory {
         self.kept.store(kept, Ordering::Relaxed);
     }
 
-    /// The textures' colours measured before, leaving none remembered.
-    pub(super) fn take_colours(&self) -> lod::read::KnownColours {
-        std::mem::take(&mut *self.colours.lock().unwrap_or_else(|e| e.into_inner()))
-    }
-
-    /// Remembers the textures' colours measured now.
-    pub(super) fn put_colours(&self, known: lod::read::KnownColours) {
-        *self.colours.lock().unwrap_or_else(|e| e.into_inner()) = known;
+    /// The textures' colours measured by the tilesets before (read and replaced by the
+    /// next).
+    pub(super) fn colours(&self) -> &Mutex<lod::colours::KnownColours> {
+        &self.colours
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, BTreeMap<String, Remembered>> {

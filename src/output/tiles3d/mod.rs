@@ -377,7 +377,7 @@ impl Tree<'_> {
         let target = width / TARGET_PER_WIDTH;
         let sources = self
             .sources
-            .get_or_init(|| lod::read::Sources::of(self.out, self.memory));
+            .get_or_init(|| lod::read::Sources::of(self.out, self.memory.map(Memory::colours)));
         let (node, file) = parent(
             self.out,
             &name,

@@ -19,6 +19,7 @@
 //! its massing, meshoptimizer's own error, half a kept card's size, the people and the
 //! buildings left out).
 
+pub mod colours;
 mod hidden;
 pub mod massing;
 pub mod read;
@@ -119,6 +120,9 @@ pub struct Content {
     /// The content's geometric error: 0 for a leaf.
     pub error: f64,
 }
+
+/// The largest leaf GLB, shared model or texture file read back.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
 
 /// The mean colour of each texture by its URI relative to `tiles/` (linear RGBA).
 #[derive(Debug, Clone, Default)]
