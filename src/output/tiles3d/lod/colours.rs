@@ -31,6 +31,10 @@ pub fn texture_colours(out: &Path, mut known: Option<&mut KnownColours>) -> Text
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();
+    // Each 8-bit value's linear value, looked up: the same numbers as computing it per
+    // texel (a `powf` each, which was 3 % of a one-lot rebuild in the workbench).
+    let linear: [f64; 256] =
+        std::array::from_fn(|v| crate::output::glb::linear(v as f32 / 255.0) as f64);
     let mut now = KnownColours::new();
     for name in names {
         let Ok(bytes) = crate::bounded::read(&dir.join(&name), MAX_FILE_BYTES) else {
@@ -41,12 +45,12 @@ pub fn texture_colours(out: &Path, mut known: Option<&mut KnownColours>) -> Text
                 let digest: [u8; 32] = Sha256::digest(&bytes).into();
                 let colour = match before.get(&name) {
                     Some((d, c)) if *d == digest => *c,
-                    _ => mean_colour(&bytes),
+                    _ => mean_colour(&bytes, &linear),
                 };
                 now.insert(name.clone(), (digest, colour));
                 colour
             }
-            None => mean_colour(&bytes),
+            None => mean_colour(&bytes, &linear),
         };
         if let Some(c) = colour {
             means.insert(format!("textures/{name}"), c);
@@ -58,13 +62,9 @@ pub fn texture_colours(out: &Path, mut known: Option<&mut KnownColours>) -> Text
     TextureColours(means)
 }
 
-/// The mean colour of an image file's bytes (linear, alpha-weighted); none when they are no
-/// image or wholly transparent.
-fn mean_colour(bytes: &[u8]) -> Option<[f32; 4]> {
-    // Each 8-bit value's linear value, looked up: the same numbers as computing it per
-    // texel (a `powf` each, which was 3 % of a one-lot rebuild in the workbench).
-    let linear: [f64; 256] =
-        std::array::from_fn(|v| crate::output::glb::linear(v as f32 / 255.0) as f64);
+/// The mean colour of an image file's bytes (linear, alpha-weighted; `linear` each 8-bit
+/// value's linear value); none when they are no image or wholly transparent.
+fn mean_colour(bytes: &[u8], linear: &[f64; 256]) -> Option<[f32; 4]> {
     let img = image::load_from_memory(bytes).ok()?.to_rgba8();
     let (mut sum, mut weight) = ([0.0f64; 3], 0.0f64);
     for p in img.pixels() {

@@ -47,15 +47,8 @@ impl Sources {
     /// textures' colours measured before are taken again for the textures whose bytes are
     /// the same, and `known` is left holding this build's.
     pub fn of(out: &Path, known: Option<&Mutex<KnownColours>>) -> Sources {
-        let lock = |k: &'_ Mutex<KnownColours>| {
-            let mut g = k.lock().unwrap_or_else(|e| e.into_inner());
-            std::mem::take(&mut *g)
-        };
-        let mut taken = known.map(lock);
-        let textures = texture_colours(out, taken.as_mut());
-        if let (Some(k), Some(taken)) = (known, taken) {
-            *k.lock().unwrap_or_else(|e| e.into_inner()) = taken;
-        }
+        let mut known = known.map(|k| k.lock().unwrap_or_else(|e| e.into_inner()));
+        let textures = texture_colours(out, known.as_deref_mut());
         Sources {
             textures,
             out: out.to_path_buf(),
