@@ -18,7 +18,7 @@ use geo::{Centroid, Contains, Point};
 use geo_types::{Coord, Polygon};
 use rayon::prelude::*;
 
-use super::obstacles::{boundary_distance, grid_free, lot_box, Obstacles};
+use super::obstacles::{boundary_distance, grid_free, Obstacles};
 use super::product::{ByTile, Gardens, Halls};
 use crate::growers::garden::ga::{self, Candidate, GaParams};
 use crate::growers::garden::{Layout, Settings};
@@ -417,8 +417,7 @@ fn place(site: &Site, obstacles: &Obstacles, p: &Params) -> Option<(Coord<f64>, 
     if !(u1 - u0).is_finite() || u1 - u0 > 5000.0 || v1 - v0 > 5000.0 {
         return None;
     }
-    let (lo, hi) = lot_box(outline);
-    let near = obstacles.near(lo, hi, g.clearance);
+    let near = obstacles.near(outline, g.clearance);
     let free = |q: Coord<f64>| {
         outline.contains(&Point(q)) && boundary_distance(q, outline) >= site.edge && !near.hit(q)
     };

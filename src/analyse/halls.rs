@@ -14,7 +14,7 @@ use geo::{Contains, Point};
 use geo_types::{Coord, Polygon};
 use rayon::prelude::*;
 
-use super::obstacles::{boundary_distance, grid_free, lot_box, Obstacles};
+use super::obstacles::{boundary_distance, grid_free, Obstacles};
 use super::product::{ByTile, Halls};
 use super::street::StreetEdges;
 use crate::model::{tile::tile_id, Dataset, FenceKind, HallStat, Lot, PlannedFence, PlannedHall};
@@ -275,8 +275,7 @@ fn find(
     if !(u1 - u0).is_finite() || u1 - u0 > MAX_LOT || v1 - v0 > MAX_LOT {
         return None;
     }
-    let (lo, hi) = lot_box(outline);
-    let near = obstacles.near(lo, hi, clearance);
+    let near = obstacles.near(outline, clearance);
     let free = |q: Coord<f64>| {
         outline.contains(&Point(q))
             && boundary_distance(q, outline) >= clearance

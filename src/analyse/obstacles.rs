@@ -128,7 +128,7 @@ impl Obstacles {
 }
 
 /// The obstacles one area's searches can meet: those whose boxes reach within the clearance
-/// of `[lo, hi]`, taken from the tree once. A hall's or a garden's plot search asks
+/// of a lot's bounding box, taken from the tree once. A hall's or a garden's plot search asks
 /// thousands of points of one lot; walking the city-wide tree for each was most of the
 /// halls' time. A point outside the area is asked of the whole tree, so the answer is
 /// always [`Obstacles::hit`]'s.
@@ -140,8 +140,14 @@ pub struct Near<'a> {
 }
 
 impl Obstacles {
-    /// The obstacles a point of `[lo, hi]` can hit with `clearance`.
-    pub fn near(&self, lo: Coord<f64>, hi: Coord<f64>, clearance: f64) -> Near<'_> {
+    /// The obstacles a point of `outline`'s bounding box can hit with `clearance` (a lot's:
+    /// its plot searches ask only about points inside it).
+    pub fn near(&self, outline: &Polygon<f64>, clearance: f64) -> Near<'_> {
+        let (lo, hi) = match geo::BoundingRect::bounding_rect(outline) {
+            Some(r) => (r.min(), r.max()),
+            // No points: an area of one point, and every other goes to the whole tree.
+            None => (Coord::zero(), Coord::zero()),
+        };
         let c = clearance.max(0.0) + WALL_HALF;
         let query = AABB::from_corners([lo.x - c, lo.y - c], [hi.x + c, hi.y + c]);
         let items = (self.tree.locate_in_envelope_intersecting(&query))
@@ -166,15 +172,6 @@ impl Near<'_> {
         let query = AABB::from_corners([p.x - c, p.y - c], [p.x + c, p.y + c]);
         (self.items.iter())
             .any(|(e, o)| e.intersects(&query) && hits(o, p, self.clearance.max(0.0)))
-    }
-}
-
-/// The bounding box of a lot's outline: the area its plot searches ask about (a point (0, 0)
-/// for an outline with no points; every point outside goes to the whole tree).
-pub fn lot_box(outline: &Polygon<f64>) -> (Coord<f64>, Coord<f64>) {
-    match geo::BoundingRect::bounding_rect(outline) {
-        Some(r) => (r.min(), r.max()),
-        None => (Coord::zero(), Coord::zero()),
     }
 }
 
@@ -371,11 +368,18 @@ mod tests {
         ]));
         for clearance in [0.0, 0.3, 1.0] {
             // The area covers half the house; points are asked inside it and beyond it.
-            let near = obs.near(
-                Coord { x: -1.0, y: 10.0 },
-                Coord { x: 8.0, y: 30.0 },
-                clearance,
+            let area = Polygon::new(
+                vec![
+                    (-1.0, 10.0),
+                    (8.0, 10.0),
+                    (8.0, 30.0),
+                    (-1.0, 30.0),
+                    (-1.0, 10.0),
+                ]
+                .into(),
+                vec![],
             );
+            let near = obs.near(&area, clearance);
             let mut asked = 0;
             for i in 0..60 {
                 for j in 0..90 {
