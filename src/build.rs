@@ -439,7 +439,9 @@ fn write_city(
             .then(|| output::gpkg::PlanWriter::start(&gpkg_path, &sources).map_err(gpkg_err));
         (started, t.elapsed())
     };
-    let draw = || city::draw_plan(&data, &plan, params, opts.plan_image);
+    // The workbench's image of the rebuild before: only the strips that changed are drawn.
+    let kept = opts.reuse.as_deref().map(|f| f.plan_image());
+    let draw = || city::draw_plan(&data, &plan, params, opts.plan_image, kept);
     // What follows the tiles and needs only them: the fingerprints, the manifest, links.json.
     let settle = |results: Vec<Result<city::Made, BuildError>>| -> Result<_, BuildError> {
         let made = results.into_iter().collect::<Result<Vec<_>, _>>()?;

@@ -146,6 +146,7 @@ proptest! {
         prop_assert_eq!(made.len(), marks.len(), "a first build makes every tile");
         let mut kept_some = false;
         let mut kept_parents = false;
+        let mut kept_strips = false;
         for n in 1..=edits.len() {
             let params = write_hypothesis(&hyp, &lots, &edits[..n]);
             let mut opts = options(&input, &live, params.clone());
@@ -154,6 +155,7 @@ proptest! {
             let (next, made) = again.fingerprints.expect("fingerprints kept");
             kept_some |= made.len() < next.len();
             kept_parents |= next.levels_of_detail().kept() > 0;
+            kept_strips |= next.plan_image().strips_kept() > 0;
             marks = next;
             let full = dir.path().join(format!("full{n}"));
             build(&options(&input, &full, params), &NoProgress).expect("full build");
@@ -163,6 +165,7 @@ proptest! {
         if edits.iter().all(|e| matches!(e, Edit::Lot { .. })) {
             prop_assert!(kept_some, "some tile kept");
             prop_assert!(kept_parents, "some parent of the levels of detail kept");
+            prop_assert!(kept_strips, "some strip of plan.png kept");
         }
     }
 }

@@ -454,13 +454,14 @@ pub(super) fn draw_plan(
     plan: &Plan,
     params: &Params,
     wanted: bool,
+    kept: Option<&output::plan::Kept>,
 ) -> (Option<Vec<u8>>, Duration) {
     let t = Instant::now();
     let image = wanted
         .then(|| {
             let grid = (params.tile_size, params.tile_origin);
             output::plan::View::fit(data, None).and_then(|view| {
-                output::plan::draw_plan(data, plan, &view, grid, super::kura_view(params))
+                output::plan::draw_plan(data, plan, &view, grid, super::kura_view(params), kept)
             })
         })
         .flatten();

@@ -162,7 +162,7 @@ fn draw_analysed(
     };
     let grid = (params.tile_size, params.tile_origin);
     output::plan::View::fit(data, bounds)
-        .and_then(|view| output::plan::draw_plan(data, plan, &view, grid, kura_view(params)))
+        .and_then(|view| output::plan::draw_plan(data, plan, &view, grid, kura_view(params), None))
         .ok_or_else(|| ReplayError::NothingToDraw.into())
 }
 

@@ -25,7 +25,7 @@ use sha2::{Digest, Sha256};
 
 use crate::generate::TilePlan;
 use crate::model::{Dataset, Plan};
-use crate::output::{features::Directory, listed, report, tiles3d::memory::Memory};
+use crate::output::{features::Directory, listed, plan, report, tiles3d::memory::Memory};
 use crate::params::Params;
 
 /// Parameters only the analysis reads: a change to one remakes the tiles whose plan it
@@ -66,12 +66,19 @@ pub struct Fingerprints {
     tiles: BTreeMap<String, TileMark>,
     /// The parents of the levels of detail, carried from build to build.
     lod: Arc<Memory>,
+    /// plan.png as drawn last, strip by strip.
+    plan: Arc<plan::Kept>,
 }
 
 impl Fingerprints {
     /// The levels of detail's parents as the build before left them.
     pub fn levels_of_detail(&self) -> &Arc<Memory> {
         &self.lod
+    }
+
+    /// plan.png's image as the build before drew it.
+    pub fn plan_image(&self) -> &plan::Kept {
+        &self.plan
     }
 
     /// How many tiles it knows.
@@ -231,6 +238,7 @@ impl<'a> Reuse<'a> {
             city: self.city,
             tiles: marks.into_iter().map(|(id, m)| (id, m.0)).collect(),
             lod: self.before.lod.clone(),
+            plan: self.before.plan.clone(),
         }
     }
 }

@@ -7,15 +7,18 @@
 
 mod furniture;
 mod paint;
+mod strips;
 
 use std::collections::{BTreeMap, HashSet};
 
 use geo_types::Coord;
-use tiny_skia::{Color, Pixmap};
+use tiny_skia::Pixmap;
 
 use crate::model::{Dataset, Plan};
 use furniture::{draw_legend, draw_scale_bar, draw_tile_grid, Shown};
 use paint::{crisp, paint, thin, wide, Batch, Draw, OUTLINE};
+use strips::Target;
+pub use strips::{Kept, STRIP_ROWS};
 
 /// Longest side of the image in pixels.
 pub const MAX_SIDE: f64 = 2400.0;
@@ -127,48 +130,66 @@ pub fn type_colours(plan: &Plan) -> BTreeMap<String, [u8; 3]> {
 
 /// Draws the plan; `None` when there is nothing to draw. `tile_grid` = (size, origin).
 /// `kura`: `None` when kura are off, else whether collisions are avoided (then the refused
-/// kura are outlined in red).
+/// kura are outlined in red). `kept`: the workbench's image of the rebuild before, whose
+/// strips are kept where nothing in them changed ([`strips`]).
 pub fn draw_plan(
     data: &Dataset,
     plan: &Plan,
     view: &View,
     tile_grid: (f64, [f64; 2]),
     kura: Option<bool>,
+    kept: Option<&Kept>,
 ) -> Option<Vec<u8>> {
     let (w, h) = view.size();
-    let mut pm = Pixmap::new(w, h)?;
-    pm.fill(Color::from_rgba8(250, 248, 242, 255));
-    // Bottom to top: street bands and blocks, lots and houses, kura, walls, people and trees,
-    // then the lines a reader checks (centrelines, frontages), the grid and the legend.
-    draw_streets(&mut pm, view, data);
     let colours = type_colours(plan);
-    draw_lots_and_houses(&mut pm, view, data, plan, &colours);
-    let refused_any = kura.is_some_and(|avoid| draw_kura(&mut pm, view, plan, avoid));
-    let any_fence = draw_fences(&mut pm, view, plan);
-    let any_hall = draw_halls(&mut pm, view, plan);
-    let any_landmark = draw_landmarks(&mut pm, view, plan);
-    let any_billboard = draw_billboards(&mut pm, view, plan);
-    draw_lines_on_top(&mut pm, view, data, plan);
+    let fills = Fills::of(data, plan, &colours);
+    // Bottom to top: street bands and blocks, lots and houses, kura, walls, people and trees,
+    // then the lines a reader checks (centrelines, frontages); over them the grid and the
+    // legend.
+    let layers = |t: &mut Target| {
+        draw_streets(t, view, data);
+        draw_lots_and_houses(t, view, data, plan, &fills);
+        if let Some(avoid) = kura {
+            draw_kura(t, view, plan, avoid);
+        }
+        draw_fences(t, view, plan);
+        draw_halls(t, view, plan);
+        draw_landmarks(t, view, plan);
+        draw_billboards(t, view, plan);
+        draw_lines_on_top(t, view, data, plan);
+    };
+    let mut pm = strips::draw(w, h, &layers, kept)?;
     draw_tile_grid(&mut pm, view, plan, tile_grid);
     draw_scale_bar(&mut pm, view);
-    let kura_rows = match kura {
-        Some(_) => 1 + usize::from(refused_any),
-        None => 0,
-    };
-    let shown = Shown {
-        footprints: !data.footprints.is_empty(),
-        kura_rows,
-        fences: any_fence,
-        halls: any_hall,
-        landmarks: any_landmark,
-        billboards: any_billboard,
-    };
-    draw_legend(&mut pm, &colours, &shown);
+    draw_legend(&mut pm, &colours, &Shown::of(data, plan, kura));
     encode_png(&pm)
 }
 
+impl Shown {
+    /// The legend's rows for what the plan holds.
+    fn of(data: &Dataset, plan: &Plan, kura: Option<bool>) -> Shown {
+        let refused = |avoid| {
+            (plan.houses.values().flatten())
+                .any(|m| m.kura.rect().is_some() && m.kura.to_build(avoid).is_none())
+        };
+        let kura_rows = match kura {
+            Some(avoid) => 1 + usize::from(refused(avoid)),
+            None => 0,
+        };
+        Shown {
+            footprints: !data.footprints.is_empty(),
+            kura_rows,
+            fences: plan.fences.values().any(|f| !f.is_empty()),
+            halls: plan.halls.values().any(|h| !h.is_empty()),
+            landmarks: plan.landmarks.values().any(|l| !l.is_empty()),
+            billboards: plan.billboards.values().any(|b| !b.is_empty()),
+        }
+    }
+}
+
 /// Street bands as wide as the streets, and block outlines.
-fn draw_streets(pm: &mut Pixmap, view: &View, data: &Dataset) {
+fn draw_streets(t: &mut Target, view: &View, data: &Dataset) {
+    t.layer("streets");
     // One batch per band width (its f32 bits: a key that sorts and compares exactly).
     let mut bands: BTreeMap<u32, Batch> = BTreeMap::new();
     for street in &data.streets {
@@ -176,38 +197,63 @@ fn draw_streets(pm: &mut Pixmap, view: &View, data: &Dataset) {
         bands
             .entry(width.to_bits())
             .or_insert_with(|| Batch::new(Draw::Stroke(paint([215, 212, 205], 255), wide(width))))
-            .line(pm, view, &street.line.0);
+            .line(t, view, &street.line.0);
     }
     for batch in bands.into_values() {
-        batch.finish(pm);
+        batch.finish(t);
     }
     let mut blocks = Batch::new(Draw::Stroke(paint([160, 160, 160], 255), thin()));
     for block in &data.blocks {
-        blocks.polygon(pm, view, block);
+        blocks.polygon(t, view, block);
     }
-    blocks.finish(pm);
+    blocks.finish(t);
+}
+
+/// The colour of each lot drawn without a house (`None`: a house stands on it), in the
+/// data's order, and of each house, in the plan's: decided once, not once a strip.
+struct Fills {
+    lots: Vec<Option<[u8; 3]>>,
+    houses: Vec<[u8; 3]>,
+}
+
+impl Fills {
+    fn of(data: &Dataset, plan: &Plan, colours: &BTreeMap<String, [u8; 3]>) -> Fills {
+        let skipped: HashSet<&str> = plan.skipped.iter().map(|s| s.id.as_str()).collect();
+        let displaced: HashSet<&str> = (plan.landmark_report.displaced.iter())
+            .filter(|d| d.kind == "machiya")
+            .map(|d| d.id.as_str())
+            .collect();
+        let planned: HashSet<&str> = (plan.houses.values().flatten())
+            .filter(|m| !m.is_footprint())
+            .map(|m| m.id.as_str())
+            .collect();
+        let lots = (data.lots.iter())
+            .map(|lot| {
+                let id = lot.id.as_str();
+                (!planned.contains(id)).then(|| {
+                    if displaced.contains(id) {
+                        LANDMARK_LOT
+                    } else if skipped.contains(id) {
+                        SKIPPED
+                    } else {
+                        OTHER_USE
+                    }
+                })
+            })
+            .collect();
+        let houses = (plan.houses.values().flatten())
+            .map(|m| match m.footprint_height() {
+                Some(_) => FOOTPRINT,
+                None => colours.get(&m.mtype).copied().unwrap_or(TYPE_COLOURS[0]),
+            })
+            .collect();
+        Fills { lots, houses }
+    }
 }
 
 /// Lots without a house (other uses, given to a landmark, skipped ones), then every house by its type's colour.
-fn draw_lots_and_houses(
-    pm: &mut Pixmap,
-    view: &View,
-    data: &Dataset,
-    plan: &Plan,
-    colours: &BTreeMap<String, [u8; 3]>,
-) {
-    let skipped: HashSet<&str> = plan.skipped.iter().map(|s| s.id.as_str()).collect();
-    let displaced: HashSet<&str> = (plan.landmark_report.displaced.iter())
-        .filter(|d| d.kind == "machiya")
-        .map(|d| d.id.as_str())
-        .collect();
-    let planned: HashSet<&str> = plan
-        .houses
-        .values()
-        .flatten()
-        .filter(|m| !m.is_footprint())
-        .map(|m| m.id.as_str())
-        .collect();
+fn draw_lots_and_houses(t: &mut Target, view: &View, data: &Dataset, plan: &Plan, fills: &Fills) {
+    t.layer("lots_and_houses");
     let outlined = |colour: [u8; 3]| {
         Batch::new(Draw::FillOutlined(
             crisp(paint(colour, 255)),
@@ -215,94 +261,87 @@ fn draw_lots_and_houses(
         ))
     };
     let mut lots: BTreeMap<[u8; 3], Batch> = BTreeMap::new();
-    for lot in &data.lots {
-        if planned.contains(lot.id.as_str()) {
-            continue;
+    for (lot, fill) in data.lots.iter().zip(&fills.lots) {
+        if let Some(fill) = *fill {
+            lots.entry(fill)
+                .or_insert_with(|| outlined(fill))
+                .polygon(t, view, &lot.outline);
         }
-        let fill = if displaced.contains(lot.id.as_str()) {
-            LANDMARK_LOT
-        } else if skipped.contains(lot.id.as_str()) {
-            SKIPPED
-        } else {
-            OTHER_USE
-        };
-        lots.entry(fill)
-            .or_insert_with(|| outlined(fill))
-            .polygon(pm, view, &lot.outline);
     }
     for batch in lots.into_values() {
-        batch.finish(pm);
+        batch.finish(t);
     }
+    t.layer("houses");
     let mut houses: BTreeMap<[u8; 3], Batch> = BTreeMap::new();
-    for m in plan.houses.values().flatten() {
-        let colour = match m.footprint_height() {
-            Some(_) => FOOTPRINT,
-            None => colours.get(&m.mtype).copied().unwrap_or(TYPE_COLOURS[0]),
-        };
+    for (m, &colour) in plan.houses.values().flatten().zip(&fills.houses) {
         houses
             .entry(colour)
             .or_insert_with(|| outlined(colour))
-            .polygon(pm, view, &m.outline);
+            .polygon(t, view, &m.outline);
     }
     for batch in houses.into_values() {
-        batch.finish(pm);
+        batch.finish(t);
     }
 }
 
-/// Kura filled where built, outlined where the avoidance (`avoid`) refused them; whether any
-/// was refused (for the legend).
-fn draw_kura(pm: &mut Pixmap, view: &View, plan: &Plan, avoid: bool) -> bool {
+/// Kura filled where built, outlined where the avoidance (`avoid`) refused them.
+fn draw_kura(t: &mut Target, view: &View, plan: &Plan, avoid: bool) {
+    t.layer("kura");
     let mut built = Batch::new(Draw::Fill(crisp(paint(KURA, 255))));
     let mut refused = Batch::new(Draw::Stroke(paint(KURA_REFUSED, 255), wide(1.5)));
     for m in plan.houses.values().flatten() {
         let Some(r) = m.kura.rect() else { continue };
         let q = crate::geom::frame::Frame::along(m.frontage.a, m.frontage.u_axis()).quad(r);
         match m.kura.to_build(avoid) {
-            Some(_) => built.ring(pm, view, &q),
-            None => refused.ring(pm, view, &q),
+            Some(_) => built.ring(t, view, &q),
+            None => refused.ring(t, view, &q),
         }
     }
-    built.finish(pm);
-    refused.finish(pm)
+    built.finish(t);
+    refused.finish(t);
 }
 
-/// The halls' plots, filled (whether there was any).
-fn draw_halls(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
+/// The halls' plots, filled.
+fn draw_halls(t: &mut Target, view: &View, plan: &Plan) {
+    t.layer("halls");
     let mut halls = Batch::new(Draw::Fill(crisp(paint(HALL, 255))));
     for h in plan.halls.values().flatten() {
-        halls.ring(pm, view, &h.outline());
+        halls.ring(t, view, &h.outline());
     }
-    halls.finish(pm)
+    halls.finish(t);
 }
 
-/// The landmarks' footprints, filled and outlined (whether there was any).
-fn draw_landmarks(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
+/// The landmarks' footprints, filled and outlined.
+fn draw_landmarks(t: &mut Target, view: &View, plan: &Plan) {
+    t.layer("landmarks");
     let draw = Draw::FillOutlined(crisp(paint(LANDMARK, 255)), paint([40, 20, 60], 255));
     let mut landmarks = Batch::new(draw);
     for l in plan.landmarks.values().flatten() {
-        landmarks.polygon(pm, view, &l.footprint);
+        landmarks.polygon(t, view, &l.footprint);
     }
-    landmarks.finish(pm)
+    landmarks.finish(t);
 }
 
 /// Walls and gates (section 4.3): a dark line along each wall segment, a red bar per gate
-/// (gates over walls); whether there was any.
-fn draw_fences(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
+/// (gates over walls).
+fn draw_fences(t: &mut Target, view: &View, plan: &Plan) {
+    t.layer("fences");
     let mut walls = Batch::new(Draw::Stroke(paint(FENCE, 255), wide(2.0)));
     let mut gates = Batch::new(Draw::Stroke(paint(GATE, 255), wide(4.0)));
     for f in plan.fences.values().flatten() {
         match f.kind {
-            crate::model::FenceKind::Wall => walls.line(pm, view, &[f.a, f.b]),
-            crate::model::FenceKind::Gate => gates.line(pm, view, &[f.a, f.b]),
+            crate::model::FenceKind::Wall => walls.line(t, view, &[f.a, f.b]),
+            crate::model::FenceKind::Gate => gates.line(t, view, &[f.a, f.b]),
         }
     }
-    let any_wall = walls.finish(pm);
-    gates.finish(pm) || any_wall
+    walls.finish(t);
+    gates.finish(t);
 }
 
 /// People and trees (section 4.4): a dot each, a tree's as wide as its crown (people over
-/// trees); whether there was any.
-fn draw_billboards(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
+/// trees).
+fn draw_billboards(t: &mut Target, view: &View, plan: &Plan) {
+    t.layer("billboards");
     // Dots stay anti-aliased: crisp, a small circle is a cross.
     let mut trees = Batch::new(Draw::Fill(paint(TREE, 220)));
     let mut people = Batch::new(Draw::Fill(paint(PERSON, 220)));
@@ -311,28 +350,29 @@ fn draw_billboards(pm: &mut Pixmap, view: &View, plan: &Plan) -> bool {
         match b.kind {
             crate::model::BillboardKind::Tree => {
                 let r = (b.height * 0.25 * view.scale) as f32;
-                trees.circle(pm, x, y, r.max(1.5));
+                trees.circle(t, x, y, r.max(1.5));
             }
-            crate::model::BillboardKind::Person => people.circle(pm, x, y, 2.5),
+            crate::model::BillboardKind::Person => people.circle(t, x, y, 2.5),
         }
     }
-    let any_tree = trees.finish(pm);
-    people.finish(pm) || any_tree
+    trees.finish(t);
+    people.finish(t);
 }
 
 /// Street centrelines and each house's frontage, on top: in cadastral data the roads are
 /// parcels too and would hide them.
-fn draw_lines_on_top(pm: &mut Pixmap, view: &View, data: &Dataset, plan: &Plan) {
+fn draw_lines_on_top(t: &mut Target, view: &View, data: &Dataset, plan: &Plan) {
+    t.layer("lines_on_top");
     let mut centrelines = Batch::new(Draw::Stroke(paint([60, 90, 140], 160), thin()));
     for street in &data.streets {
-        centrelines.line(pm, view, &street.line.0);
+        centrelines.line(t, view, &street.line.0);
     }
-    centrelines.finish(pm);
+    centrelines.finish(t);
     let mut frontages = Batch::new(Draw::Stroke(paint(FRONTAGE, 255), wide(2.5)));
     for m in plan.houses.values().flatten() {
-        frontages.line(pm, view, &[m.frontage.a, m.frontage.b]);
+        frontages.line(t, view, &[m.frontage.a, m.frontage.b]);
     }
-    frontages.finish(pm);
+    frontages.finish(t);
 }
 
 /// PNG with fast compression: at 2400 x 2400 the default level took most of the plan's time.
@@ -385,15 +425,19 @@ mod tests {
             scale: 1.0,
         };
         let mut pm = Pixmap::new(100, 100).unwrap();
+        let mut t = Target::Draw {
+            pm: pm.as_mut(),
+            top: 0,
+        };
         let mut batch = Batch::new(Draw::Fill(paint([255, 0, 0], 255)));
         // Two squares overlapping in 40..60, wound opposite ways.
         batch.polygon(
-            &mut pm,
+            &mut t,
             &view,
             &Polygon::new(square(0.0, 0.0, 60.0, false), vec![]),
         );
         batch.polygon(
-            &mut pm,
+            &mut t,
             &view,
             &Polygon::new(square(40.0, 0.0, 60.0, true), vec![]),
         );
@@ -402,8 +446,8 @@ mod tests {
             square(10.0, 70.0, 25.0, false),
             vec![square(17.0, 77.0, 10.0, false)],
         );
-        batch.polygon(&mut pm, &view, &holed);
-        assert!(batch.finish(&mut pm));
+        batch.polygon(&mut t, &view, &holed);
+        batch.finish(&mut t);
         // Map y up, pixel y down: map (x, y) is pixel (x, 100 - y).
         assert!(red_at(&pm, 50, 70), "the overlap is filled");
         assert!(
@@ -413,5 +457,77 @@ mod tests {
         assert!(!red_at(&pm, 22, 18), "the hole stays open");
         assert!(red_at(&pm, 12, 18), "around the hole is filled");
         assert!(!red_at(&pm, 50, 10), "outside every polygon is not");
+    }
+
+    /// Squares of side 10 m (pixels, at this view) at each of `at`, in one batch, and a
+    /// circle over the first.
+    fn layers(at: &[(f64, f64)]) -> impl Fn(&mut Target) + Sync + '_ {
+        let view = View {
+            bounds: [0.0, 0.0, 300.0, 600.0],
+            scale: 1.0,
+        };
+        move |t: &mut Target| {
+            t.layer("squares");
+            let mut squares = Batch::new(Draw::Fill(paint([200, 40, 40], 255)));
+            for &(x, y) in at {
+                let ring = LineString(vec![
+                    coord! { x: x, y: y },
+                    coord! { x: x + 10.0, y: y },
+                    coord! { x: x + 10.0, y: y + 10.0 },
+                    coord! { x: x, y: y + 10.0 },
+                    coord! { x: x, y: y },
+                ]);
+                squares.polygon(t, &view, &Polygon::new(ring, vec![]));
+            }
+            squares.finish(t);
+            t.layer("dots");
+            let mut dots = Batch::new(Draw::Fill(paint([20, 20, 120], 200)));
+            let (x, y) = view.pixel(&coord! { x: at[0].0, y: at[0].1 });
+            dots.circle(t, x, y, 7.0);
+            dots.finish(t);
+        }
+    }
+
+    /// A kept image with one shape moved is the image drawn afresh, byte for byte, and
+    /// only the strips the shape left and entered have new keys.
+    #[test]
+    fn a_kept_image_redrawn_where_a_shape_moved_is_the_image_drawn_afresh() {
+        let before = [(20.0, 580.0), (150.0, 300.0), (250.0, 20.0)];
+        // The second square moves from rows ~290-300 (strip 2) to ~440-450 (strip 3).
+        let after = [(20.0, 580.0), (150.0, 150.0), (250.0, 20.0)];
+        let kept = Kept::default();
+        strips::draw(300, 600, &layers(&before), Some(&kept)).unwrap();
+        let again = strips::draw(300, 600, &layers(&after), Some(&kept)).unwrap();
+        let afresh = strips::draw(300, 600, &layers(&after), None).unwrap();
+        assert_eq!(again.data(), afresh.data());
+        assert_eq!(
+            kept.strips_kept(),
+            600usize.div_ceil(STRIP_ROWS as usize) - 2
+        );
+        assert_ne!(
+            again.data(),
+            strips::draw(300, 600, &layers(&before), None)
+                .unwrap()
+                .data()
+        );
+        let n = 600u32.div_ceil(STRIP_ROWS);
+        let (a, b) = (
+            strips::strip_keys(n, &layers(&before)),
+            strips::strip_keys(n, &layers(&after)),
+        );
+        let changed: Vec<usize> = (0..a.len()).filter(|&s| a[s] != b[s]).collect();
+        assert_eq!(changed, vec![2, 3]);
+    }
+
+    #[test]
+    fn an_image_of_another_size_is_drawn_whole() {
+        let at = [(20.0, 580.0), (150.0, 300.0)];
+        let kept = Kept::default();
+        strips::draw(300, 600, &layers(&at), Some(&kept)).unwrap();
+        let smaller = strips::draw(300, 590, &layers(&at), Some(&kept)).unwrap();
+        assert_eq!(
+            smaller.data(),
+            strips::draw(300, 590, &layers(&at), None).unwrap().data()
+        );
     }
 }

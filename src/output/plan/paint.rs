@@ -3,8 +3,9 @@
 //! of thousands of lots as fast as one).
 
 use geo_types::{Coord, Polygon};
-use tiny_skia::{FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
+use tiny_skia::{FillRule, Paint, PathBuilder, PixmapMut, Stroke, Transform};
 
+use super::strips::Target;
 use super::View;
 
 pub(super) fn paint(rgb: [u8; 3], a: u8) -> Paint<'static> {
@@ -31,23 +32,6 @@ pub(super) fn push_line(pb: &mut PathBuilder, view: &View, pts: &[Coord<f64>]) {
     }
 }
 
-/// A closed ring through `pts`, in their order.
-pub(super) fn push_closed<'a>(
-    pb: &mut PathBuilder,
-    view: &View,
-    mut pts: impl Iterator<Item = &'a Coord<f64>>,
-) {
-    if let Some(first) = pts.next() {
-        let (x, y) = view.pixel(first);
-        pb.move_to(x, y);
-        for c in pts {
-            let (x, y) = view.pixel(c);
-            pb.line_to(x, y);
-        }
-        pb.close();
-    }
-}
-
 /// What a [`Batch`] does with each of its paths.
 pub(super) enum Draw {
     /// Fills it (nonzero rule).
@@ -61,16 +45,51 @@ pub(super) enum Draw {
 }
 
 impl Draw {
-    pub(super) fn path(&self, pm: &mut Pixmap, path: &tiny_skia::Path) {
-        let id = Transform::identity();
+    pub(super) fn path(&self, pm: &mut PixmapMut, path: &tiny_skia::Path) {
+        let at = Transform::identity();
         match self {
-            Draw::Fill(paint) => pm.fill_path(path, paint, FillRule::Winding, id, None),
-            Draw::Stroke(paint, stroke) => pm.stroke_path(path, paint, stroke, id, None),
+            Draw::Fill(paint) => pm.fill_path(path, paint, FillRule::Winding, at, None),
+            Draw::Stroke(paint, stroke) => pm.stroke_path(path, paint, stroke, at, None),
             Draw::FillOutlined(fill, outline) => {
-                pm.fill_path(path, fill, FillRule::Winding, id, None);
-                pm.stroke_path(path, outline, &thin(), id, None);
+                pm.fill_path(path, fill, FillRule::Winding, at, None);
+                pm.stroke_path(path, outline, &thin(), at, None);
             }
         }
+    }
+
+    /// Pixels a shape's ink may reach past its points: half a stroke, its joins' mitres
+    /// (at most twice the width with tiny-skia's default limit of 4) and anti-aliasing.
+    fn reach(&self) -> f32 {
+        match self {
+            Draw::Stroke(_, stroke) => 2.0 * stroke.width + 2.0,
+            Draw::Fill(_) | Draw::FillOutlined(..) => 2.0,
+        }
+    }
+
+    /// What the pixels of its shapes depend on besides their points: colours, anti-aliasing,
+    /// widths (a strip's key, [`super::strips`]).
+    fn look(&self) -> Vec<u8> {
+        let mut look = Vec::with_capacity(48);
+        let mut paint = |p: &Paint| {
+            if let tiny_skia::Shader::SolidColor(c) = &p.shader {
+                for v in [c.red(), c.green(), c.blue(), c.alpha()] {
+                    look.extend(v.to_le_bytes());
+                }
+            }
+            look.push(p.anti_alias as u8);
+        };
+        match self {
+            Draw::Fill(p) => paint(p),
+            Draw::Stroke(p, stroke) => {
+                paint(p);
+                look.extend(stroke.width.to_le_bytes());
+            }
+            Draw::FillOutlined(f, o) => {
+                paint(f);
+                paint(o);
+            }
+        }
+        look
     }
 }
 
@@ -80,10 +99,18 @@ impl Draw {
 /// [`Batch::SHAPES`] shapes and is drawn as soon as it is full, because tiny-skia builds
 /// every edge of a path before it draws, and a million lots' paths held at once would be
 /// hundreds of megabytes.
+///
+/// Each shape is offered to the [`Target`] first, which takes the ones that cross its
+/// strip of the image (or only hashes them, for the strips' keys).
 pub(super) struct Batch {
     draw: Draw,
+    look: Vec<u8>,
+    reach: f32,
     open: PathBuilder,
     shapes: usize,
+    /// The shape being added, in pixels, and where each of its rings ends.
+    points: Vec<(f32, f32)>,
+    rings: Vec<usize>,
 }
 
 impl Batch {
@@ -92,73 +119,152 @@ impl Batch {
 
     pub(super) fn new(draw: Draw) -> Batch {
         Batch {
+            look: draw.look(),
+            reach: draw.reach(),
             draw,
             open: PathBuilder::new(),
             shapes: 0,
+            points: Vec::new(),
+            rings: Vec::new(),
         }
     }
 
     /// A polygon's rings, the exterior counter-clockwise on screen and the holes clockwise,
     /// so the nonzero rule fills the union of overlapping polygons and keeps their holes
     /// (even-odd would punch a hole where two lots of the data overlap).
-    pub(super) fn polygon(&mut self, pm: &mut Pixmap, view: &View, poly: &Polygon<f64>) {
-        self.push_ring(view, &poly.exterior().0, true);
-        for hole in poly.interiors() {
-            self.push_ring(view, &hole.0, false);
+    pub(super) fn polygon(&mut self, t: &mut Target, view: &View, poly: &Polygon<f64>) {
+        let rings = || std::iter::once(poly.exterior()).chain(poly.interiors());
+        let rows = self.rows(view, rings().flat_map(|r| r.0.iter()));
+        if t.wants(rows) {
+            self.push_ring(view, &poly.exterior().0, true);
+            for hole in poly.interiors() {
+                self.push_ring(view, &hole.0, false);
+            }
+            self.offer(t, Shape::Rings, rows);
         }
-        self.shape_done(pm);
     }
 
     /// A closed ring (a shape of its own), counter-clockwise on screen.
-    pub(super) fn ring(&mut self, pm: &mut Pixmap, view: &View, pts: &[Coord<f64>]) {
-        self.push_ring(view, pts, true);
-        self.shape_done(pm);
+    pub(super) fn ring(&mut self, t: &mut Target, view: &View, pts: &[Coord<f64>]) {
+        let rows = self.rows(view, pts.iter());
+        if t.wants(rows) {
+            self.push_ring(view, pts, true);
+            self.offer(t, Shape::Rings, rows);
+        }
+    }
+
+    /// The rows of pixels a shape's ink may reach: its points' topmost and bottommost rows,
+    /// found from their map coordinates (the pixel row falls as north rises, exactly: the
+    /// conversion is monotonic), so a shape away from a strip costs no conversion.
+    fn rows<'c>(&self, view: &View, pts: impl Iterator<Item = &'c Coord<f64>>) -> (f32, f32) {
+        let (south, north) = pts.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
+            (lo.min(c.y), hi.max(c.y))
+        });
+        let at = |y| view.pixel(&Coord { x: 0.0, y }).1;
+        (at(north) - self.reach, at(south) + self.reach)
     }
 
     /// A closed ring, turned to `outer`'s orientation. The turn is read from the map
     /// coordinates (north up: clockwise there is counter-clockwise on screen), so no copy of
     /// the ring is made.
-    pub(super) fn push_ring(&mut self, view: &View, pts: &[Coord<f64>], outer: bool) {
+    fn push_ring(&mut self, view: &View, pts: &[Coord<f64>], outer: bool) {
         let twice_area: f64 = pts
             .iter()
             .zip(pts.iter().cycle().skip(1))
             .map(|(a, b)| a.x * b.y - b.x * a.y)
             .sum();
         if (twice_area < 0.0) == outer {
-            push_closed(&mut self.open, view, pts.iter().rev());
+            self.points.extend(pts.iter().rev().map(|c| view.pixel(c)));
         } else {
-            push_closed(&mut self.open, view, pts.iter());
+            self.points.extend(pts.iter().map(|c| view.pixel(c)));
         }
+        self.rings.push(self.points.len());
     }
 
     /// An open polyline.
-    pub(super) fn line(&mut self, pm: &mut Pixmap, view: &View, pts: &[Coord<f64>]) {
-        push_line(&mut self.open, view, pts);
-        self.shape_done(pm);
-    }
-
-    pub(super) fn circle(&mut self, pm: &mut Pixmap, x: f32, y: f32, r: f32) {
-        self.open.push_circle(x, y, r);
-        self.shape_done(pm);
-    }
-
-    pub(super) fn shape_done(&mut self, pm: &mut Pixmap) {
-        self.shapes += 1;
-        if self.shapes.is_multiple_of(Self::SHAPES) {
-            self.draw_open(pm);
+    pub(super) fn line(&mut self, t: &mut Target, view: &View, pts: &[Coord<f64>]) {
+        let rows = self.rows(view, pts.iter());
+        if t.wants(rows) {
+            self.points.extend(pts.iter().map(|c| view.pixel(c)));
+            self.offer(t, Shape::Line, rows);
         }
     }
 
-    pub(super) fn draw_open(&mut self, pm: &mut Pixmap) {
+    pub(super) fn circle(&mut self, t: &mut Target, x: f32, y: f32, r: f32) {
+        let rows = (y - r - self.reach, y + r + self.reach);
+        if t.wants(rows) {
+            self.points.extend([(x, y), (r, r)]);
+            self.offer(t, Shape::Circle, rows);
+        }
+    }
+
+    /// Hands the shape in `points` to the target, and adds it to the open path, moved to
+    /// the target's strip, when the target draws it.
+    fn offer(&mut self, t: &mut Target, shape: Shape, rows: (f32, f32)) {
+        if let Some(top) = t.take(rows, &self.look, shape as u8, &self.points) {
+            self.push(shape, top);
+            self.shapes += 1;
+            if self.shapes.is_multiple_of(Self::SHAPES) {
+                self.draw_open(t);
+            }
+        }
+        self.points.clear();
+        self.rings.clear();
+    }
+
+    /// The shape in `points` added to the open path, `top` rows up.
+    fn push(&mut self, shape: Shape, top: f32) {
+        let pb = &mut self.open;
+        match shape {
+            Shape::Circle => {
+                let ((x, y), (r, _)) = (self.points[0], self.points[1]);
+                pb.push_circle(x, y - top, r);
+            }
+            Shape::Line => push_points(pb, &self.points, top, false),
+            Shape::Rings => {
+                let mut start = 0;
+                for &end in &self.rings {
+                    push_points(pb, &self.points[start..end], top, true);
+                    start = end;
+                }
+            }
+        }
+    }
+
+    fn draw_open(&mut self, t: &mut Target) {
         if let Some(path) = std::mem::take(&mut self.open).finish() {
-            self.draw.path(pm, &path);
+            if let Some(pm) = t.pixmap() {
+                self.draw.path(pm, &path);
+            }
         }
     }
 
-    /// Draws what is left; whether anything was added.
-    pub(super) fn finish(mut self, pm: &mut Pixmap) -> bool {
-        self.draw_open(pm);
-        self.shapes > 0
+    /// Draws what is left.
+    pub(super) fn finish(mut self, t: &mut Target) {
+        self.draw_open(t);
+    }
+}
+
+/// What the points of a shape in a [`Batch`] make.
+#[derive(Clone, Copy)]
+enum Shape {
+    /// Closed rings, each ending where `Batch::rings` says.
+    Rings,
+    /// An open polyline.
+    Line,
+    /// A circle: its centre, then its radius twice.
+    Circle,
+}
+
+/// A path through `pts`, `top` rows up, closed or not.
+fn push_points(pb: &mut PathBuilder, pts: &[(f32, f32)], top: f32, closed: bool) {
+    let Some(&(x, y)) = pts.first() else { return };
+    pb.move_to(x, y - top);
+    for &(x, y) in &pts[1..] {
+        pb.line_to(x, y - top);
+    }
+    if closed {
+        pb.close();
     }
 }
 
