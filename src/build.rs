@@ -452,18 +452,33 @@ fn write_city(
         writer.links(&mut manifest, &data)?;
         Ok((fingerprints, counts, manifest))
     };
+    // A build that keeps tiles (the workbench's) makes its levels of detail as soon as its
+    // tiles are written, beside plan.gpkg's first layers: a lot's edit makes one tile and
+    // its parents, and plan.gpkg's layers take as long. A whole build makes them after,
+    // once the analysis is let go (at a million lots it was most of what was live).
+    let lod_beside = opts.reuse.is_some();
     let clock = StageClock::start();
     let (((image, plan_time), (gpkg, gpkg_time)), tiles_done) = rayon::join(
         || rayon::join(draw, start_gpkg),
         || {
             let results = make_tiles();
             progress.finish();
-            settle(results)
+            let (fingerprints, counts, manifest) = settle(results)?;
+            let with_lod = lod_beside
+                .then(|| {
+                    let mut m = manifest.clone();
+                    writer.formats(&mut m).map(|()| m)
+                })
+                .transpose()?;
+            Ok::<_, BuildError>((fingerprints, counts, manifest, with_lod))
         },
     );
     // With what is drawn beside them: a lot's edit makes one tile, then waits for those.
-    timings.stages.push(clock.stop("tiles"));
-    let (fingerprints, counts, mut manifest) = tiles_done?;
+    timings.stages.push(clock.stop(match lod_beside {
+        true => "tiles and levels of detail",
+        false => "tiles",
+    }));
+    let (fingerprints, counts, manifest, with_lod) = tiles_done?;
     // Its maps of every lot and house are not needed by the levels of detail (1,000,000
     // lots: tens of MB).
     drop(directory);
@@ -475,7 +490,15 @@ fn write_city(
     // Freeing the analysis's millions of small allocations takes a moment nobody waits for.
     std::thread::spawn(move || drop((data, plan)));
     let clock = StageClock::start();
-    writer.formats(&mut manifest)?;
+    // plan.gpkg was finished from the manifest of the tiles alone, as a whole build has it.
+    let manifest = match with_lod {
+        Some(m) => m,
+        None => {
+            let mut manifest = manifest;
+            writer.formats(&mut manifest)?;
+            manifest
+        }
+    };
     let (report, stale_time) = writer.close(manifest)?;
     timings
         .stages
