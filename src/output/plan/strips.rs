@@ -125,7 +125,7 @@ struct Canvas {
 }
 
 /// The image `width` x `height` of what `layers` draws, strip by strip on every core; with
-/// `kept`, the strips whose keys are those of the image kept are copied from it, and the
+/// `kept`, the strips whose keys are those of the image kept stay as they are in it, and the
 /// image is kept for the next.
 pub(super) fn draw(
     width: u32,
