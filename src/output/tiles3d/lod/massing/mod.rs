@@ -229,6 +229,51 @@ mod tests {
         }
     }
 
+    /// The way back measures each corner once: a gable massing's 14 faces give their 14
+    /// centres and 10 corners, a flat box's 10 faces 10 centres and 8 corners, and the
+    /// figure against an irregular building is the one of every face's corners and centre.
+    #[test]
+    fn the_way_back_measures_each_corner_once_and_finds_the_same() {
+        let house = gabled(12.0, 7.0, 3.5, 7.5);
+        let lean_to = Mass {
+            rect: [[12.0, 1.0], [15.0, 1.0], [15.0, 5.0], [12.0, 5.0]],
+            eave: 2.0,
+            ridge: 2.6,
+            ..house.clone()
+        };
+        let building: Vec<_> = [house.clone(), lean_to]
+            .iter()
+            .flat_map(|m| m.gable_triangles())
+            .collect();
+        let every = |tris: &[[[f64; 3]; 3]]| -> Vec<[f64; 3]> {
+            tris.iter()
+                .flat_map(|t| {
+                    let c = [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0);
+                    [t[0], t[1], t[2], c]
+                })
+                .collect()
+        };
+        let massing = Mass {
+            eave: 4.5,
+            flat: 5.0,
+            ..house
+        };
+        for (tris, points) in [
+            (massing.gable_triangles(), 14 + 10),
+            (massing.flat_triangles(), 10 + 8),
+        ] {
+            let once = samples(&tris);
+            assert_eq!(once.len(), points);
+            assert!(every(&tris).iter().all(|p| once.contains(p)));
+            let inf = f64::INFINITY;
+            let faces = Faces::new(&building);
+            let deduped = error(&once, &faces, 0.0, inf, &mut Search::default());
+            let all = error(&every(&tris), &faces, 0.0, inf, &mut Search::default());
+            assert_eq!(deduped.to_bits(), all.to_bits());
+            assert!(all > 0.5, "the lean-to lies outside the massing: {all}");
+        }
+    }
+
     /// A box of 10 x 6 x 8 m with a gable roof: its own massing is exact (error 0 up to the
     /// height steps), and the flat box's error is the roof's height above its top.
     #[test]
