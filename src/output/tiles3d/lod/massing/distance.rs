@@ -33,7 +33,7 @@ pub struct Search {
 pub fn hausdorff(
     points: &[[f64; 3]],
     original: &Faces,
-    tris: &[[[f64; 3]; 3]],
+    (tris, corners): (&[[[f64; 3]; 3]], &[[f64; 3]]),
     cutoff: f64,
     starts: &mut Starts,
 ) -> f64 {
@@ -42,30 +42,21 @@ pub fn hausdorff(
     if there >= cutoff {
         return there;
     }
-    let samples = samples(tris);
+    let samples = samples(tris, corners);
     starts.back.starts.resize(samples.len(), usize::MAX);
     // The way back only matters where it is larger than the way there.
     error(&samples, original, there, cutoff, &mut starts.back)
 }
 
-/// The corners and centre of each of the massing's faces: where it is measured against the
-/// building. Each corner once, in the order first met: a gable massing's 14 faces share 10
-/// corners, and a point measured again cannot change a largest distance (each was measured
-/// four times over, most of the way back's searches).
-pub(super) fn samples(tris: &[[[f64; 3]; 3]]) -> Vec<[f64; 3]> {
-    let mut points: Vec<[f64; 3]> = Vec::with_capacity(tris.len() * 2);
-    for t in tris {
-        for corner in *t {
-            if !points
-                .iter()
-                .any(|p| p.map(f64::to_bits) == corner.map(f64::to_bits))
-            {
-                points.push(corner);
-            }
-        }
-        points.push([0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0));
-    }
-    points
+/// Where the massing is measured against the building: its `corners`, each once (the
+/// corners of its faces `tris`: a gable massing's 14 faces share 10, a flat box's 10 share
+/// 8), and each face's centre. A point measured again cannot change a largest distance;
+/// each corner was measured four times over, most of the way back's searches.
+pub(super) fn samples(tris: &[[[f64; 3]; 3]], corners: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let centres = tris
+        .iter()
+        .map(|t| [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0));
+    corners.iter().copied().chain(centres).collect()
 }
 
 /// The largest of `floor` and the distances from each point to the nearest of the triangles;

@@ -37,6 +37,49 @@ pub struct Mass {
 /// How many heights are tried between the base and the ridge.
 const STEPS: usize = 8;
 
+/// The heights tried, `k` of [`STEPS`] from the base (the upper half), from the middle of the
+/// roof outwards. The error mostly falls and rises again about its least, so the best is met
+/// among the first two or three, and the others stop at their first points (the cutoff of
+/// [`hausdorff`]); in rising order each better height was measured in full. The choice is
+/// the same whatever the order ([`Best`]).
+const ORDER: [usize; 5] = [6, 5, 7, 4, 8];
+
+/// The least error measured so far among one kind's candidates, and its step: a height
+/// wins on a smaller error or, at an equal one, a lower step, so the choice is the one of
+/// trying them in rising order and keeping each strictly better one.
+#[derive(Debug, Clone, Copy)]
+struct Best {
+    error: f64,
+    k: usize,
+}
+
+impl Best {
+    /// None yet: an infinite error never wins (a building no candidate fits keeps its
+    /// ridge).
+    const NONE: Best = Best {
+        error: f64::INFINITY,
+        k: 0,
+    };
+
+    /// Where candidate `k`'s measure may stop: at the best error for a higher step (a tie
+    /// loses), past it for a lower one (a tie wins, so it is measured in full).
+    fn cutoff(&self, k: usize) -> f64 {
+        match k < self.k {
+            true => self.error.next_up(),
+            false => self.error,
+        }
+    }
+
+    /// Whether candidate `k` of error `e` is the new best (and takes its place).
+    fn offer(&mut self, k: usize, e: f64) -> bool {
+        let wins = e < self.error || (e == self.error && k < self.k);
+        if wins {
+            *self = Best { error: e, k };
+        }
+        wins
+    }
+}
+
 /// The massing of the building whose triangles are `tris` (corner positions) with their
 /// colours; `None` when it has no footprint (fewer than three distinct plan points).
 pub fn mass(id: u32, tris: &[([[f64; 3]; 3], [u8; 4])]) -> Option<Mass> {
@@ -70,24 +113,37 @@ pub fn mass(id: u32, tris: &[([[f64; 3]; 3], [u8; 4])]) -> Option<Mass> {
     // Where each point's search starts, per kind of massing: where it ended for the height
     // before (the candidates differ in a few heights, so the nearest face rarely moves).
     let (mut gable_starts, mut flat_starts) = (Starts::default(), Starts::default());
-    for k in STEPS / 2..=STEPS {
+    let (mut gable_best, mut flat_best) = (Best::NONE, Best::NONE);
+    for k in ORDER {
         let h = base + (ridge - base) * k as f64 / STEPS as f64;
         let gable = Mass {
             eave: h,
             ..m.clone()
         };
-        let tris = gable.gable_triangles();
-        let e = hausdorff(&points, &original, &tris, m.gable_error, &mut gable_starts);
-        if e < m.gable_error {
+        let (tris, corners) = (gable.gable_triangles(), gable.gable_corners());
+        let e = hausdorff(
+            &points,
+            &original,
+            (&tris, &corners),
+            gable_best.cutoff(k),
+            &mut gable_starts,
+        );
+        if gable_best.offer(k, e) {
             (m.eave, m.gable_error) = (h, e);
         }
         let flat = Mass {
             flat: h,
             ..m.clone()
         };
-        let tris = flat.flat_triangles();
-        let e = hausdorff(&points, &original, &tris, m.flat_error, &mut flat_starts);
-        if e < m.flat_error {
+        let (tris, corners) = (flat.flat_triangles(), flat.flat_corners());
+        let e = hausdorff(
+            &points,
+            &original,
+            (&tris, &corners),
+            flat_best.cutoff(k),
+            &mut flat_starts,
+        );
+        if flat_best.offer(k, e) {
             (m.flat, m.flat_error) = (h, e);
         }
     }
@@ -128,6 +184,21 @@ impl Mass {
             [hi[3], hi[0], r1],
         ]);
         t
+    }
+
+    /// The corners of [`Mass::gable_triangles`], each once.
+    fn gable_corners(&self) -> [[f64; 3]; 10] {
+        let (lo, hi) = (self.ring(self.base), self.ring(self.eave));
+        let [r1, r2] = self.ridge_points();
+        [
+            lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3], r1, r2,
+        ]
+    }
+
+    /// The corners of [`Mass::flat_triangles`], each once.
+    fn flat_corners(&self) -> [[f64; 3]; 8] {
+        let (lo, hi) = (self.ring(self.base), self.ring(self.flat));
+        [lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]]
     }
 
     /// Walls to the flat top and the top: 10 triangles, facing out.
@@ -245,32 +316,44 @@ mod tests {
             .iter()
             .flat_map(|m| m.gable_triangles())
             .collect();
-        let every = |tris: &[[[f64; 3]; 3]]| -> Vec<[f64; 3]> {
-            tris.iter()
-                .flat_map(|t| {
-                    let c = [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0);
-                    [t[0], t[1], t[2], c]
-                })
-                .collect()
-        };
         let massing = Mass {
             eave: 4.5,
             flat: 5.0,
             ..house
         };
-        for (tris, points) in [
-            (massing.gable_triangles(), 14 + 10),
-            (massing.flat_triangles(), 10 + 8),
+        for (tris, corners, points) in [
+            (
+                massing.gable_triangles(),
+                massing.gable_corners().to_vec(),
+                14 + 10,
+            ),
+            (
+                massing.flat_triangles(),
+                massing.flat_corners().to_vec(),
+                10 + 8,
+            ),
         ] {
-            let once = samples(&tris);
+            let once = samples(&tris, &corners);
             assert_eq!(once.len(), points);
-            assert!(every(&tris).iter().all(|p| once.contains(p)));
+            let bits = |p: &[f64; 3]| p.map(f64::to_bits);
+            let distinct: std::collections::BTreeSet<_> = once.iter().map(bits).collect();
+            assert_eq!(distinct.len(), points, "each corner once");
+            assert!(every_sample(&tris).iter().all(|p| once.contains(p)));
             let inf = f64::INFINITY;
             let faces = Faces::new(&building);
             let deduped = error(&once, &faces, 0.0, inf, &mut Search::default());
-            let all = error(&every(&tris), &faces, 0.0, inf, &mut Search::default());
+            let all = error(
+                &every_sample(&tris),
+                &faces,
+                0.0,
+                inf,
+                &mut Search::default(),
+            );
             assert_eq!(deduped.to_bits(), all.to_bits());
-            assert!(all > 0.5, "the lean-to lies outside the massing: {all}");
+            assert!(
+                all > 0.5,
+                "the massing's eaves stand above the house's: {all}"
+            );
         }
     }
 
@@ -307,9 +390,12 @@ mod tests {
         assert_eq!(m.flat_triangles().len(), 10);
     }
 
-    /// The cutoffs and the floor only skip work: on an irregular building (a gabled box with
-    /// a lean-to and a chimney) the chosen heights and errors are those of measuring every
-    /// candidate in full.
+    /// The cutoffs, the floor and the order of the candidates only skip work: the chosen
+    /// heights and errors are those of measuring every candidate in full, in rising order,
+    /// keeping each strictly better one. On an irregular building (a gabled box with a
+    /// lean-to and a chimney), on an L (its error is the empty corner of its rectangle,
+    /// farther from the low wing the higher the massing: the lowest height wins though it
+    /// is tried fourth), and on a plain gabled house.
     #[test]
     fn the_cutoffs_choose_what_measuring_every_candidate_chooses() {
         let house = gabled(12.0, 7.0, 3.5, 7.5);
@@ -325,33 +411,63 @@ mod tests {
             ridge: 9.0,
             ..house.clone()
         };
-        let tris: Vec<_> = [house, lean_to, chimney]
-            .iter()
-            .flat_map(|m| m.gable_triangles())
-            .map(|t| (t, [200, 200, 200, 255]))
-            .collect();
-        let m = mass(1, &tris).unwrap();
-        // Every candidate measured in full, both ways, as before the cutoffs.
+        let wing = Mass {
+            rect: [[0.0, 7.0], [4.0, 7.0], [4.0, 20.0], [0.0, 20.0]],
+            eave: 3.0,
+            ridge: 3.2,
+            ..house.clone()
+        };
+        let buildings = [
+            vec![house.clone(), lean_to, chimney],
+            vec![house.clone(), wing],
+            vec![gabled(9.0, 5.0, 3.0, 6.0)],
+        ];
+        let mut steps = Vec::new();
+        for parts in buildings {
+            let tris: Vec<_> = (parts.iter())
+                .flat_map(|m| m.gable_triangles())
+                .map(|t| (t, [200, 200, 200, 255]))
+                .collect();
+            let m = mass(1, &tris).unwrap();
+            let (gable, flat) = in_full(&tris, &m);
+            assert_eq!((m.gable_error, m.eave), gable);
+            assert_eq!((m.flat_error, m.flat), flat);
+            steps.push(((m.eave - m.base) / (m.ridge - m.base) * STEPS as f64).round());
+        }
+        assert_eq!(steps[1], 4.0, "the L: the lowest height");
+    }
+
+    /// Each face's corners and centre, as the way back measured them before each corner was
+    /// measured once.
+    fn every_sample(tris: &[[[f64; 3]; 3]]) -> Vec<[f64; 3]> {
+        tris.iter()
+            .flat_map(|t| {
+                let c = [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0);
+                [t[0], t[1], t[2], c]
+            })
+            .collect()
+    }
+
+    /// Each candidate of `m`'s building (`tris`) measured in full, both ways, in rising
+    /// order, each strictly better one kept: (error, height) of the gable and of the flat
+    /// box.
+    fn in_full(tris: &[([[f64; 3]; 3], [u8; 4])], m: &Mass) -> ((f64, f64), (f64, f64)) {
         let points: Vec<[f64; 3]> = tris.iter().flat_map(|(t, _)| *t).collect();
         let original: Vec<_> = tris.iter().map(|(t, _)| *t).collect();
         let full = |massing: &[[[f64; 3]; 3]]| {
             let inf = f64::INFINITY;
-            let there = error(
-                &points,
-                &Faces::new(massing),
-                0.0,
-                inf,
-                &mut Search::default(),
-            );
+            let faces = Faces::new(massing);
+            let there = error(&points, &faces, 0.0, inf, &mut Search::default());
+            let back = Faces::new(&original);
             there.max(error(
-                &samples(massing),
-                &Faces::new(&original),
+                &every_sample(massing),
+                &back,
                 0.0,
                 inf,
                 &mut Search::default(),
             ))
         };
-        let (mut gable, mut flat) = ((f64::INFINITY, 0.0), (f64::INFINITY, 0.0));
+        let (mut gable, mut flat) = ((f64::INFINITY, m.ridge), (f64::INFINITY, m.ridge));
         for k in STEPS / 2..=STEPS {
             let h = m.base + (m.ridge - m.base) * k as f64 / STEPS as f64;
             let e = full(
@@ -375,12 +491,31 @@ mod tests {
                 flat = (e, h);
             }
         }
-        assert_eq!((m.gable_error, m.eave), gable);
-        assert_eq!((m.flat_error, m.flat), flat);
-        assert!(
-            m.gable_error > 0.1,
-            "an irregular building: {}",
-            m.gable_error
-        );
+        (gable, flat)
+    }
+
+    /// Equal errors go to the lowest height whatever the order they are met in; a lower
+    /// height is measured past the best error (a tie would win), a higher one stops at it;
+    /// an infinite error never wins.
+    #[test]
+    fn equal_errors_go_to_the_lowest_height() {
+        let mut best = Best::NONE;
+        assert!(!best.offer(6, f64::INFINITY));
+        for k in ORDER {
+            best.offer(k, 2.0);
+        }
+        assert_eq!((best.error, best.k), (2.0, 4));
+        let best = Best { error: 2.0, k: 6 };
+        assert!(best.cutoff(5) > 2.0 && best.cutoff(5) == 2.0f64.next_up());
+        assert_eq!(best.cutoff(7), 2.0);
+        assert_eq!(Best::NONE.cutoff(4), f64::INFINITY);
+    }
+
+    /// [`ORDER`] tries every height of the upper half once.
+    #[test]
+    fn the_order_tries_each_height_once() {
+        let mut order = ORDER.to_vec();
+        order.sort_unstable();
+        assert_eq!(order, (STEPS / 2..=STEPS).collect::<Vec<_>>());
     }
 }
