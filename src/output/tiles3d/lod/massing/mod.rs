@@ -53,6 +53,36 @@ struct Best {
     k: usize,
 }
 
+impl Default for Best {
+    fn default() -> Best {
+        Best::NONE
+    }
+}
+
+/// One kind of massing's candidates as they are measured in turn.
+#[derive(Debug, Default)]
+struct Trial {
+    best: Best,
+    starts: Starts,
+}
+
+impl Trial {
+    /// Measures the candidate of step `k` (its faces and their corners) against the
+    /// building (its vertices `points`, its faces `original`); its error when it is the new
+    /// best.
+    fn height(
+        &mut self,
+        k: usize,
+        points: &[[f64; 3]],
+        original: &Faces,
+        faces: (&[[[f64; 3]; 3]], &[[f64; 3]]),
+    ) -> Option<f64> {
+        let cutoff = self.best.cutoff(k);
+        let e = hausdorff(points, original, faces, cutoff, &mut self.starts);
+        self.best.offer(k, e).then_some(e)
+    }
+}
+
 impl Best {
     /// None yet: an infinite error never wins (a building no candidate fits keeps its
     /// ridge).
@@ -110,40 +140,26 @@ pub fn mass(id: u32, tris: &[([[f64; 3]; 3], [u8; 4])]) -> Option<Mass> {
     let original: Vec<[[f64; 3]; 3]> = tris.iter().map(|(t, _)| *t).collect();
     // Measured against by every candidate: its boxes once.
     let original = Faces::new(&original);
-    // Where each point's search starts, per kind of massing: where it ended for the height
-    // before (the candidates differ in a few heights, so the nearest face rarely moves).
-    let (mut gable_starts, mut flat_starts) = (Starts::default(), Starts::default());
-    let (mut gable_best, mut flat_best) = (Best::NONE, Best::NONE);
+    // Each kind of massing's trial: its best height so far, and where each point's search
+    // starts (where it ended for the height before: the candidates differ in a few
+    // heights, so the nearest face rarely moves).
+    let (mut gable, mut flat) = (Trial::default(), Trial::default());
     for k in ORDER {
         let h = base + (ridge - base) * k as f64 / STEPS as f64;
-        let gable = Mass {
+        let g = Mass {
             eave: h,
             ..m.clone()
         };
-        let (tris, corners) = (gable.gable_triangles(), gable.gable_corners());
-        let e = hausdorff(
-            &points,
-            &original,
-            (&tris, &corners),
-            gable_best.cutoff(k),
-            &mut gable_starts,
-        );
-        if gable_best.offer(k, e) {
+        let faces = (&g.gable_triangles()[..], &g.gable_corners()[..]);
+        if let Some(e) = gable.height(k, &points, &original, faces) {
             (m.eave, m.gable_error) = (h, e);
         }
-        let flat = Mass {
+        let f = Mass {
             flat: h,
             ..m.clone()
         };
-        let (tris, corners) = (flat.flat_triangles(), flat.flat_corners());
-        let e = hausdorff(
-            &points,
-            &original,
-            (&tris, &corners),
-            flat_best.cutoff(k),
-            &mut flat_starts,
-        );
-        if flat_best.offer(k, e) {
+        let faces = (&f.flat_triangles()[..], &f.flat_corners()[..]);
+        if let Some(e) = flat.height(k, &points, &original, faces) {
             (m.flat, m.flat_error) = (h, e);
         }
     }
@@ -300,11 +316,8 @@ mod tests {
         }
     }
 
-    /// The way back measures each corner once: a gable massing's 14 faces give their 14
-    /// centres and 10 corners, a flat box's 10 faces 10 centres and 8 corners, and the
-    /// figure against an irregular building is the one of every face's corners and centre.
-    #[test]
-    fn the_way_back_measures_each_corner_once_and_finds_the_same() {
+    /// A gabled house of 12 x 7 m (eaves 3.5 m, ridge 7.5 m) and a low lean-to beside it.
+    fn house_and_lean_to() -> (Mass, Mass) {
         let house = gabled(12.0, 7.0, 3.5, 7.5);
         let lean_to = Mass {
             rect: [[12.0, 1.0], [15.0, 1.0], [15.0, 5.0], [12.0, 5.0]],
@@ -312,6 +325,15 @@ mod tests {
             ridge: 2.6,
             ..house.clone()
         };
+        (house, lean_to)
+    }
+
+    /// The way back measures each corner once: a gable massing's 14 faces give their 14
+    /// centres and 10 corners, a flat box's 10 faces 10 centres and 8 corners, and the
+    /// figure against an irregular building is the one of every face's corners and centre.
+    #[test]
+    fn the_way_back_measures_each_corner_once_and_finds_the_same() {
+        let (house, lean_to) = house_and_lean_to();
         let building: Vec<_> = [house.clone(), lean_to]
             .iter()
             .flat_map(|m| m.gable_triangles())
@@ -398,13 +420,7 @@ mod tests {
     /// is tried fourth), and on a plain gabled house.
     #[test]
     fn the_cutoffs_choose_what_measuring_every_candidate_chooses() {
-        let house = gabled(12.0, 7.0, 3.5, 7.5);
-        let lean_to = Mass {
-            rect: [[12.0, 1.0], [15.0, 1.0], [15.0, 5.0], [12.0, 5.0]],
-            eave: 2.0,
-            ridge: 2.6,
-            ..house.clone()
-        };
+        let (house, lean_to) = house_and_lean_to();
         let chimney = Mass {
             rect: [[2.0, 2.0], [3.0, 2.0], [3.0, 3.0], [2.0, 3.0]],
             eave: 9.0,
