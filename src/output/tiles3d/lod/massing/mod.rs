@@ -53,6 +53,33 @@ struct Best {
     k: usize,
 }
 
+impl Best {
+    /// None yet: an infinite error never wins (a building no candidate fits keeps its
+    /// ridge).
+    const NONE: Best = Best {
+        error: f64::INFINITY,
+        k: 0,
+    };
+
+    /// Where candidate `k`'s measure may stop: at the best error for a higher step (a tie
+    /// loses), past it for a lower one (a tie wins, so it is measured in full).
+    fn cutoff(&self, k: usize) -> f64 {
+        match k < self.k {
+            true => self.error.next_up(),
+            false => self.error,
+        }
+    }
+
+    /// Whether candidate `k` of error `e` is the new best (and takes its place).
+    fn offer(&mut self, k: usize, e: f64) -> bool {
+        let wins = e < self.error || (e == self.error && k < self.k);
+        if wins {
+            *self = Best { error: e, k };
+        }
+        wins
+    }
+}
+
 impl Default for Best {
     fn default() -> Best {
         Best::NONE
@@ -80,33 +107,6 @@ impl Trial {
         let cutoff = self.best.cutoff(k);
         let e = hausdorff(points, original, faces, cutoff, &mut self.starts);
         self.best.offer(k, e).then_some(e)
-    }
-}
-
-impl Best {
-    /// None yet: an infinite error never wins (a building no candidate fits keeps its
-    /// ridge).
-    const NONE: Best = Best {
-        error: f64::INFINITY,
-        k: 0,
-    };
-
-    /// Where candidate `k`'s measure may stop: at the best error for a higher step (a tie
-    /// loses), past it for a lower one (a tie wins, so it is measured in full).
-    fn cutoff(&self, k: usize) -> f64 {
-        match k < self.k {
-            true => self.error.next_up(),
-            false => self.error,
-        }
-    }
-
-    /// Whether candidate `k` of error `e` is the new best (and takes its place).
-    fn offer(&mut self, k: usize, e: f64) -> bool {
-        let wins = e < self.error || (e == self.error && k < self.k);
-        if wins {
-            *self = Best { error: e, k };
-        }
-        wins
     }
 }
 
@@ -438,7 +438,7 @@ mod tests {
             vec![house.clone(), wing],
             vec![gabled(9.0, 5.0, 3.0, 6.0)],
         ];
-        let mut steps = Vec::new();
+        let (mut steps, mut errors) = (Vec::new(), Vec::new());
         for parts in buildings {
             let tris: Vec<_> = (parts.iter())
                 .flat_map(|m| m.gable_triangles())
@@ -449,7 +449,9 @@ mod tests {
             assert_eq!((m.gable_error, m.eave), gable);
             assert_eq!((m.flat_error, m.flat), flat);
             steps.push(((m.eave - m.base) / (m.ridge - m.base) * STEPS as f64).round());
+            errors.push(m.gable_error);
         }
+        assert!(errors[0] > 0.1, "an irregular building: {}", errors[0]);
         assert_eq!(steps[1], 4.0, "the L: the lowest height");
     }
 
