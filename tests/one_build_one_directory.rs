@@ -534,3 +534,25 @@ fn init_follows_no_link_and_its_printed_command_builds() {
     assert!(o.status.success(), "`{line}`: {}", stderr_of(&o));
     assert!(out.join("plan.png").exists(), "`{line}` builds into out/");
 }
+
+/// A `--force` rebuild over an earlier build leaves the directory a build into an empty one
+/// makes, byte for byte: the files it replaced (kept under a second name until its own
+/// thread frees them, so that their blocks are not freed on the writers' threads) and the
+/// earlier build's tiles it has no more are all gone.
+#[test]
+fn a_rebuild_over_an_earlier_build_leaves_what_a_fresh_build_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let (over, fresh) = (dir.path().join("over"), dir.path().join("fresh"));
+    let p = dir.path().join("seed.toml");
+    std::fs::write(&p, "seed = 2\n").unwrap();
+    build_ok(&fixture("kyoto-small"), &over, &["--quiet"]);
+    let o = build_with(&fixture("kyoto-small"), &over, &["--quiet", "--force"], &p);
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    let o = build_with(&fixture("kyoto-small"), &fresh, &["--quiet"], &p);
+    assert!(o.status.success(), "{}", stderr_of(&o));
+    assert!(
+        all_files(&over).keys().all(|f| !f.contains(".tmp-")),
+        "no second name or temporary left"
+    );
+    common::assert_same_tree(&over, &fresh);
+}
