@@ -398,9 +398,6 @@ fn write_city(
         )?),
         _ => None,
     };
-    // What this build's files replace, freed on a thread of its own (see `Retired`): after
-    // the tiles, beside the levels of detail, and for good when this returns.
-    let retired = output::atomic::Retired::new(&opts.out);
     let writer = city::CityWriter::prepare(opts, catalog, library, &plan)?;
     let directory = output::features::Directory::of(&data, &plan, params);
     let tiles: Vec<&String> = (plan.tiles.iter())
@@ -466,7 +463,6 @@ fn write_city(
         || {
             let results = make_tiles();
             progress.finish();
-            retired.sweep_beside();
             let (fingerprints, counts, manifest) = settle(results)?;
             let with_lod = lod_beside
                 .then(|| {

@@ -536,9 +536,7 @@ fn init_follows_no_link_and_its_printed_command_builds() {
 }
 
 /// A `--force` rebuild over an earlier build leaves the directory a build into an empty one
-/// makes, byte for byte: the files it replaced (kept under a second name until its own
-/// thread frees them, so that their blocks are not freed on the writers' threads) and the
-/// earlier build's tiles it has no more are all gone.
+/// makes, byte for byte: no temporary, and none of the earlier build's files it has no more.
 #[test]
 fn a_rebuild_over_an_earlier_build_leaves_what_a_fresh_build_does() {
     let dir = tempfile::tempdir().unwrap();
@@ -552,7 +550,7 @@ fn a_rebuild_over_an_earlier_build_leaves_what_a_fresh_build_does() {
     assert!(o.status.success(), "{}", stderr_of(&o));
     assert!(
         all_files(&over).keys().all(|f| !f.contains(".tmp-")),
-        "no second name or temporary left"
+        "no temporary left"
     );
     common::assert_same_tree(&over, &fresh);
 }

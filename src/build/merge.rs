@@ -148,9 +148,6 @@ pub fn merge(dirs: &[PathBuf], draw_plan: bool) -> Result<Report, BuildError> {
         return Err(MergeError::Unfinished(missing.join(", ")).into());
     }
     let _lock = crate::output::lock::OutLock::acquire(target)?;
-    // The levels of detail and tileset.json replace the shards' own (after the lock: dropped
-    // first).
-    let _retired = crate::output::atomic::Retired::new(target);
     let (tiles, files) = gather(&shards)?;
     // Every file is copied under a temporary name and checked against its shard's manifest
     // as it streams by (a file of the target itself is checked in place); only when all are
