@@ -343,7 +343,7 @@ impl Default for Params {
 }
 
 /// The largest parameter file read (the defaults, with every comment, are 20 KB).
-const MAX_PARAMS_BYTES: u64 = 16 << 20;
+pub const MAX_PARAMS_BYTES: u64 = 16 << 20;
 
 /// The text of a parameter file, through `bounded` (a FIFO or device named instead is
 /// refused, never waited on).

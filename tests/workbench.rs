@@ -200,7 +200,12 @@ fn the_hypothesis_is_never_kept_inside_the_input_or_the_build() {
     copy_fixture("kyoto-small", &input);
     let out = dir.path().join("out");
     build_ok(&input, &out, &["--quiet", "--format", "glb"]);
-    for params in [input.join("hyp.toml"), out.join("hyp.toml")] {
+    // A file of the input named as the parameter file is named as such, not read as TOML.
+    for params in [
+        input.join("hyp.toml"),
+        out.join("hyp.toml"),
+        input.join("lots.shp"),
+    ] {
         let o = edo_city()
             .args(["serve", "--port", "0", "--edit"])
             .arg(&params)
@@ -312,6 +317,6 @@ fn a_kept_draw_survives_a_reroll() {
         "/api/edit/lock",
         json!({"section": "roofs", "keep": true}),
     ));
-    assert_eq!(status, 422);
-    assert!(e.contains("`seeds.roofs`"), "{e}");
+    assert_eq!(status, 400);
+    assert!(e.contains("`roofs` draws from no seed of its own"), "{e}");
 }

@@ -104,14 +104,27 @@ export function createWorkbench({ scene, point, render, reload, base }) {
     return list;
   }
 
-  async function post(route, body) {
+  /** The page's token for writes (GET /api/token). */
+  async function pageToken() {
     if (!token) token = (await (await fetch('/api/token')).json()).token;
-    const r = await fetch(`/api/edit/${route}`, {
+    return token;
+  }
+
+  async function post(route, body) {
+    const send = async () => fetch(`/api/edit/${route}`, {
       method: 'POST',
-      headers: { 'content-type': 'application/json', 'x-edo-city-token': token },
+      headers: { 'content-type': 'application/json', 'x-edo-city-token': await pageToken() },
       body: JSON.stringify(body),
     });
-    const answer = await r.json();
+    let r = await send();
+    let answer = await r.json();
+    // A token the server no longer takes (it was started again since this page loaded):
+    // a new one, and the edit sent once more. Nothing was done with the refused request.
+    if (r.status === 403 && /token/.test(answer.error || '')) {
+      token = null;
+      r = await send();
+      answer = await r.json();
+    }
     if (!r.ok) {
       edit.status = { ...edit.status, error: answer.error };
       showStatus();

@@ -16,6 +16,7 @@ use super::product::{ByTile, Landmarks};
 use crate::model::landmark::{
     z_up, Displaced, LandmarkReport, PaletteEntry, PlacedLandmark, SkippedLandmark,
 };
+use crate::model::number::Num;
 use crate::model::{
     Dataset, KuraDecision, LandmarkRecord, Model, PlannedFence, PlannedHouse, PlannedLandmark,
     Skipped,
@@ -185,14 +186,18 @@ fn place<'a>(
             "absurd scale: the model is {:.0} x {:.0} x {:.0} m after scaling by {}, over \
              {MAX_SIZE} m: give the scale that makes it metres (a model in centimetres \
              needs 0.01), or check landmarks.up",
-            size[0], size[1], size[2], r.scale
+            Num(size[0]),
+            Num(size[1]),
+            Num(size[2]),
+            Num(r.scale)
         ));
     }
     if largest < MIN_SIZE {
         return Err(format!(
             "absurd scale: the model is {:.3} m at most after scaling by {}, under {MIN_SIZE} \
              m: give the scale that makes it metres (a model in kilometres needs 1000)",
-            largest, r.scale
+            Num(largest),
+            Num(r.scale)
         ));
     }
     let anchor = match lp.anchor.as_str() {

@@ -79,6 +79,37 @@ impl Confined {
     }
 }
 
+impl Confined {
+    /// Whether `path` lies inside an allowed directory as written and with its links
+    /// resolved, for a path that need not exist yet (a parameter a page sets): the nearest
+    /// part of it that exists is resolved and the rest added. A part that exists but does
+    /// not resolve (a link to nowhere, a loop) is outside.
+    pub fn contains(&self, path: &Path) -> bool {
+        let lexical = normalise(path);
+        if !self.lexical.iter().any(|r| lexical.starts_with(r)) {
+            return false;
+        }
+        let mut at = lexical.as_path();
+        let mut rest = Vec::new();
+        loop {
+            match std::fs::canonicalize(at) {
+                Ok(real) => {
+                    let full = rest.iter().rev().fold(real, |p, c| p.join(c));
+                    return self.canonical.iter().any(|r| full.starts_with(r));
+                }
+                Err(_) if std::fs::symlink_metadata(at).is_ok() => return false,
+                Err(_) => match (at.parent(), at.file_name()) {
+                    (Some(parent), Some(name)) => {
+                        rest.push(name);
+                        at = parent;
+                    }
+                    _ => return false,
+                },
+            }
+        }
+    }
+}
+
 /// `path` made absolute with `.` and `..` taken out as written (no file system access, so
 /// nothing is learnt of paths outside).
 fn normalise(path: &Path) -> PathBuf {
@@ -99,6 +130,27 @@ fn normalise(path: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_path_yet_to_be_made_is_inside_as_written_and_as_resolved() {
+        let top = tempfile::tempdir().unwrap();
+        let inside = top.path().join("in");
+        std::fs::create_dir(&inside).unwrap();
+        let c = Confined::new([inside.as_path()], "the directory");
+        assert!(c.contains(&inside.join("a.csv")));
+        assert!(c.contains(&inside.join("new/deeper/a.csv")));
+        assert!(!c.contains(&inside.join("../a.csv")));
+        assert!(!c.contains(Path::new("/etc/passwd")));
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(top.path(), inside.join("up")).unwrap();
+            assert!(!c.contains(&inside.join("up/a.csv")));
+            std::os::unix::fs::symlink("/nowhere/at/all", inside.join("dangling")).unwrap();
+            assert!(!c.contains(&inside.join("dangling")));
+            std::os::unix::fs::symlink(inside.join("loop"), inside.join("loop")).unwrap();
+            assert!(!c.contains(&inside.join("loop/x")));
+        }
+    }
 
     #[test]
     fn reads_inside_and_refuses_outside_links_devices_and_large_files() {

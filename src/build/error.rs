@@ -93,6 +93,20 @@ pub enum OptionsError {
 
 /// A write that failed, as the error to show: a full disk says what to do.
 pub(super) fn write_err(path: &Path, cause: std::io::Error) -> BuildError {
+    // An error a step met at one file names that file.
+    let at_file = cause
+        .get_ref()
+        .is_some_and(|e| e.is::<crate::output::AtFile>());
+    let (path, cause) = match at_file {
+        true => {
+            let kind = cause.kind();
+            match (cause.into_inner()).and_then(|e| e.downcast::<crate::output::AtFile>().ok()) {
+                Some(at) => (at.path, at.cause),
+                None => (path.to_path_buf(), kind.into()),
+            }
+        }
+        false => (path.to_path_buf(), cause),
+    };
     let full = cause.raw_os_error() == Some(28) || cause.kind() == std::io::ErrorKind::StorageFull;
     let hint = if full {
         ". Every file written is whole (temporaries are removed); free some space or build \

@@ -286,6 +286,15 @@ fn start_workbench(
         .with_context(|| format!("{}: not a manifest", out.join("manifest.json").display()))?;
     let input = find_input(&m, out, params, input)?;
     let templates = m["input"]["templates"].as_str().map(PathBuf::from);
+    // The parameter file first, before it is read: `--edit IN/lots.shp` is a file of the
+    // input, not a parameter file that does not parse.
+    outside_the_build(
+        params,
+        &workbench::absolute(params),
+        "the parameter file",
+        &input,
+        out,
+    )?;
     let files = workbench::Files::of(params)?;
     // The hypothesis's files are written at `save`: never into what the build reads or
     // writes (an overrides file named `lots.csv` in the input would replace the lots' table).
@@ -294,11 +303,32 @@ fn start_workbench(
         (&files.overrides, "its overrides"),
         (&files.history, "its log"),
     ] {
+        outside_the_build(params, path, what, &input, out)?;
+    }
+    let place = workbench::Place {
+        input,
+        out: out.to_path_buf(),
+        templates,
+        threads,
+        served: dirs.to_vec(),
+    };
+    workbench::Workbench::start(files, place)
+}
+
+/// Refuses a file of the hypothesis (`what`, at `path`) inside the input or the build.
+fn outside_the_build(
+    params: &Path,
+    path: &Path,
+    what: &str,
+    input: &Path,
+    out: &Path,
+) -> Result<()> {
+    {
         let real = path
             .parent()
             .and_then(|d| d.canonicalize().ok())
             .map(|d| d.join(path.file_name().unwrap_or_default()));
-        for (dir, name) in [(&input, "the input"), (&out.to_path_buf(), "the build")] {
+        for (dir, name) in [(input, "the input"), (out, "the build")] {
             let inside = match (&real, dir.canonicalize()) {
                 (Some(r), Ok(d)) => r.starts_with(&d),
                 _ => false,
@@ -314,14 +344,7 @@ fn start_workbench(
             }
         }
     }
-    let place = workbench::Place {
-        input,
-        out: out.to_path_buf(),
-        templates,
-        threads,
-        served: dirs.to_vec(),
-    };
-    workbench::Workbench::start(files, place)
+    Ok(())
 }
 
 /// The input directory a build was made from: `given`, else the manifest's own path (a

@@ -254,7 +254,11 @@ fn finish(dir: &Path, params: &Params, file: &str, raws: Vec<Raw>, data: &mut Da
             let rotation = number(&l.rotation_field, 0.0)?;
             let scale = number(&l.scale_field, 1.0)?;
             if scale <= 0.0 {
-                return Err(format!("`{}` = {scale}: a scale is above 0", l.scale_field));
+                return Err(format!(
+                    "`{}` = {}: a scale is above 0",
+                    l.scale_field,
+                    crate::model::number::Num(scale)
+                ));
             }
             let z = match get(&l.z_field) {
                 "" => None,

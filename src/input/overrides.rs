@@ -60,7 +60,7 @@ pub fn parse(text: &str, file: &str) -> Result<Vec<Override>, InputError> {
                 format!("more than {MAX_ROWS} overrides: fold them into the lots' table"),
             ));
         }
-        let cell = |i: usize| record.get(i).unwrap_or("").trim().to_string();
+        let cell = |i: usize| unguard(record.get(i).unwrap_or("").trim()).to_string();
         let o = Override {
             lot: cell(0),
             field: cell(1),
@@ -105,14 +105,44 @@ pub fn use_of(value: &str) -> Result<LotUse, String> {
 }
 
 /// The overrides as a CSV table, header first, one row an edit, as [`parse`] reads it.
+/// A cell a spreadsheet would take for a formula is guarded ([`guard`]).
 pub fn to_csv(rows: &[Override]) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let _ = w.write_record(HEADER);
     for o in rows {
-        let _ = w.write_record([&o.lot, &o.field, &o.value]);
+        let cells = [guard(&o.lot), guard(&o.field), guard(&o.value)];
+        let _ = w.write_record(cells.iter().map(|c| c.as_bytes()));
     }
     let bytes = w.into_inner().unwrap_or_default();
     String::from_utf8(bytes).unwrap_or_default()
+}
+
+/// The first characters that make a spreadsheet read a cell as a formula (CWE-1236).
+const FORMULA: [char; 4] = ['=', '+', '-', '@'];
+
+/// Whether `cell` is a formula's start behind any number of `'`: the cells [`guard`] guards.
+fn guarded(cell: &str) -> bool {
+    cell.trim_start_matches('\'').starts_with(FORMULA)
+}
+
+/// A cell as written to the overrides table: one that a spreadsheet opening the table would
+/// run as a formula (`=`, `+`, `-`, `@` first, as OWASP's CSV injection page lists them) gets
+/// a `'` in front, which spreadsheets show as text; [`unguard`] takes it off again, so
+/// every value comes back as it went in (a value that already begins with `'` and then a
+/// formula's start gets one more, and loses just that one).
+pub fn guard(cell: &str) -> std::borrow::Cow<'_, str> {
+    match guarded(cell) {
+        true => format!("'{cell}").into(),
+        false => cell.into(),
+    }
+}
+
+/// A cell as [`guard`] wrote it, back as it was.
+pub fn unguard(cell: &str) -> &str {
+    match cell.strip_prefix('\'') {
+        Some(rest) if guarded(rest) => rest,
+        _ => cell,
+    }
 }
 
 /// Reads the file `[input] overrides` names, if any (or takes the rows given in memory):
@@ -263,6 +293,38 @@ mod tests {
         assert!(text.starts_with("lot,field,value\n"), "{text}");
         assert_eq!(parse(&text, "o.csv").unwrap(), rows);
         assert!(parse("lot,field,value\n", "o.csv").unwrap().is_empty());
+    }
+
+    #[test]
+    fn no_cell_is_written_as_a_spreadsheet_formula_and_each_reads_back() {
+        let values = [
+            "=1+2",
+            "@SUM(A1)",
+            "-3",
+            "+x",
+            "'=x",
+            "''@y",
+            "'plain",
+            "=a,b \"c\"",
+        ];
+        let rows: Vec<Override> = (values.iter().enumerate())
+            .map(|(i, v)| Override {
+                lot: v.to_string(),
+                field: "district".into(),
+                value: v.to_string(),
+                row: i + 2,
+            })
+            .collect();
+        let text = to_csv(&rows);
+        let mut reader = csv::Reader::from_reader(text.as_bytes());
+        for record in reader.records() {
+            for cell in record.unwrap().iter() {
+                assert!(!cell.starts_with(FORMULA), "{cell} in {text}");
+            }
+        }
+        assert_eq!(parse(&text, "o.csv").unwrap(), rows);
+        assert_eq!(unguard("'plain"), "'plain");
+        assert_eq!(guard("sangai"), "sangai");
     }
 
     #[test]

@@ -11,6 +11,7 @@ mod dataset;
 pub mod dem;
 pub mod design;
 pub mod landmark;
+pub mod number;
 pub mod object;
 pub mod overrides;
 mod plan;

@@ -46,6 +46,29 @@ use crate::generate::mesh::Mesh;
 use crate::materials::TEXTURES;
 use report::ManifestFile;
 
+/// An I/O error at one file of a build's whole-city steps, carried through a `Sink`'s
+/// `io::Result` so that the message names the file, not the output directory (a
+/// `city.city.jsonl` that was a directory read "cannot write OUT": issue 74).
+#[derive(Debug, thiserror::Error)]
+#[error("{cause}")]
+pub struct AtFile {
+    /// The file.
+    pub path: std::path::PathBuf,
+    /// What the operating system said.
+    pub cause: std::io::Error,
+}
+
+/// `cause` as an error at `path` (see [`AtFile`]).
+pub fn at_file(path: &Path, cause: std::io::Error) -> std::io::Error {
+    std::io::Error::new(
+        cause.kind(),
+        AtFile {
+            path: path.to_path_buf(),
+            cause,
+        },
+    )
+}
+
 /// The sha256 of `bytes` in lower-case hex, as the manifest lists every file.
 pub fn sha256_hex(bytes: &[u8]) -> String {
     hex(&Sha256::digest(bytes))

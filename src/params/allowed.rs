@@ -133,6 +133,7 @@ pub fn check_number(key: &str, value: f64) -> Result<(), String> {
     if value.is_finite() && above && value <= high {
         return Ok(());
     }
+    let value = crate::model::number::Num(value);
     Err(match (closed, low) {
         (false, 0.0) => format!("`{key}` must be a positive number up to {high}, got {value}"),
         (true, 0.0) => format!("`{key}` must be from 0 to {high}, got {value}"),

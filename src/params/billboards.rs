@@ -152,7 +152,8 @@ pub fn check_species(
         for (name, w) in mix {
             if !(w.is_finite() && (0.0..=1e9).contains(w)) {
                 return Err(format!(
-                    "`{key}.{usage}.{name}` must be a weight from 0 to 1e9, got {w}"
+                    "`{key}.{usage}.{name}` must be a weight from 0 to 1e9, got {}",
+                    crate::model::number::Num(*w)
                 ));
             }
         }

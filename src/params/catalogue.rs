@@ -11,6 +11,71 @@ use super::DEFAULT_TOML;
 /// `resolve::merge`), so the panel sets them as one value.
 pub const WHOLE: &[&str] = &["type_mix", "values", "constants"];
 
+/// Tables a parameter file may add keys of any name to: `[seeds] trees = 1`, `[district.<id>]`,
+/// `[landmarks.models] pagoda = "pagoda.glb"`, a use in `[halls.uses]`.
+pub const OPEN: &[&str] = &[
+    "seeds",
+    "district",
+    "fence.types",
+    "halls.uses",
+    "ground.materials",
+    "landmarks.models",
+    "trees.species",
+];
+/// The most dotted parts a key may have: `district.<id>.template.<name>.<param>` has five.
+pub const MAX_KEY_PARTS: usize = 6;
+/// The longest key, in bytes.
+pub const MAX_KEY_BYTES: usize = 256;
+
+/// Whether `key` can name a parameter: one of the catalogue's, or one under an [`OPEN`]
+/// table, within [`MAX_KEY_PARTS`] and [`MAX_KEY_BYTES`]. Asked before anything is built from
+/// a key a page sends (a key of 30,000 dotted parts made a document 30,000 tables deep,
+/// which overflowed the server's stack: issue 74); whether its value is right is the build's
+/// to say.
+pub fn knows(key: &str) -> bool {
+    let parts: Vec<&str> = key.split('.').collect();
+    if key.len() > MAX_KEY_BYTES
+        || parts.len() > MAX_KEY_PARTS
+        || parts
+            .iter()
+            .any(|p| p.is_empty() || p.chars().any(char::is_control))
+    {
+        return false;
+    }
+    let open = OPEN.iter().any(|t| {
+        key.strip_prefix(t)
+            .is_some_and(|rest| rest.starts_with('.'))
+    });
+    open || catalogue().iter().any(|p| p.key == key)
+}
+
+/// Where a path-valued parameter's relative path is taken from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathBase {
+    /// The input directory (`layers.*.file`, `layers.*.table`).
+    Input,
+    /// The parameter file's directory (`input.overrides`, `garden.designs`, `extends`).
+    ParamsFile,
+    /// The directory the build is run from (`textures`, `machiya.templates`,
+    /// `landmarks.models_dir`).
+    WorkingDir,
+    /// `landmarks.models_dir` (the input directory when it is "").
+    Models,
+}
+
+/// Where `key`'s value is a path from, when it names a file or a directory.
+pub fn path_base(key: &str) -> Option<PathBase> {
+    match key {
+        "textures" | "machiya.templates" | "landmarks.models_dir" => Some(PathBase::WorkingDir),
+        "input.overrides" | "garden.designs" | "extends" => Some(PathBase::ParamsFile),
+        k if k.starts_with("landmarks.models.") => Some(PathBase::Models),
+        k if k.starts_with("layers.") && (k.ends_with(".file") || k.ends_with(".table")) => {
+            Some(PathBase::Input)
+        }
+        _ => None,
+    }
+}
+
 /// One parameter as the defaults document it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ParamDoc {
@@ -128,6 +193,47 @@ fn json_of(v: &toml_edit::Value) -> serde_json::Value {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn keys_are_known_before_anything_is_built_from_them() {
+        for k in [
+            "seed",
+            "kura.gap",
+            "type_mix",
+            "seeds.trees",
+            "district.a.trees_per_ha",
+        ] {
+            assert!(knows(k), "{k}");
+        }
+        assert!(knows("landmarks.models.pagoda"));
+        for k in [
+            "",
+            "nope",
+            "kura.nope",
+            "kura..gap",
+            "seeds",
+            ".seed",
+            "seed.",
+        ] {
+            assert!(!knows(k), "{k}");
+        }
+        assert!(!knows(&vec!["district"; 30_000].join(".")));
+        assert!(!knows(&format!("district.{}", "x".repeat(300))));
+        assert!(!knows("district.a.b.c.d.e.f"));
+        assert_eq!(path_base("layers.lots.file"), Some(PathBase::Input));
+        assert_eq!(path_base("layers.lots.table"), Some(PathBase::Input));
+        assert_eq!(path_base("machiya.templates"), Some(PathBase::WorkingDir));
+        assert_eq!(path_base("input.overrides"), Some(PathBase::ParamsFile));
+        assert_eq!(path_base("landmarks.models.pagoda"), Some(PathBase::Models));
+        assert_eq!(path_base("layers.lots.encoding"), None);
+        // Every catalogue key that names a file is one of these.
+        for p in catalogue() {
+            let doc = p.doc.to_lowercase();
+            if p.kind == "string" && (p.key.ends_with(".file") || doc.contains("directory of")) {
+                assert!(path_base(&p.key).is_some(), "{}", p.key);
+            }
+        }
+    }
 
     #[test]
     fn every_default_is_listed_with_its_doc() {

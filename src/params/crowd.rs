@@ -84,20 +84,21 @@ impl CrowdParams {
             return Err(format!(
                 "`crowd.duration` must be more than 0 and at most {MAX_DURATION} s, got {} \
                  (it replaced `crowd.steps`: duration = steps x dt)",
-                self.duration
+                crate::model::number::Num(self.duration)
             ));
         }
         if self.dt.is_nan() || self.dt < 0.05 || self.keys() > MAX_KEYS {
             return Err(format!(
                 "`crowd.dt` must be at least 0.05 s and `crowd.duration / crowd.dt` at most \
                  {MAX_KEYS} keys, got dt = {} for a clip of {} s",
-                self.dt, self.duration
+                crate::model::number::Num(self.dt),
+                crate::model::number::Num(self.duration)
             ));
         }
         if !(0.0..=20.0).contains(&self.straight) {
             return Err(format!(
                 "`crowd.straight` must be from 0 to 20, got {}",
-                self.straight
+                crate::model::number::Num(self.straight)
             ));
         }
         Ok(())

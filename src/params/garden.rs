@@ -44,6 +44,7 @@ impl GardenParams {
             ("clearance", self.clearance, 0.0, 100.0),
         ] {
             if !(v.is_finite() && v >= lo && v <= hi) {
+                let v = crate::model::number::Num(v);
                 return Err(format!("`garden.{key}` must be from {lo} to {hi}, got {v}"));
             }
         }

@@ -25,6 +25,7 @@ impl HallParams {
     pub(super) fn validate(&self) -> Result<(), String> {
         let c = self.clearance;
         if !(c.is_finite() && (0.0..=100.0).contains(&c)) {
+            let c = crate::model::number::Num(c);
             return Err(format!("`halls.clearance` must be from 0 to 100, got {c}"));
         }
         for (u, names) in &self.uses {
@@ -61,7 +62,8 @@ impl GroundParams {
         let s = self.texture_size;
         if !(s.is_finite() && (0.1..=1000.0).contains(&s)) {
             return Err(format!(
-                "`ground.texture_size` must be from 0.1 to 1000, got {s}"
+                "`ground.texture_size` must be from 0.1 to 1000, got {}",
+                crate::model::number::Num(s)
             ));
         }
         if !matches!(self.streets.as_str(), "auto" | "centrelines" | "blocks") {

@@ -143,7 +143,8 @@ impl Params {
             ] {
                 if let Some(v) = v.filter(|v| !(v.is_finite() && (0.0..=high).contains(v))) {
                     return Err(format!(
-                        "`district.{id}.{key}` must be from 0 to {high}, got {v}"
+                        "`district.{id}.{key}` must be from 0 to {high}, got {}",
+                        crate::model::number::Num(v)
                     ));
                 }
             }

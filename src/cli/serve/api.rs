@@ -206,7 +206,9 @@ impl Api {
         let body = &call.body[..];
         // A bug must still answer as the API promises: JSON, and nothing written.
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match route {
-            "token" => Ok(json!({ "token": guard.issue() })),
+            "token" => guard
+                .page(&call.headers)
+                .map(|()| json!({ "token": guard.issue() })),
             "gardens" => self.list(query),
             "gardens/open" => parse(body).and_then(|o| self.open(o, &page)),
             "gardens/next" => parse(body).and_then(|s: Step| {

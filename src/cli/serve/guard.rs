@@ -11,36 +11,41 @@
 //!   page token in [`TOKEN_HEADER`]: one `GET /api/token` hands out per page load, which
 //!   another origin cannot read (no CORS headers) and cannot guess (128 random bits).
 //!
+//! A token is 128 random bits and their HMAC-SHA256 under a key drawn when the server starts
+//! (issue 74): the server checks a token by its MAC, so it keeps no list of them, and no
+//! number of tokens asked for by anyone can push an open page's token out (a list of the
+//! last 256 could be flushed by 256 cross-site `<img src>` GETs, which locked the page out).
+//! The token route itself answers only this server's pages and scripts (`Sec-Fetch-Site`,
+//! `Origin`), so another site's GETs are refused before anything is drawn.
+//!
 //! The designer's sessions are named by random ids of the same size and answer only the
 //! page that opened them.
 
-use std::collections::VecDeque;
-use std::sync::Mutex;
-
+use hmac::{Hmac, Mac};
 use http::header::{CONTENT_TYPE, HOST, ORIGIN};
 use http::HeaderMap;
+use sha2::Sha256;
 
 use super::designer::{refuse, Refusal};
 
 /// The header a write carries its page token in.
 pub const TOKEN_HEADER: &str = "x-edo-city-token";
-/// Page tokens held at once; a page older than this many later loads reloads for a new one.
-const MAX_PAGES: usize = 256;
 /// The host names this server answers to (it listens on 127.0.0.1; browsers may say any).
 const LOOPBACK: [&str; 3] = ["127.0.0.1", "localhost", "[::1]"];
 
-/// The checks, and the page tokens handed out.
+/// The checks, and the key the page tokens are signed with.
 pub struct Guard {
     port: u16,
-    pages: Mutex<VecDeque<String>>,
+    key: [u8; 32],
 }
 
 impl Guard {
-    /// The guard of a server on 127.0.0.1:`port`.
+    /// The guard of a server on 127.0.0.1:`port`, with a token key of its own.
     pub fn new(port: u16) -> Guard {
+        use rand::RngExt as _;
         Guard {
             port,
-            pages: Mutex::new(VecDeque::new()),
+            key: rand::rng().random(),
         }
     }
 
@@ -80,20 +85,44 @@ impl Guard {
         name_ok && port_ok
     }
 
-    /// A new page token.
+    /// A new page token: 128 random bits and their MAC, as hex.
     pub fn issue(&self) -> String {
-        let token = random_id();
-        let mut pages = self.pages.lock().unwrap_or_else(|e| e.into_inner());
-        if pages.len() >= MAX_PAGES {
-            pages.pop_front();
-        }
-        pages.push_back(token.clone());
-        token
+        let nonce = random_id();
+        let tag = self.mac(&nonce);
+        format!("{nonce}{tag}")
     }
 
-    /// Checks a write request; the page token it carries.
-    pub fn write(&self, headers: &HeaderMap) -> Result<String, Refusal> {
-        let get = |name: &str| headers.get(name).and_then(|v| v.to_str().ok());
+    /// The MAC of a token's random part, as hex (its first 128 bits).
+    fn mac(&self, nonce: &str) -> String {
+        let mut m = <Hmac<Sha256> as Mac>::new_from_slice(&self.key).expect("any key length");
+        m.update(nonce.as_bytes());
+        let tag = m.finalize().into_bytes();
+        tag[..16].iter().map(|b| format!("{b:02x}")).collect()
+    }
+
+    /// Whether `token` is one this server issued (its MAC checked in constant time).
+    fn issued(&self, token: &str) -> bool {
+        if token.len() != 64 || !token.is_ascii() {
+            return false;
+        }
+        let (nonce, tag) = token.split_at(32);
+        let mut m = <Hmac<Sha256> as Mac>::new_from_slice(&self.key).expect("any key length");
+        m.update(nonce.as_bytes());
+        let Some(tag) = unhex(tag) else {
+            return false;
+        };
+        m.verify_truncated_left(&tag).is_ok()
+    }
+
+    /// Refuses a request for a page token that does not come from this server's own pages
+    /// (or a script, which says nothing of where it comes from): another site cannot read
+    /// the answer, and is not answered at all.
+    pub fn page(&self, headers: &HeaderMap) -> Result<(), Refusal> {
+        self.same_origin(headers, "a page token")
+    }
+
+    /// Refuses a request that says it comes from another origin or site.
+    fn same_origin(&self, headers: &HeaderMap, what: &str) -> Result<(), Refusal> {
         if let Some(origin) = headers.get(ORIGIN) {
             let origin = origin.to_str().unwrap_or("");
             let ours = origin
@@ -103,7 +132,7 @@ impl Guard {
                 return Err(refuse(
                     403,
                     format!(
-                        "a write from the origin `{}` is refused: only pages of \
+                        "{what} from the origin `{}` is refused: only pages of \
                          http://127.0.0.1:{} may change files",
                         excerpt(origin),
                         self.port
@@ -111,14 +140,22 @@ impl Guard {
                 ));
             }
         }
-        if let Some(site) = get("sec-fetch-site") {
+        if let Some(site) = headers.get("sec-fetch-site") {
+            let site = site.to_str().unwrap_or("");
             if site != "same-origin" && site != "none" {
                 return Err(refuse(
                     403,
-                    format!("a write from another site (`{}`) is refused", excerpt(site)),
+                    format!("{what} from another site (`{}`) is refused", excerpt(site)),
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// Checks a write request; the page token it carries.
+    pub fn write(&self, headers: &HeaderMap) -> Result<String, Refusal> {
+        let get = |name: &str| headers.get(name).and_then(|v| v.to_str().ok());
+        self.same_origin(headers, "a write")?;
         let json = headers
             .get(CONTENT_TYPE)
             .and_then(|v| v.to_str().ok())
@@ -131,8 +168,7 @@ impl Guard {
             ));
         }
         let token = get(TOKEN_HEADER).unwrap_or("");
-        let pages = self.pages.lock().unwrap_or_else(|e| e.into_inner());
-        match !token.is_empty() && pages.iter().any(|t| t == token) {
+        match self.issued(token) {
             true => Ok(token.to_string()),
             false => Err(refuse(
                 403,
@@ -151,6 +187,14 @@ pub fn random_id() -> String {
     use rand::RngExt as _;
     let bits: u128 = rand::rng().random();
     format!("{bits:032x}")
+}
+
+/// The bytes of a hex string, if it is one.
+fn unhex(s: &str) -> Option<Vec<u8>> {
+    (0..s.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(s.get(i..i + 2)?, 16).ok())
+        .collect()
 }
 
 /// At most 60 characters of a header, for a message.
@@ -200,7 +244,7 @@ mod tests {
     fn a_write_needs_our_origin_json_and_a_page_token() {
         let g = Guard::new(8080);
         let token = g.issue();
-        assert_eq!(token.len(), 32);
+        assert_eq!(token.len(), 64);
         assert_ne!(token, g.issue(), "each page its own");
         let json = ("content-type", "application/json; charset=utf-8");
         let ok = headers(&[
@@ -241,10 +285,37 @@ mod tests {
         assert_eq!(status(&[(TOKEN_HEADER, &token)]), 415);
         assert_eq!(status(&[json]), 403);
         assert_eq!(status(&[json, (TOKEN_HEADER, "0123")]), 403);
-        // Old pages give way to new ones, within a bound.
-        for _ in 0..MAX_PAGES {
+        // No number of tokens handed out since pushes an open page's out (issue 74).
+        for _ in 0..10_000 {
             g.issue();
         }
-        assert_eq!(status(&[json, (TOKEN_HEADER, &token)]), 403);
+        assert!(g.write(&ok).is_ok());
+        // A token of this shape that the server did not sign, or signed by another server.
+        let forged = format!("{}{}", &token[..32], "0".repeat(32));
+        assert_eq!(status(&[json, (TOKEN_HEADER, &forged)]), 403);
+        let other = Guard::new(8080).issue();
+        assert_eq!(status(&[json, (TOKEN_HEADER, &other)]), 403);
+        assert_eq!(status(&[json, (TOKEN_HEADER, &"zz".repeat(32))]), 403);
+        assert_eq!(
+            status(&[json, (TOKEN_HEADER, "é".repeat(32).as_str())]),
+            403
+        );
+    }
+
+    #[test]
+    fn a_page_token_goes_only_to_this_servers_pages() {
+        let g = Guard::new(8080);
+        // The page's own fetch, and a script's (which says nothing of where it comes from).
+        assert!(g
+            .page(&headers(&[("sec-fetch-site", "same-origin")]))
+            .is_ok());
+        assert!(g.page(&HeaderMap::new()).is_ok());
+        // Another site's `<img src>` or a top-level GET from another site's link.
+        for cross in ["cross-site", "same-site"] {
+            let h = headers(&[("sec-fetch-site", cross)]);
+            assert_eq!(g.page(&h).unwrap_err().status, 403, "{cross}");
+        }
+        let h = headers(&[("origin", "http://evil.example")]);
+        assert_eq!(g.page(&h).unwrap_err().status, 403);
     }
 }

@@ -280,14 +280,11 @@ fn write_model(out: &Path, manifest: &Manifest) -> std::io::Result<ManifestFile>
             sha256: super::hex(&h.finalize()),
         })
     })();
-    match written {
-        Ok(f) => {
-            std::fs::rename(&tmp, &path)?;
-            Ok(f)
-        }
+    match written.and_then(|f| std::fs::rename(&tmp, &path).map(|()| f)) {
+        Ok(f) => Ok(f),
         Err(e) => {
             let _ = std::fs::remove_file(&tmp);
-            Err(e)
+            Err(super::at_file(&path, e))
         }
     }
 }

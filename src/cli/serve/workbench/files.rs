@@ -1,21 +1,27 @@
 //! The workbench's files beside the parameter file `--edit` names: the parameter file
 //! itself, its overrides (`<params>.overrides.csv`, unless the file names another) and its
-//! revision log (`<params>.history.jsonl`: one line a change, `{time, key, old, new}`, and
-//! `lot` for a lot's field). Each is written whole, a temporary renamed over it; nothing
-//! else is written.
+//! revision log (`<params>.history.jsonl`, `log.rs`).
+//!
+//! A save is one transaction (issue 74): the new parameter file and overrides are written to
+//! temporaries beside them, the log's lines appended, then the temporaries renamed over the
+//! files; a failure at any step undoes the steps before it (the log cut back to its length,
+//! an overrides file renamed already written back), so the files hold the whole save or
+//! none of it. Before anything is written, both files are checked against what the
+//! workbench last read or wrote of them (a sha256 of each): another editor's work, a second
+//! server on the same file or a row added by hand, is never overwritten. Nothing else is
+//! written.
 
-use std::collections::BTreeMap;
+use std::fs::{self, OpenOptions};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use edo_city::input::overrides::{self, MAX_OVERRIDES_BYTES};
-use serde_json::{json, Value};
+use edo_city::params::MAX_PARAMS_BYTES;
+use sha2::{Digest, Sha256};
 
 use super::super::designer::{refuse, Refusal};
-use super::{toml as edit, Hypothesis};
-
-/// The largest parameter file or revision log read.
-const MAX_TEXT: u64 = 64 << 20;
+use super::{log, toml as edit, Hypothesis};
 
 /// The parameter file and the files beside it.
 pub struct Files {
@@ -26,6 +32,16 @@ pub struct Files {
     /// Its revision log.
     pub history: PathBuf,
 }
+
+/// What the workbench last read or wrote of its files: a sha256 of each, `None` when absent.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Disk {
+    params: Option<[u8; 32]>,
+    overrides: Option<[u8; 32]>,
+}
+
+/// A file as it is on disk now: its bytes, `None` when absent.
+type Now = Option<Vec<u8>>;
 
 impl Files {
     /// The files of the parameter file `params` (which need not exist yet: it is written at
@@ -42,12 +58,12 @@ impl Files {
             .file_stem()
             .map_or_else(|| "params".into(), |s| s.to_string_lossy().into_owned());
         let text = match params.is_file() {
-            true => read(&params)?,
+            true => read_params(&params)?,
             false => String::new(),
         };
         // A file that already names its overrides keeps them where it says.
         let overrides = match edit::get_key(&text, "input.overrides") {
-            Some(Value::String(f)) if !f.is_empty() => dir.join(f),
+            Some(serde_json::Value::String(f)) if !f.is_empty() => dir.join(f),
             _ => dir.join(format!("{stem}.overrides.csv")),
         };
         Ok(Files {
@@ -69,217 +85,249 @@ impl Files {
         }
     }
 
-    /// The hypothesis on disk.
-    pub fn read(&self) -> anyhow::Result<Hypothesis> {
-        let text = match self.params.is_file() {
-            true => read(&self.params)?,
-            false => String::new(),
+    /// The hypothesis on disk, and what was read of each file.
+    pub fn read(&self) -> anyhow::Result<(Hypothesis, Disk)> {
+        let (params, over) = self.now().map_err(|m| anyhow::anyhow!("{m}"))?;
+        let text = match &params {
+            Some(b) => text_of(&self.params, b.clone())?,
+            None => String::new(),
         };
-        let rows = match self.overrides.is_file() {
-            true => {
-                let t = edo_city::bounded::read_text(&self.overrides, MAX_OVERRIDES_BYTES)
-                    .with_context(|| format!("cannot read {}", self.overrides.display()))?;
+        let rows = match &over {
+            Some(b) => {
+                let t = text_of(&self.overrides, b.clone())?;
                 overrides::parse(&t, &self.overrides.display().to_string())?
             }
-            false => Vec::new(),
+            None => Vec::new(),
         };
-        Ok(Hypothesis { text, rows })
+        let disk = Disk {
+            params: params.as_deref().map(sha),
+            overrides: over.as_deref().map(sha),
+        };
+        Ok((Hypothesis { text, rows }, disk))
     }
 
-    /// Writes `now` over `saved`: the overrides, then the parameter file naming them, then
-    /// the log of what changed; the number of changes logged. Refused when the parameter
-    /// file changed on disk since it was read (another editor's work is never overwritten).
-    pub fn save(&self, saved: &Hypothesis, now: &Hypothesis) -> Result<usize, Refusal> {
-        let on_disk = match self.params.is_file() {
-            true => read(&self.params).map_err(|e| refuse(409, format!("{e:#}")))?,
-            false => String::new(),
+    /// The parameter file's and the overrides' bytes as they are now.
+    fn now(&self) -> Result<(Now, Now), String> {
+        let one = |path: &Path, cap: u64| -> Result<Now, String> {
+            match fs::symlink_metadata(path) {
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+                _ => edo_city::bounded::read(path, cap)
+                    .map(Some)
+                    .map_err(|e| format!("cannot read {}: {e}", path.display())),
+            }
         };
-        if on_disk != saved.text {
-            return Err(refuse(
-                409,
-                format!(
-                    "{} changed on disk since the workbench read it: nothing was saved; \
-                     restart `serve --edit` to edit the new file",
-                    self.params.display()
-                ),
-            ));
+        Ok((
+            one(&self.params, MAX_PARAMS_BYTES)?,
+            one(&self.overrides, MAX_OVERRIDES_BYTES)?,
+        ))
+    }
+
+    /// Removes the temporaries a killed save left beside the files (`.<file>.tmp-<pid>-<n>`
+    /// of a process that is gone); their number.
+    pub fn sweep(&self) -> usize {
+        let mut swept = 0;
+        for file in [&self.params, &self.overrides, &self.history] {
+            let (Some(dir), Some(name)) = (file.parent(), file.file_name()) else {
+                continue;
+            };
+            let prefix = format!(".{}.tmp-", name.to_string_lossy());
+            let Ok(entries) = fs::read_dir(dir) else {
+                continue;
+            };
+            for e in entries.flatten() {
+                let name = e.file_name().to_string_lossy().into_owned();
+                let Some(run) = name.strip_prefix(&prefix) else {
+                    continue;
+                };
+                let pid = run.split('-').next().unwrap_or("");
+                let ours = !pid.is_empty() && run.bytes().all(|b| b.is_ascii_digit() || b == b'-');
+                let alive = Path::new("/proc").join(pid).exists();
+                if ours && !alive && e.file_type().is_ok_and(|t| t.is_file()) {
+                    swept += usize::from(fs::remove_file(e.path()).is_ok());
+                }
+            }
         }
-        let write = |path: &Path, bytes: &[u8]| {
-            edo_city::output::atomic::write_atomic(path, bytes).map_err(|e| {
-                refuse(
-                    500,
+        swept
+    }
+
+    /// Writes `now` over `saved`, all of it or nothing (see the module's doc), when the files
+    /// are still what `disk` says; the number of changes logged and what is on disk after.
+    pub fn save(
+        &self,
+        disk: &Disk,
+        saved: &Hypothesis,
+        now: &Hypothesis,
+    ) -> Result<(usize, Disk), Refusal> {
+        let (params_now, over_now) = self.now().map_err(|m| refuse(500, nothing(m)))?;
+        for (path, was, is) in [
+            (&self.params, disk.params, params_now.as_deref().map(sha)),
+            (
+                &self.overrides,
+                disk.overrides,
+                over_now.as_deref().map(sha),
+            ),
+        ] {
+            if was != is {
+                return Err(refuse(
+                    409,
                     format!(
-                        "cannot write {}: {e}; nothing else was written",
+                        "{} changed on disk since the workbench read it (another editor, or a \
+                         second `serve --edit` on the same file): nothing was saved; restart \
+                         `serve --edit` to edit the file as it is now",
                         path.display()
                     ),
-                )
-            })
+                ));
+            }
+        }
+        let rows_bytes = (now.rows != saved.rows || (!now.rows.is_empty() && over_now.is_none()))
+            .then(|| overrides::to_csv(&now.rows).into_bytes());
+        let text_bytes =
+            (now.text != saved.text || params_now.is_none()).then(|| now.text.clone().into_bytes());
+        let lines = log::changes(saved, now);
+        let mut t = Transaction::default();
+        let result = (|| {
+            if let Some(b) = &rows_bytes {
+                t.stage(&self.overrides, b, over_now.clone())?;
+            }
+            if let Some(b) = &text_bytes {
+                t.stage(&self.params, b, params_now.clone())?;
+            }
+            t.append(&self.history, &lines)?;
+            t.commit()
+        })();
+        if let Err(message) = result {
+            return Err(refuse(500, t.undo(message)));
+        }
+        let after = Disk {
+            params: text_bytes.as_deref().or(params_now.as_deref()).map(sha),
+            overrides: rows_bytes.as_deref().or(over_now.as_deref()).map(sha),
         };
-        if now.rows != saved.rows || (!now.rows.is_empty() && !self.overrides.exists()) {
-            write(&self.overrides, overrides::to_csv(&now.rows).as_bytes())?;
+        Ok((lines.len(), after))
+    }
+}
+
+/// A save's writes so far, to be undone when a later one fails.
+#[derive(Default)]
+struct Transaction {
+    /// Each file: its temporary, and its bytes before (`None`: it did not exist).
+    staged: Vec<(PathBuf, PathBuf, Now)>,
+    /// How many of them are renamed over their file.
+    renamed: usize,
+    /// The log and its length before the lines were appended.
+    log: Option<(PathBuf, u64)>,
+}
+
+impl Transaction {
+    /// Writes `bytes` to a temporary beside `path`, to its disk.
+    fn stage(&mut self, path: &Path, bytes: &[u8], before: Now) -> Result<(), String> {
+        let tmp = edo_city::output::atomic::temporary_for(path);
+        let written = (|| {
+            let mut f = fs::File::create(&tmp)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        })();
+        if let Err(e) = written {
+            let _ = fs::remove_file(&tmp);
+            return Err(format!("cannot write {}: {e}", path.display()));
         }
-        if now.text != saved.text || !self.params.exists() {
-            write(&self.params, now.text.as_bytes())?;
+        self.staged.push((path.to_path_buf(), tmp, before));
+        Ok(())
+    }
+
+    /// Appends `lines` to the log at `path` (a regular file, or none yet).
+    fn append(&mut self, path: &Path, lines: &[serde_json::Value]) -> Result<(), String> {
+        if lines.is_empty() {
+            return Ok(());
         }
-        let lines = changes(saved, now);
-        if !lines.is_empty() {
-            let mut log = match self.history.is_file() {
-                true => read(&self.history).map_err(|e| refuse(500, format!("{e:#}")))?,
-                false => String::new(),
+        let cannot = |e: &dyn std::fmt::Display| format!("cannot write {}: {e}", path.display());
+        let len = match fs::symlink_metadata(path) {
+            Ok(m) if m.is_file() => m.len(),
+            Ok(_) => return Err(cannot(&"not a regular file")),
+            Err(_) => 0,
+        };
+        let text: String = lines.iter().map(|l| format!("{l}\n")).collect();
+        let mut f = OpenOptions::new()
+            .append(true)
+            .create(true)
+            .open(path)
+            .map_err(|e| cannot(&e))?;
+        self.log = Some((path.to_path_buf(), len));
+        f.write_all(text.as_bytes())
+            .and_then(|()| f.sync_all())
+            .map_err(|e| cannot(&e))
+    }
+
+    /// Renames every temporary over its file.
+    fn commit(&mut self) -> Result<(), String> {
+        for (path, tmp, _) in &self.staged[self.renamed..] {
+            fs::rename(tmp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            self.renamed += 1;
+        }
+        Ok(())
+    }
+
+    /// Undoes what was done after `failure`; the message: nothing saved, or what could not
+    /// be set back.
+    fn undo(self, failure: String) -> String {
+        let mut stuck = Vec::new();
+        for (_, tmp, _) in &self.staged[self.renamed..] {
+            let _ = fs::remove_file(tmp);
+        }
+        for (path, _, before) in &self.staged[..self.renamed] {
+            let back = match before {
+                Some(b) => edo_city::output::atomic::write_atomic(path, b),
+                None => fs::remove_file(path),
             };
-            for l in &lines {
-                log += &format!("{l}\n");
-            }
-            write(&self.history, log.as_bytes())?;
-        }
-        Ok(lines.len())
-    }
-}
-
-fn read(path: &Path) -> anyhow::Result<String> {
-    edo_city::bounded::read_text(path, MAX_TEXT)
-        .with_context(|| format!("cannot read {}", path.display()))
-}
-
-/// One log line per key whose value differs between the two texts, and per lot field whose
-/// override differs; `time` is the save's, in UTC.
-fn changes(before: &Hypothesis, after: &Hypothesis) -> Vec<Value> {
-    let time = now_utc();
-    let mut out = Vec::new();
-    let (a, b) = (leaves(&before.text), leaves(&after.text));
-    let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
-    for k in keys {
-        if a.get(k) != b.get(k) {
-            out.push(json!({"time": time, "key": k, "old": a.get(k), "new": b.get(k)}));
-        }
-    }
-    let fields = |h: &Hypothesis| -> BTreeMap<(String, String), String> {
-        (h.rows.iter())
-            .map(|o| ((o.lot.clone(), o.field.clone()), o.value.clone()))
-            .collect()
-    };
-    let (a, b) = (fields(before), fields(after));
-    let keys: std::collections::BTreeSet<&(String, String)> = a.keys().chain(b.keys()).collect();
-    for k in keys {
-        if a.get(k) != b.get(k) {
-            out.push(json!({
-                "time": time, "lot": k.0, "key": k.1, "old": a.get(k), "new": b.get(k)
-            }));
-        }
-    }
-    out
-}
-
-/// Every key a parameter text sets (a table given whole, `type_mix`, as one).
-pub fn leaves(text: &str) -> BTreeMap<String, Value> {
-    let mut out = BTreeMap::new();
-    if let Ok(t) = text.parse::<::toml::Table>() {
-        if let Ok(v) = serde_json::to_value(t) {
-            flatten(&v, "", &mut out);
-        }
-    }
-    out
-}
-
-fn flatten(v: &Value, at: &str, out: &mut BTreeMap<String, Value>) {
-    let name = at.rsplit('.').next().unwrap_or(at);
-    match v {
-        Value::Object(map) if !edo_city::params::catalogue::WHOLE.contains(&name) => {
-            for (k, v) in map {
-                let key = if at.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{at}.{k}")
-                };
-                flatten(v, &key, out);
+            if back.is_err() {
+                stuck.push(path.display().to_string());
             }
         }
-        _ => {
-            out.insert(at.to_string(), v.clone());
+        if let Some((path, len)) = &self.log {
+            let cut = OpenOptions::new()
+                .write(true)
+                .open(path)
+                .and_then(|f| f.set_len(*len));
+            if cut.is_err() {
+                stuck.push(path.display().to_string());
+            }
+        }
+        match stuck.is_empty() {
+            true => nothing(failure),
+            false => format!(
+                "{failure}; {} could not be set back as it was (it holds this save's part): \
+                 check it before saving again",
+                stuck.join(" and ")
+            ),
         }
     }
 }
 
-/// The time now as `YYYY-MM-DDTHH:MM:SSZ`.
-fn now_utc() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs() as i64);
-    utc(secs)
+/// A failure's message, with nothing written.
+fn nothing(failure: String) -> String {
+    format!("{failure}; nothing was saved")
 }
 
-/// Seconds since 1970 as `YYYY-MM-DDTHH:MM:SSZ` (civil from days, Howard Hinnant's
-/// algorithm: std has no calendar, and a date is all the log needs of one).
-fn utc(secs: i64) -> String {
-    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!(
-        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
-        rem / 3600,
-        rem % 3600 / 60,
-        rem % 60
-    )
+fn sha(bytes: &[u8]) -> [u8; 32] {
+    Sha256::digest(bytes).into()
+}
+
+/// The parameter file's text, with the bound `build --params` reads it within.
+fn read_params(path: &Path) -> anyhow::Result<String> {
+    let bytes = edo_city::bounded::read(path, MAX_PARAMS_BYTES)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    text_of(path, bytes)
+}
+
+/// A file's bytes as text, or what it is instead.
+fn text_of(path: &Path, bytes: Vec<u8>) -> anyhow::Result<String> {
+    String::from_utf8(bytes).map_err(|_| {
+        anyhow::anyhow!(
+            "{} is not a text file (not UTF-8): --edit names a parameter file (.toml) of \
+             your own, which the workbench reads and writes",
+            path.display()
+        )
+    })
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_save_logs_each_change_and_keeps_the_persons_text() {
-        let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("hyp.toml");
-        std::fs::write(&p, "# mine\nseed = 2\n").unwrap();
-        let files = Files::of(&p).unwrap();
-        assert_eq!(files.overrides, dir.path().join("hyp.overrides.csv"));
-        let saved = files.read().unwrap();
-        let mut now = saved.clone();
-        now.text = edit::set_key(&now.text, "kura.gap", &json!(2.5)).unwrap();
-        now.rows.push(overrides::Override {
-            lot: "7".into(),
-            field: "mtype".into(),
-            value: "sangai".into(),
-            row: 2,
-        });
-        assert_eq!(files.save(&saved, &now).unwrap(), 2);
-        assert_eq!(
-            std::fs::read_to_string(&p).unwrap(),
-            "# mine\nseed = 2\n\n[kura]\ngap = 2.5\n"
-        );
-        assert_eq!(files.read().unwrap().rows, now.rows);
-        let log = std::fs::read_to_string(&files.history).unwrap();
-        let lines: Vec<Value> = log
-            .lines()
-            .map(|l| serde_json::from_str(l).unwrap())
-            .collect();
-        assert_eq!(lines[0]["key"], "kura.gap");
-        assert_eq!(
-            (lines[0]["old"].clone(), lines[0]["new"].clone()),
-            (Value::Null, json!(2.5))
-        );
-        assert_eq!(
-            (lines[1]["lot"].as_str(), lines[1]["new"].as_str()),
-            (Some("7"), Some("sangai"))
-        );
-        assert_eq!(lines[1]["time"].as_str().unwrap().len(), 20);
-        // Another editor's change on disk is never overwritten.
-        std::fs::write(&p, "seed = 9\n").unwrap();
-        assert_eq!(files.save(&now, &saved).unwrap_err().status, 409);
-        assert_eq!(std::fs::read_to_string(&p).unwrap(), "seed = 9\n");
-    }
-
-    #[test]
-    fn seconds_read_as_dates() {
-        assert_eq!(utc(0), "1970-01-01T00:00:00Z");
-        assert_eq!(utc(951_782_400), "2000-02-29T00:00:00Z");
-        assert_eq!(utc(1_796_083_199), "2026-11-30T23:59:59Z");
-    }
-}
+mod tests;

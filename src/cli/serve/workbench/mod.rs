@@ -3,35 +3,51 @@
 //! out the same (`build::reuse`), undone and redone, and saved as the person's own
 //! parameter file, its overrides table and a revision log beside it.
 //!
-//! The edits live in memory until `save`: the files on disk change only then, each written
-//! whole (a temporary renamed over it), so a crash loses nothing saved. One build runs at a
-//! time, on a thread of its own, always of the newest edit: edits that arrive while it runs
-//! are built together next (a bounded queue of one). A build that fails (a lot the input
-//! does not have, a value the build refuses) takes the hypothesis back to the last one
-//! built, and every edit waiting on it gets the build's own message.
+//! It never loses a person's work (issue 74):
+//! - the edits live in memory until `save`, which writes the files as one transaction
+//!   (`files.rs`), only a hypothesis that built (it waits for the builds asked for), and
+//!   only over files that are still what the workbench last read or wrote;
+//! - one build runs at a time, on a thread of its own (`builds.rs`), always of the newest
+//!   edit: edits that arrive while it runs are built together next. A build that fails
+//!   takes the hypothesis back to the last one built, or, before any was, to the file as
+//!   the person wrote it; every edit waiting on it, and every edit made on top of it, gets
+//!   the build's own message;
+//! - a key is looked up in the catalogue before anything is built from it; the files the
+//!   workbench owns are no parameters a page may set, and a path a page sets lies inside the
+//!   input or beside the parameter file (`keys.rs`);
+//! - the undo steps are bounded by their bytes as well as their count (`steps.rs`);
+//! - a build of OUT by another run is noticed by the manifest's fingerprint, and the next
+//!   rebuild then trusts nothing it kept of OUT.
 
+mod builds;
 mod files;
+mod keys;
+mod log;
 pub mod routes;
+mod steps;
 mod toml;
 
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Condvar, Mutex};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use edo_city::build::reuse::Fingerprints;
-use edo_city::build::{BuildOptions, NoProgress, Selection, Timings};
-use edo_city::input::overrides::{self, Override};
-use edo_city::output::gpkg::{lot_differences, plan_lots, LotDiff, PlanLots};
-use edo_city::params::Params;
+use edo_city::input::overrides::{self, Override, MAX_OVERRIDES_BYTES, MAX_ROWS};
+use edo_city::output::gpkg::{plan_lots, LotDiff, PlanLots};
+use edo_city::params::{Params, MAX_PARAMS_BYTES};
 
 use super::designer::{refuse, Refusal};
+use files::Disk;
 pub use files::Files;
+use steps::Steps;
 
-/// Undo steps kept.
-const MAX_UNDO: usize = 200;
-/// How long an edit's request waits for its build before answering that it is still
-/// building (the page then follows `status`).
-const WAIT: Duration = Duration::from_secs(120);
+/// How long a request waits for its build before answering that it is still building (the
+/// page then follows `status`): well inside the server's 60 s limit on an answer that moves
+/// no byte (`http::Limits::stall`), which closed a request waiting two minutes unanswered.
+const WAIT: Duration = Duration::from_secs(45);
+/// Failures remembered for the edits still waiting on them.
+const MAX_FAILURES: usize = 64;
 
 /// A hypothesis as edited: the parameter file's text and the overrides' rows.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -62,18 +78,21 @@ pub struct Workbench {
 /// What every page sees.
 struct State {
     now: Hypothesis,
-    /// The hypothesis OUT holds (the last one built).
-    good: Hypothesis,
-    /// The hypothesis on disk.
+    /// The hypothesis OUT holds (the last one built); `None` until a build succeeded.
+    good: Option<Hypothesis>,
+    /// The hypothesis on disk, and what was last read or written of each file.
     saved: Hypothesis,
-    undo: Vec<Hypothesis>,
-    redo: Vec<Hypothesis>,
+    disk: Disk,
+    undo: Steps,
+    redo: Steps,
     /// The newest edit's revision; the one OUT shows; the last one a build was tried for.
     requested: u64,
     built: u64,
     tried: u64,
-    /// The last build's failure: the revision it was for and the build's message.
-    failed: Option<(u64, String)>,
+    /// The last build's failure, while no build has succeeded since.
+    failed: Option<Failure>,
+    /// The latest failures, newest last, for the requests still waiting on them.
+    failures: VecDeque<Failure>,
     busy: bool,
     changed_tiles: Vec<String>,
     /// The lots whose type, kura, house or trees the last build changed (as `compare
@@ -83,6 +102,36 @@ struct State {
     lots: Arc<PlanLots>,
     last_ms: u64,
     fingerprints: Arc<Fingerprints>,
+    /// The sha256 of OUT's manifest as the workbench's last build left it.
+    manifest: Option<[u8; 32]>,
+    /// What the pages should know that is no error (OUT built by another run meanwhile).
+    notice: Option<String>,
+}
+
+/// A build that failed: the revisions after `after` up to `upto` did not build.
+#[derive(Debug, Clone)]
+struct Failure {
+    /// The revision built when it failed.
+    after: u64,
+    /// The revision the build was for.
+    rev: u64,
+    /// The newest revision asked for when it failed: the edits made on top of it.
+    upto: u64,
+    message: String,
+}
+
+impl Failure {
+    /// The answer to the edit of revision `rev`, one of those it took back.
+    fn message_for(&self, rev: u64) -> String {
+        match rev > self.rev {
+            false => self.message.clone(),
+            true => format!(
+                "{} (this edit was made on top of revision {}, which did not build: both were \
+                 taken back; make it again)",
+                self.message, self.rev
+            ),
+        }
+    }
 }
 
 /// The outcome of an edit, once built.
@@ -98,7 +147,13 @@ impl Workbench {
     /// The workbench of `files` building into `place`, starting from what is on disk; its
     /// first build (every tile, to know what each was made from) is started at once.
     pub fn start(files: Files, place: Place) -> anyhow::Result<Arc<Workbench>> {
-        let saved = files.read()?;
+        let swept = files.sweep();
+        if swept > 0 {
+            eprintln!(
+                "removed {swept} temporary file(s) a killed save left beside the parameter file"
+            );
+        }
+        let (saved, disk) = files.read()?;
         // The hypothesis must read as a build would read it, before anything is served.
         resolve(&files, &saved).map_err(|m| anyhow::anyhow!("{m}"))?;
         let lots = Arc::new(plan_lots(&place.out).unwrap_or_default());
@@ -107,20 +162,24 @@ impl Workbench {
             place,
             state: Mutex::new(State {
                 now: saved.clone(),
-                good: Hypothesis::default(),
+                good: None,
                 saved,
-                undo: Vec::new(),
-                redo: Vec::new(),
+                disk,
+                undo: Steps::default(),
+                redo: Steps::default(),
                 requested: 1,
                 built: 0,
                 tried: 0,
                 failed: None,
+                failures: VecDeque::new(),
                 busy: false,
                 changed_tiles: Vec::new(),
                 changed_lots: Vec::new(),
                 lots,
                 last_ms: 0,
                 fingerprints: Arc::new(Fingerprints::default()),
+                manifest: None,
+                notice: None,
             }),
             bell: Condvar::new(),
         });
@@ -131,129 +190,8 @@ impl Workbench {
         Ok(wb)
     }
 
-    fn lock(&self) -> std::sync::MutexGuard<'_, State> {
+    fn lock(&self) -> MutexGuard<'_, State> {
         self.state.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
-    /// The builder's loop: the newest edit not tried yet, built; forever.
-    fn builds(&self) {
-        loop {
-            let (rev, hyp, before, lots) = {
-                let mut s = self.lock();
-                while s.tried == s.requested {
-                    s = self.bell.wait(s).unwrap_or_else(|e| e.into_inner());
-                }
-                s.busy = true;
-                let lots = s.lots.clone();
-                (s.requested, s.now.clone(), s.fingerprints.clone(), lots)
-            };
-            let t = Instant::now();
-            let result = self.build(&hyp, before);
-            // What changed, lot by lot, off the lock: the pages' polls go on meanwhile.
-            let t_lots = Instant::now();
-            let new_lots = result
-                .as_ref()
-                .ok()
-                .map(|_| plan_lots(&self.place.out).unwrap_or_default());
-            let changed_lots = match &new_lots {
-                Some(new) => self.outlines(lot_differences(&lots, new)),
-                None => Vec::new(),
-            };
-            if let Ok((_, made, timings)) = &result {
-                log_rebuild(rev, made.len(), t.elapsed(), timings, t_lots.elapsed());
-            }
-            let result = result.map(|(marks, made, _)| (marks, made));
-            let mut s = self.lock();
-            s.busy = false;
-            s.tried = rev;
-            match result {
-                Ok((marks, made)) => {
-                    s.built = rev;
-                    s.good = hyp;
-                    s.changed_tiles = made;
-                    s.changed_lots = changed_lots;
-                    s.lots = Arc::new(new_lots.unwrap_or_default());
-                    s.last_ms = t.elapsed().as_millis() as u64;
-                    s.fingerprints = Arc::new(marks);
-                    s.failed = None;
-                }
-                Err(message) => {
-                    s.failed = Some((rev, message));
-                    // Back to what OUT holds, with the undo steps it had; edits made since
-                    // the failed one was asked for go too (they were built on it).
-                    let good = s.good.clone();
-                    while let Some(top) = s.undo.pop() {
-                        if top == good {
-                            break;
-                        }
-                    }
-                    s.now = good;
-                    s.tried = s.requested;
-                }
-            }
-            self.bell.notify_all();
-        }
-    }
-
-    /// One build of `hyp` into OUT, keeping the tiles `before` says would come out the same.
-    fn build(
-        &self,
-        hyp: &Hypothesis,
-        before: Arc<Fingerprints>,
-    ) -> Result<(Fingerprints, Vec<String>, Timings), String> {
-        let params = resolve(&self.files, hyp)?;
-        let opts = BuildOptions {
-            input: self.place.input.clone(),
-            out: self.place.out.clone(),
-            params,
-            templates: self.place.templates.clone(),
-            threads: self.place.threads,
-            plan_image: true,
-            selection: Selection::All,
-            force: false,
-            cache: None,
-            reuse: Some(before),
-        };
-        let outcome = edo_city::build::build(&opts, &NoProgress).map_err(|e| e.to_string())?;
-        let (marks, made) =
-            (outcome.fingerprints).ok_or_else(|| "the build kept no fingerprints".to_string())?;
-        Ok((marks, made, outcome.timings))
-    }
-
-    /// The lots' rings moved to metres from the build's origin (the viewer's frame).
-    fn outlines(&self, mut lots: Vec<LotDiff>) -> Vec<LotDiff> {
-        let origin = edo_city::bounded::read(&self.place.out.join("manifest.json"), 2 << 30)
-            .ok()
-            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
-            .map_or([0.0, 0.0], |m| {
-                [
-                    m["origin"][0].as_f64().unwrap_or(0.0),
-                    m["origin"][1].as_f64().unwrap_or(0.0),
-                ]
-            });
-        for l in &mut lots {
-            for p in &mut l.ring {
-                *p = [p[0] - origin[0], p[1] - origin[1]];
-            }
-        }
-        lots
-    }
-
-    /// The lots where served build `h` and the hypothesis as built disagree (type, kura,
-    /// house, trees), as `compare --gpkg` finds them; rings in the viewer's frame.
-    pub fn compare(&self, h: usize) -> Result<Vec<LotDiff>, Refusal> {
-        let dir = self.place.served.get(h).ok_or_else(|| {
-            refuse(
-                404,
-                format!(
-                    "no build {h}: serve has {} build(s)",
-                    self.place.served.len()
-                ),
-            )
-        })?;
-        let other = plan_lots(dir).map_err(|e| refuse(422, e.to_string()))?;
-        let now = self.lock().lots.clone();
-        Ok(self.outlines(lot_differences(&other, &now)))
     }
 
     /// Applies an edit made by `change` from the hypothesis as it stands (checked as the
@@ -275,12 +213,10 @@ impl Workbench {
                     pending: false,
                 });
             }
+            within_bounds(&next)?;
             resolve(&self.files, &next).map_err(|m| refuse(422, m))?;
             let now = std::mem::replace(&mut s.now, next);
             s.undo.push(now);
-            if s.undo.len() > MAX_UNDO {
-                s.undo.remove(0);
-            }
             s.redo.clear();
             s.requested += 1;
             s.requested
@@ -294,10 +230,13 @@ impl Workbench {
         let deadline = Instant::now() + WAIT;
         let mut s = self.lock();
         loop {
-            if let Some((failed, message)) = &s.failed {
-                if *failed >= rev {
-                    return Err(refuse(422, message.clone()));
-                }
+            let failed = s
+                .failures
+                .iter()
+                .rev()
+                .find(|f| f.after < rev && rev <= f.upto);
+            if let Some(f) = failed {
+                return Err(refuse(422, f.message_for(rev)));
             }
             if s.built >= rev {
                 return Ok(Done {
@@ -316,11 +255,35 @@ impl Workbench {
                     pending: true,
                 });
             }
-            s = self
-                .bell
-                .wait_timeout(s, left)
-                .map_or_else(|e| e.into_inner().0, |r| r.0);
+            s = self.sleep(s, left);
         }
+    }
+
+    /// Waits for the bell, at most `left`.
+    fn sleep<'a>(&self, s: MutexGuard<'a, State>, left: Duration) -> MutexGuard<'a, State> {
+        self.bell
+            .wait_timeout(s, left)
+            .map_or_else(|e| e.into_inner().0, |r| r.0)
+    }
+
+    /// Waits until every build asked for has ended (or [`WAIT`] has passed: 503).
+    fn idle<'a>(&self, mut s: MutexGuard<'a, State>) -> Result<MutexGuard<'a, State>, Refusal> {
+        let deadline = Instant::now() + WAIT;
+        while s.busy || s.tried < s.requested {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return Err(refuse(
+                    503,
+                    format!(
+                        "revision {} is still building: nothing was saved; save again once it \
+                         is built (the status shows it)",
+                        s.requested
+                    ),
+                ));
+            }
+            s = self.sleep(s, left);
+        }
+        Ok(s)
     }
 
     /// Sets parameter `key` to `value` (null: back to the default).
@@ -330,6 +293,7 @@ impl Workbench {
         key: &str,
         value: &serde_json::Value,
     ) -> Result<Done, Refusal> {
+        keys::check(self, key, value)?;
         self.edit(base, |h| {
             let text = toml::set_key(&h.text, key, value).map_err(|m| refuse(400, m))?;
             Ok(Hypothesis {
@@ -354,7 +318,8 @@ impl Workbench {
             value: value.trim().into(),
             row: 0,
         };
-        overrides::check(&one).map_err(|m| refuse(422, format!("lot `{lot}`: {m}")))?;
+        overrides::check(&one)
+            .map_err(|m| refuse(422, format!("lot `{}`: {m}", keys::excerpt(lot))))?;
         let name = self.files.overrides_name();
         self.edit(base, |h| {
             let mut next = h.clone();
@@ -404,18 +369,29 @@ impl Workbench {
         self.wait(rev)
     }
 
-    /// A new draw of everything random: `seed` one more.
+    /// A new draw of everything random: the next `seed` (after the largest seed a parameter
+    /// file can hold, TOML's largest integer, comes 0).
     pub fn reroll(&self, base: Option<u64>) -> Result<Done, Refusal> {
         let seed = {
             let s = self.lock();
             resolve(&self.files, &s.now).map_or(1, |p| p.seed)
         };
-        self.set(base, "seed", &serde_json::json!(seed.wrapping_add(1)))
+        self.set(base, "seed", &serde_json::json!(next_seed(seed)))
     }
 
     /// Keeps `section`'s draw (its own seed, `[seeds]`, set to the one it draws from now) or
     /// lets it follow `seed` again.
     pub fn keep_draw(&self, base: Option<u64>, section: &str, keep: bool) -> Result<Done, Refusal> {
+        if !edo_city::params::SEED_SECTIONS.contains(&section) {
+            return Err(refuse(
+                400,
+                format!(
+                    "`{}` draws from no seed of its own: give one of {}",
+                    keys::excerpt(section),
+                    edo_city::params::SEED_SECTIONS.join(", ")
+                ),
+            ));
+        }
         let key = format!("seeds.{section}");
         let value = match keep {
             true => {
@@ -428,12 +404,29 @@ impl Workbench {
         self.set(base, &key, &value)
     }
 
-    /// Writes the hypothesis as it stands: the parameter file, its overrides, the log.
+    /// Writes the hypothesis as it built: the parameter file, its overrides, the log, as one
+    /// transaction. The builds asked for end first (a save during a failing edit writes what
+    /// the build took back to, never what it refused); a build of OUT by another run since
+    /// is made again first, so that OUT holds what is saved.
     pub fn save(&self) -> Result<serde_json::Value, Refusal> {
-        let mut s = self.lock();
-        let now = s.now.clone();
-        let lines = self.files.save(&s.saved, &now)?;
-        s.saved = now;
+        let mut s = self.idle(self.lock())?;
+        if s.good.is_some() && self.out_changed(&s) {
+            s.requested += 1;
+            self.bell.notify_all();
+            s = self.idle(s)?;
+        }
+        let target = s.good.clone().unwrap_or_else(|| s.saved.clone());
+        if target != s.now {
+            return Err(refuse(
+                409,
+                "the hypothesis did not build as it stands: nothing was saved; see the error, \
+                 undo or make the edit again"
+                    .into(),
+            ));
+        }
+        let (lines, disk) = self.files.save(&s.disk, &s.saved, &target)?;
+        s.disk = disk;
+        s.saved = target;
         Ok(serde_json::json!({ "saved": true, "changes": lines }))
     }
 
@@ -447,7 +440,8 @@ impl Workbench {
             "changedTiles": s.changed_tiles,
             "changedLots": s.changed_lots,
             "lastMs": s.last_ms,
-            "error": s.failed.as_ref().map(|f| f.1.clone()),
+            "error": s.failed.as_ref().map(|f| f.message.clone()),
+            "notice": s.notice,
             "saved": s.saved == s.now,
             "undo": s.undo.len(),
             "redo": s.redo.len(),
@@ -463,6 +457,11 @@ impl Workbench {
     /// The files, for messages.
     pub fn files(&self) -> &Files {
         &self.files
+    }
+
+    /// The input directory the builds read.
+    pub fn input(&self) -> &Path {
+        &self.place.input
     }
 
     /// The builds' template directory, when they have one of their own.
@@ -486,6 +485,47 @@ fn stale(s: &State, base: Option<u64>) -> Result<(), Refusal> {
     }
 }
 
+/// Refuses a hypothesis that `build --params` would not read once saved: a parameter file
+/// over the build's bound, or more overrides than a build reads.
+fn within_bounds(h: &Hypothesis) -> Result<(), Refusal> {
+    if h.text.len() as u64 > MAX_PARAMS_BYTES {
+        return Err(refuse(
+            413,
+            format!(
+                "the parameter file would be {} bytes, more than the {MAX_PARAMS_BYTES} a build \
+                 reads",
+                h.text.len()
+            ),
+        ));
+    }
+    // Each row's CSV is at most its text twice (every quote doubled) and its separators.
+    let most: usize = (h.rows.iter())
+        .map(|o| 2 * (o.lot.len() + o.field.len() + o.value.len()) + 9)
+        .sum();
+    let over = h.rows.len() > MAX_ROWS
+        || (most as u64 > MAX_OVERRIDES_BYTES
+            && overrides::to_csv(&h.rows).len() as u64 > MAX_OVERRIDES_BYTES);
+    match over {
+        true => Err(refuse(
+            413,
+            format!(
+                "the overrides would be more than a build reads ({MAX_ROWS} rows, \
+                 {MAX_OVERRIDES_BYTES} bytes): fold them into the lots' table"
+            ),
+        )),
+        false => Ok(()),
+    }
+}
+
+/// The seed after `seed`: the largest a TOML integer holds is followed by 0 (a seed past it
+/// would be written as a float, which no build reads).
+fn next_seed(seed: u64) -> u64 {
+    match seed >= i64::MAX as u64 {
+        true => 0,
+        false => seed + 1,
+    }
+}
+
 /// The parameters of `hyp` as `build --params` reads them once saved, the overrides given
 /// in memory.
 fn resolve(files: &Files, hyp: &Hypothesis) -> Result<Params, String> {
@@ -501,22 +541,48 @@ pub fn absolute(path: &Path) -> PathBuf {
     edo_city::build::absolute(path)
 }
 
-/// One line on the server's stderr per rebuild: what was made, in how long, stage by stage
-/// (as `build --timings` names them), the plan files drawn beside the tiles, and the lots
-/// compared after it.
-fn log_rebuild(rev: u64, tiles: usize, took: Duration, timings: &Timings, compared: Duration) {
-    let mut line = format!(
-        "revision {rev}: {tiles} tile(s) made in {:.2} s (",
-        took.as_secs_f64()
-    );
-    for st in &timings.stages {
-        line += &format!("{} {:.2} s, ", st.name, st.wall.as_secs_f64());
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_seed_after_the_largest_is_one_toml_holds() {
+        assert_eq!(next_seed(1), 2);
+        assert_eq!(next_seed(i64::MAX as u64 - 1), i64::MAX as u64);
+        assert_eq!(next_seed(i64::MAX as u64), 0);
+        assert_eq!(next_seed(u64::MAX), 0);
     }
-    line += &format!(
-        "of which plan.png {:.2} s and plan.gpkg {:.2} s, ",
-        timings.plan.as_secs_f64(),
-        (timings.gpkg[0] + timings.gpkg[1]).as_secs_f64()
-    );
-    line += &format!("lots compared {:.2} s)", compared.as_secs_f64());
-    eprintln!("{line}");
+
+    #[test]
+    fn an_edit_taken_back_with_the_one_below_it_says_so() {
+        let f = Failure {
+            after: 1,
+            rev: 2,
+            upto: 3,
+            message: "no lot has the id `x`".into(),
+        };
+        assert_eq!(f.message_for(2), "no lot has the id `x`");
+        assert!(f.message_for(3).contains("made on top of revision 2"));
+    }
+
+    #[test]
+    fn a_hypothesis_past_what_a_build_reads_is_refused() {
+        let mut h = Hypothesis {
+            text: "x".repeat(MAX_PARAMS_BYTES as usize + 1),
+            rows: Vec::new(),
+        };
+        assert_eq!(within_bounds(&h).unwrap_err().status, 413);
+        h.text = "seed = 1\n".into();
+        assert!(within_bounds(&h).is_ok());
+        h.rows = vec![
+            Override {
+                lot: "1".into(),
+                field: "mtype".into(),
+                value: "x".repeat(1000),
+                row: 2,
+            };
+            70_000
+        ];
+        assert_eq!(within_bounds(&h).unwrap_err().status, 413);
+    }
 }

@@ -147,7 +147,7 @@ fn params(bench: Option<&Workbench>) -> Value {
     };
     let values = serde_json::to_value(current.unwrap_or_else(Params::default)).unwrap_or_default();
     // The keys the person's file sets, read once (a table's key is set when any of its own is).
-    let set = super::files::leaves(&text);
+    let set = super::log::leaves(&text);
     let sets = |key: &str| {
         set.keys()
             .any(|k| k == key || k.strip_prefix(key).is_some_and(|r| r.starts_with('.')))
