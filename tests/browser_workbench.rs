@@ -64,6 +64,12 @@ fn a_visitor_changes_a_lot_and_a_parameter_undoes_them_and_saves_a_hypothesis() 
 
     let s = workbench_mjs(&url, &["save", "5", "hiraya"]);
     assert_eq!(s["errors"], serde_json::json!([]), "{s}");
+    // Another site's 300 token requests beside the page locked it out of nothing.
+    assert_eq!(s["flood"], 300, "{s}");
+    assert!(
+        !s["gap"]["changedTiles"].as_array().unwrap().is_empty(),
+        "{s}"
+    );
     assert_eq!(s["saved"]["saved"], true, "{s}");
     assert_eq!(s["status"]["saved"], true, "{s}");
 

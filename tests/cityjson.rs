@@ -409,3 +409,26 @@ fn real_towns_are_valid_city_models() {
         );
     }
 }
+
+#[test]
+fn a_model_that_cannot_be_written_is_named_not_the_output_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o_dir");
+    std::fs::create_dir_all(out.join("city.city.jsonl")).unwrap();
+    let o = common::build_cmd(
+        &fixture("kyoto-small"),
+        &out,
+        &["--quiet", "--format", "cityjson"],
+    )
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_ne!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains(&format!(
+            "cannot write {}",
+            out.join("city.city.jsonl").display()
+        )),
+        "{err}"
+    );
+}

@@ -228,6 +228,8 @@ fn every_unusable_landmark_is_skipped_with_its_record_and_why() {
         format!("nofaces,lines.obj,,{x},{y},0,1,"),
         format!("huge,ok.obj,,{x},{y},0,100,"),
         format!("tiny,ok.obj,,{x},{y},0,0.001,"),
+        format!("tiniest,ok.obj,,{x},{y},0,1e-300,"),
+        format!("hugest,ok.obj,,{x},{y},0,1e300,"),
         format!("far,far.obj,,{x},{y},0,1,"),
         format!("nokind,,castle,{x},{y},0,1,"),
         format!("badscale,ok.obj,,{x},{y},0,-2,"),
@@ -276,6 +278,15 @@ fn every_unusable_landmark_is_skipped_with_its_record_and_why() {
         "{}",
         why("tiny")
     );
+    // Every number in a reason is bounded in length (1e-300 once made 447 characters).
+    for id in ["tiniest", "hugest"] {
+        assert!(
+            why(id).contains("absurd scale") && why(id).len() < 250,
+            "{}",
+            why(id)
+        );
+    }
+    assert!(why("tiniest").contains("1e-300"), "{}", why("tiniest"));
     assert!(why("far").contains("from its point"), "{}", why("far"));
     assert!(
         why("nokind").contains("kind `castle` has no model"),
@@ -284,7 +295,7 @@ fn every_unusable_landmark_is_skipped_with_its_record_and_why() {
     );
     assert!(why("badscale").contains("above 0"), "{}", why("badscale"));
     assert!(why("badrot").contains("not a number"), "{}", why("badrot"));
-    assert_eq!(skipped.len(), 10, "{skipped:?}");
+    assert_eq!(skipped.len(), 12, "{skipped:?}");
     assert_eq!(l["placed"].as_array().unwrap().len(), 1);
     assert_eq!(l["placed"][0]["id"], "good");
     let lm = report["accounting"]
@@ -300,7 +311,7 @@ fn every_unusable_landmark_is_skipped_with_its_record_and_why() {
             lm["skipped"].as_u64(),
             lm["unaccounted"].as_u64()
         ),
-        (Some(11), Some(1), Some(10), Some(0))
+        (Some(13), Some(1), Some(12), Some(0))
     );
 }
 

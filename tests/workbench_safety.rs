@@ -419,3 +419,37 @@ fn serve_reads_a_parameter_file_within_the_bound_build_reads_it() {
     .unwrap();
     assert_eq!(b.status.code(), Some(2));
 }
+
+#[test]
+fn a_save_that_fails_writes_nothing_and_the_next_save_goes_through() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, params) = town(dir.path(), "# mine\nseed = 1\n");
+    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    idle(port);
+    let token = token(port);
+    post(
+        port,
+        &token,
+        "/api/edit/lot",
+        json!({"lot": "9", "field": "mtype", "value": "sangai"}),
+    );
+    // The log's name taken by a directory: the last write of the save fails.
+    let log = dir.path().join("hyp.history.jsonl");
+    std::fs::create_dir(&log).unwrap();
+    let (status, e) = error(post(port, &token, "/api/edit/save", json!({})));
+    assert_eq!(status, 500, "{e}");
+    assert!(e.ends_with("nothing was saved"), "{e}");
+    assert_eq!(
+        std::fs::read_to_string(&params).unwrap(),
+        "# mine\nseed = 1\n"
+    );
+    assert!(!dir.path().join("hyp.overrides.csv").exists());
+    // Once the cause is gone: saved, not 409 about the workbench's own earlier try.
+    std::fs::remove_dir(&log).unwrap();
+    let (status, saved) = post(port, &token, "/api/edit/save", json!({}));
+    assert_eq!(status, 200, "{saved}");
+    assert!(std::fs::read_to_string(&params)
+        .unwrap()
+        .starts_with("# mine\nseed = 1\n"));
+    assert_eq!(std::fs::read_to_string(&log).unwrap().lines().count(), 2);
+}

@@ -32,18 +32,27 @@ export async function openPage(viewport = { width: 1280, height: 720 }) {
 /** What the page `html` finds when a browser opens it on another origin (a server of its
  * own on 127.0.0.2): its script leaves a Promise in `window.attacked`, which is returned. */
 export async function fromElsewhere(html) {
+  const browser = await launchChromium();
+  try {
+    return await inTabElsewhere(browser, html);
+  } finally {
+    await browser.close();
+  }
+}
+
+/** [`fromElsewhere`] in a new tab of `browser`, beside the pages it has open. */
+export async function inTabElsewhere(browser, html) {
   const evil = http.createServer((req, res) => {
     res.writeHead(200, { 'content-type': 'text/html; charset=utf-8' });
     res.end(html);
   });
   await new Promise((ok) => evil.listen(0, '127.0.0.2', ok));
-  const browser = await launchChromium();
+  const tab = await browser.newPage();
   try {
-    const tab = await browser.newPage();
     await tab.goto(`http://127.0.0.2:${evil.address().port}/`, { waitUntil: 'load' });
     return await tab.evaluate(() => window.attacked);
   } finally {
-    await browser.close();
+    await tab.close();
     evil.close();
   }
 }

@@ -10,11 +10,12 @@
 //     the picture of docs/workbench.md: the lot's type changed, the lot outlined, the lot
 //     editor and the panel's search showing.
 //   node test/workbench.mjs <url> save <lot> <type>
-//     gives <lot> <type>, sets `kura.gap` = 3, saves; prints the answers.
+//     gives <lot> <type>, lets a page of another site beside it ask for 300 page tokens
+//     as `<img src>` does, sets `kura.gap` = 3, saves; prints the answers.
 //   node test/workbench.mjs <url> attack
 //     a page of another origin POSTs edits and a save (blind no-cors text/plain, and JSON
 //     with a made-up token): prints what each attempt got; the caller checks the files.
-import { fromElsewhere, openPage } from './launch.mjs';
+import { fromElsewhere, inTabElsewhere, openPage } from './launch.mjs';
 
 const [url, phase, lot, type, shots] = process.argv.slice(2);
 if (!url || !phase) {
@@ -115,6 +116,16 @@ try {
     out.clicked = await page.evaluate(() => window.edoCity.info);
   } else if (phase === 'save') {
     out.lot = await page.evaluate(([l, t]) => window.edoCity.edit.lot(l, 'mtype', t), [lot, type]);
+    // Another site open beside it asks for 300 page tokens the way `<img src>` does
+    // (issue 74: they pushed this page's token out); this page's next edits must still go.
+    out.flood = await inTabElsewhere(browser, `<!doctype html><script>
+      window.attacked = Promise.all(Array.from({ length: 300 }, (_, i) => new Promise((ok) => {
+        const img = new Image();
+        img.onload = () => ok('loaded');
+        img.onerror = () => ok('failed');
+        img.src = ${JSON.stringify(url)} + 'api/token?' + i;
+      }))).then((all) => all.length);
+    </script>`);
     out.gap = await page.evaluate(() => window.edoCity.edit.set('kura.gap', 3.0));
     out.saved = await page.evaluate(() => window.edoCity.edit.save());
     out.status = await page.evaluate(() => window.edoCity.edit.status);

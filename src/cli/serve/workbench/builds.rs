@@ -210,3 +210,56 @@ fn log_rebuild(rev: u64, tiles: usize, took: Duration, timings: &Timings, compar
     line += &format!("lots compared {:.2} s)", compared.as_secs_f64());
     eprintln!("{line}");
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hyp(seed: u64) -> Hypothesis {
+        Hypothesis {
+            text: format!("seed = {seed}\n"),
+            rows: Vec::new(),
+        }
+    }
+
+    /// Revision `rev`'s edit, as `Workbench::edit` makes it.
+    fn edit(s: &mut State, to: Hypothesis) -> u64 {
+        let now = std::mem::replace(&mut s.now, to);
+        s.undo.push(now);
+        s.requested += 1;
+        s.requested
+    }
+
+    #[test]
+    fn a_failed_first_build_keeps_the_file_as_the_person_wrote_it() {
+        let mut s = State::new(hyp(7), Default::default(), Default::default());
+        failed(&mut s, 1, "no lot has the id `x`".into());
+        assert_eq!(s.now, hyp(7), "not the defaults");
+        assert_eq!((s.tried, s.requested), (1, 1));
+    }
+
+    #[test]
+    fn the_edits_made_on_a_failing_build_are_taken_back_and_answered() {
+        let mut s = State::new(hyp(1), Default::default(), Default::default());
+        s.built = 1;
+        s.tried = 1;
+        s.good = Some(hyp(1));
+        let failing = edit(&mut s, hyp(2));
+        // Made while revision 2 builds, on top of it.
+        let on_top = edit(&mut s, hyp(3));
+        let and_another = edit(&mut s, hyp(4));
+        failed(&mut s, failing, "no lot has the id `x`".into());
+        assert_eq!(s.now, hyp(1));
+        assert_eq!(s.undo.len(), 0);
+        assert_eq!(s.tried, s.requested, "no build is left waiting for");
+        let f = s.failures.back().unwrap().clone();
+        for rev in [failing, on_top, and_another] {
+            assert!(f.after < rev && rev <= f.upto, "{rev} is answered");
+        }
+        assert!(f.message_for(on_top).contains("on top of revision 2"));
+        // The next edit builds on what OUT holds.
+        let next = edit(&mut s, hyp(5));
+        assert!(next > f.upto);
+        assert_eq!(s.undo.pop(), Some(hyp(1)));
+    }
+}

@@ -108,6 +108,33 @@ struct State {
     notice: Option<String>,
 }
 
+impl State {
+    /// Before the first build: the hypothesis on disk, nothing built yet.
+    fn new(saved: Hypothesis, disk: Disk, lots: Arc<PlanLots>) -> State {
+        State {
+            now: saved.clone(),
+            good: None,
+            saved,
+            disk,
+            undo: Steps::default(),
+            redo: Steps::default(),
+            requested: 1,
+            built: 0,
+            tried: 0,
+            failed: None,
+            failures: VecDeque::new(),
+            busy: false,
+            changed_tiles: Vec::new(),
+            changed_lots: Vec::new(),
+            lots,
+            last_ms: 0,
+            fingerprints: Arc::new(Fingerprints::default()),
+            manifest: None,
+            notice: None,
+        }
+    }
+}
+
 /// A build that failed: the revisions after `after` up to `upto` did not build.
 #[derive(Debug, Clone)]
 struct Failure {
@@ -160,27 +187,7 @@ impl Workbench {
         let wb = Arc::new(Workbench {
             files,
             place,
-            state: Mutex::new(State {
-                now: saved.clone(),
-                good: None,
-                saved,
-                disk,
-                undo: Steps::default(),
-                redo: Steps::default(),
-                requested: 1,
-                built: 0,
-                tried: 0,
-                failed: None,
-                failures: VecDeque::new(),
-                busy: false,
-                changed_tiles: Vec::new(),
-                changed_lots: Vec::new(),
-                lots,
-                last_ms: 0,
-                fingerprints: Arc::new(Fingerprints::default()),
-                manifest: None,
-                notice: None,
-            }),
+            state: Mutex::new(State::new(saved, disk, lots)),
             bell: Condvar::new(),
         });
         let builder = wb.clone();
