@@ -223,7 +223,8 @@ export function createWorkbench({ scene, point, render, reload, base }) {
       ? `error: ${s.error}`
       : s.busy
         ? 'rebuilding…'
-        : `revision ${s.revision}: ${s.changedTiles.length} tile(s) rebuilt in ${(s.lastMs / 1000).toFixed(1)} s${saved}`;
+        : `revision ${s.revision}: ${s.changedTiles.length} tile(s) rebuilt in ${(s.lastMs / 1000).toFixed(1)} s${saved}`
+          + (s.notice ? ` · ${s.notice}` : '');
     el.classList.toggle('error', Boolean(s.error));
   }
 
