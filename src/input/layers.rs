@@ -105,7 +105,7 @@ impl Opened {
 fn open(
     dir: &Path,
     role: &'static str,
-    file: &str,
+    (file, layer): (&str, &str),
     encoding: &str,
     default_file: &str,
 ) -> Result<Option<Opened>, InputError> {
@@ -123,7 +123,7 @@ fn open(
             path.display()
         )));
     }
-    let layer = shp::read_layer(&path, encoding)?;
+    let layer = read(&path, layer, role, encoding)?;
     Ok(Some(Opened {
         role,
         file: path.display().to_string(),
@@ -132,6 +132,39 @@ fn open(
         reproject: false,
         against_winding: Default::default(),
     }))
+}
+
+/// Reads the layer at `path` by its kind: a GeoPackage's `layer`, a GeoJSON file, else a
+/// shapefile (`encoding` is a DBF's).
+fn read(path: &Path, layer: &str, role: &str, encoding: &str) -> Result<shp::Layer, InputError> {
+    match Format::of(path) {
+        Format::GeoPackage => super::gpkg::read_layer(path, layer, role),
+        Format::GeoJson => super::geojson::read_layer(path),
+        Format::Shapefile => shp::read_layer(path, encoding),
+    }
+}
+
+/// The kinds of layer file a build reads, by their names' endings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    Shapefile,
+    GeoPackage,
+    GeoJson,
+}
+
+impl Format {
+    /// The format of the file at `path`, by its ending (a shapefile unless it is another's).
+    pub fn of(path: &Path) -> Format {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_lowercase())
+            .unwrap_or_default();
+        match ext.as_str() {
+            "gpkg" => Format::GeoPackage,
+            "geojson" | "json" => Format::GeoJson,
+            _ => Format::Shapefile,
+        }
+    }
 }
 
 /// Every layer a build reads, one slot a role; `None` where the role is switched off or its
@@ -164,46 +197,91 @@ impl Layers {
     ) -> Result<Layers, InputError> {
         let l = &params.layers;
         // (role, file, encoding, the default file: an optional role's is allowed to be absent)
-        let role = |role, file: &str, encoding: &str, default: &str| {
+        let role = |role, file: (&str, &str), encoding: &str, default: &str| {
             open(dir, role, file, encoding, default)
         };
         Ok(Layers {
-            lots: role("lots", &l.lots.file, &l.lots.encoding, &d.lots.file)?,
-            footprints: role("footprints", &l.footprints.file, &l.footprints.encoding, "")?,
+            lots: role(
+                "lots",
+                (&l.lots.file, &l.lots.layer),
+                &l.lots.encoding,
+                &d.lots.file,
+            )?,
+            footprints: role(
+                "footprints",
+                (&l.footprints.file, &l.footprints.layer),
+                &l.footprints.encoding,
+                "",
+            )?,
             streets: role(
                 "streets",
-                &l.streets.file,
+                (&l.streets.file, &l.streets.layer),
                 &l.streets.encoding,
                 &d.streets.file,
             )?,
-            blocks: role("blocks", &l.blocks.file, &l.blocks.encoding, &d.blocks.file)?,
+            blocks: role(
+                "blocks",
+                (&l.blocks.file, &l.blocks.layer),
+                &l.blocks.encoding,
+                &d.blocks.file,
+            )?,
             widths: role(
                 "street_widths",
-                &l.street_widths.file,
+                (&l.street_widths.file, &l.street_widths.layer),
                 &l.street_widths.encoding,
                 "",
             )?,
-            districts: role("districts", &l.districts.file, &l.districts.encoding, "")?,
-            fences: role("fences", &l.fences.file, &l.fences.encoding, &d.fences.file)?,
-            people: role("people", &l.people.file, &l.people.encoding, &d.people.file)?,
-            trees: role("trees", &l.trees.file, &l.trees.encoding, &d.trees.file)?,
+            districts: role(
+                "districts",
+                (&l.districts.file, &l.districts.layer),
+                &l.districts.encoding,
+                "",
+            )?,
+            fences: role(
+                "fences",
+                (&l.fences.file, &l.fences.layer),
+                &l.fences.encoding,
+                &d.fences.file,
+            )?,
+            people: role(
+                "people",
+                (&l.people.file, &l.people.layer),
+                &l.people.encoding,
+                &d.people.file,
+            )?,
+            trees: role(
+                "trees",
+                (&l.trees.file, &l.trees.layer),
+                &l.trees.encoding,
+                &d.trees.file,
+            )?,
             gardens: role(
                 "gardens",
-                &l.gardens.file,
+                (&l.gardens.file, &l.gardens.layer),
                 &l.gardens.encoding,
                 &d.gardens.file,
             )?,
-            water: role("water", &l.water.file, &l.water.encoding, &d.water.file)?,
+            water: role(
+                "water",
+                (&l.water.file, &l.water.layer),
+                &l.water.encoding,
+                &d.water.file,
+            )?,
             // A table of links is read by its own reader.
             links: match is_table(&links_file(dir, params, d)) {
                 true => None,
-                false => role("links", &l.links.file, &l.links.encoding, &d.links.file)?,
+                false => role(
+                    "links",
+                    (&l.links.file, &l.links.layer),
+                    &l.links.encoding,
+                    &d.links.file,
+                )?,
             },
             // So is a table of landmarks.
             landmarks: match params.landmarks.enabled && !is_table(&l.landmarks.file) {
                 true => role(
                     "landmarks",
-                    &l.landmarks.file,
+                    (&l.landmarks.file, &l.landmarks.layer),
                     &l.landmarks.encoding,
                     &d.landmarks.file,
                 )?,

@@ -20,6 +20,9 @@ pub mod widths;
 
 mod areas;
 mod designs;
+mod features;
+mod geojson;
+pub mod gpkg;
 mod landmarks;
 mod layers;
 mod lines;

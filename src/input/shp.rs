@@ -385,7 +385,7 @@ fn field_text(value: &dbase::FieldValue) -> String {
 }
 
 /// Whole numbers print without a fraction so that numeric ids read as `12`, not `12.0`.
-fn fmt_number(v: f64) -> String {
+pub(super) fn fmt_number(v: f64) -> String {
     if v.fract() == 0.0 && v.abs() < 1e15 {
         format!("{}", v as i64)
     } else {

@@ -18,6 +18,10 @@ pub use super::allowed::{MAX_PER_100M, MAX_PER_HA, TREE_STYLES};
 pub struct PointsLayer {
     /// The point layer's file (`people.shp`, `trees.shp`); "" for none.
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// Its text encoding, when the `.cpg` is wrong or missing.
     #[serde(default)]
     pub encoding: String,
@@ -235,6 +239,7 @@ pub(super) mod partial {
     #[allow(dead_code)]
     pub struct PointsLayer {
         file: Option<String>,
+        layer: Option<String>,
         encoding: Option<String>,
         id_field: Option<String>,
         height_field: Option<String>,

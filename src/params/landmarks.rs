@@ -14,6 +14,10 @@ pub struct LandmarksLayer {
     /// `landmarks.shp`, or a `.csv`/`.xlsx` table, relative to the input directory; "" = none
     /// (a missing default file is no layer).
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
@@ -113,6 +117,7 @@ pub(super) mod partial {
     #[allow(dead_code)]
     pub struct LandmarksLayer {
         file: Option<String>,
+        layer: Option<String>,
         encoding: Option<String>,
         id_field: Option<String>,
         model_field: Option<String>,

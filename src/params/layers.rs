@@ -56,6 +56,10 @@ pub struct IdLayer {
     /// Shapefile path, relative to the input directory; "" = no such layer (a missing
     /// default file is no layer).
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
@@ -78,6 +82,10 @@ pub struct LinksLayer {
     /// `links.shp` or `links.csv`, relative to the input directory; "" = none (a missing
     /// default file is no layer).
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
@@ -102,6 +110,10 @@ pub struct LinksLayer {
 pub struct DistrictsLayer {
     /// "" = no such layer.
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
@@ -116,6 +128,10 @@ pub struct DistrictsLayer {
 pub struct LotsLayer {
     /// Shapefile path, relative to the input directory.
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
@@ -161,6 +177,10 @@ pub struct LotFields {
 pub struct BlocksLayer {
     /// Shapefile path, relative to the input directory; "" = no such layer.
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
@@ -172,6 +192,10 @@ pub struct BlocksLayer {
 pub struct StreetsLayer {
     /// Shapefile path, relative to the input directory; "" = no such layer.
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
@@ -188,6 +212,10 @@ pub struct StreetsLayer {
 pub struct StreetWidthsLayer {
     /// "" = no such layer.
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,
@@ -203,6 +231,10 @@ pub struct StreetWidthsLayer {
 pub struct FootprintsLayer {
     /// "" = no such layer.
     pub file: String,
+    /// The layer of a GeoPackage `file` holds ("" = its only feature layer, else the one
+    /// named as the role); other files have one layer.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub layer: String,
     /// DBF text encoding; empty = the `.cpg` file, else the DBF header, else UTF-8.
     #[serde(default)]
     pub encoding: String,

@@ -76,6 +76,7 @@ struct Layers {
 #[allow(dead_code)]
 struct LinksLayer {
     file: Option<String>,
+    layer: Option<String>,
     encoding: Option<String>,
     id_field: Option<String>,
     title_field: Option<String>,
@@ -95,6 +96,7 @@ struct DemLayer {
 #[allow(dead_code)]
 struct FencesLayer {
     file: Option<String>,
+    layer: Option<String>,
     encoding: Option<String>,
     id_field: Option<String>,
 }
@@ -103,6 +105,7 @@ struct FencesLayer {
 #[allow(dead_code)]
 struct Districts {
     file: Option<String>,
+    layer: Option<String>,
     encoding: Option<String>,
     id_field: Option<String>,
 }
@@ -111,6 +114,7 @@ struct Districts {
 #[allow(dead_code)]
 struct Widths {
     file: Option<String>,
+    layer: Option<String>,
     encoding: Option<String>,
     width_field: Option<String>,
     max_distance: Option<f64>,
@@ -120,6 +124,7 @@ struct Widths {
 #[allow(dead_code)]
 struct Footprints {
     file: Option<String>,
+    layer: Option<String>,
     encoding: Option<String>,
     fields: Option<FootprintFields>,
     values: Option<BTreeMap<String, BTreeMap<String, String>>>,
@@ -142,6 +147,7 @@ struct FootprintFields {
 #[allow(dead_code)]
 struct Lots {
     file: Option<String>,
+    layer: Option<String>,
     encoding: Option<String>,
     table: Option<String>,
     sheet: Option<String>,
@@ -166,6 +172,7 @@ struct LotFields {
 #[allow(dead_code)]
 struct Blocks {
     file: Option<String>,
+    layer: Option<String>,
     encoding: Option<String>,
 }
 #[derive(Deserialize)]
@@ -173,6 +180,7 @@ struct Blocks {
 #[allow(dead_code)]
 struct Streets {
     file: Option<String>,
+    layer: Option<String>,
     encoding: Option<String>,
     width_field: Option<String>,
     default_width: Option<f64>,

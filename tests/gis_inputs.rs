@@ -1,0 +1,262 @@
+//! Layers beside shapefiles (issue 77): GeoPackage layers and GeoJSON files, converted from
+//! the example town by GDAL's `ogr2ogr` (Debian's gdal-bin, `make gis-deps`), built as the
+//! shapefiles are; and what a GeoPackage from elsewhere may not do.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::*;
+
+/// `ogr2ogr` with `args`; fails the test with GDAL's words.
+fn ogr2ogr(args: &[&str]) {
+    let o = Command::new("ogr2ogr")
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("ogr2ogr is missing ({e}): run `make gis-deps`");
+        });
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// The example town's lots, blocks and streets as the layers of one GeoPackage, with its
+/// tables beside it; the parameter file naming them.
+fn town_gpkg(dir: &Path) -> (PathBuf, PathBuf) {
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    let gpkg = input.join("town.gpkg");
+    let fixture = fixture("kyoto-small");
+    for (i, layer) in ["lots", "blocks", "streets"].iter().enumerate() {
+        let shp = fixture.join(format!("{layer}.shp"));
+        let mut args = vec!["-f", "GPKG", "-nln", layer];
+        if i > 0 {
+            args.push("-update");
+        }
+        args.extend([gpkg.to_str().unwrap(), shp.to_str().unwrap()]);
+        ogr2ogr(&args);
+    }
+    for table in ["lots.csv", "links.csv"] {
+        std::fs::copy(fixture.join(table), input.join(table)).unwrap();
+    }
+    let params = dir.join("gpkg.toml");
+    std::fs::write(
+        &params,
+        "[layers.lots]\nfile = \"town.gpkg\"\nlayer = \"lots\"\n\
+         [layers.blocks]\nfile = \"town.gpkg\"\nlayer = \"blocks\"\n\
+         [layers.streets]\nfile = \"town.gpkg\"\nlayer = \"streets\"\n",
+    )
+    .unwrap();
+    (input, params)
+}
+
+/// A GLB's JSON chunk and its binary chunk.
+fn glb_parts(path: &Path) -> (serde_json::Value, Vec<u8>) {
+    let b = std::fs::read(path).unwrap();
+    let n = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
+    let json = serde_json::from_slice(&b[20..20 + n]).unwrap();
+    (json, b[20 + n..].to_vec())
+}
+
+#[test]
+fn a_geopackage_of_the_town_builds_the_shapefiles_tiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, params) = town_gpkg(dir.path());
+    let from_gpkg = dir.path().join("gpkg");
+    build_ok(
+        &input,
+        &from_gpkg,
+        &["--quiet", "--params", params.to_str().unwrap()],
+    );
+    let from_shp = dir.path().join("shp");
+    build_ok(&fixture("kyoto-small"), &from_shp, &["--quiet"]);
+    // Every OBJ tile byte for byte.
+    assert_eq!(
+        tile_hashes(&from_gpkg, &["obj"]),
+        tile_hashes(&from_shp, &["obj"])
+    );
+    // Every GLB: the same binary chunk; its metadata's list of source files names the
+    // GeoPackage instead of lots.shp, and nothing else differs.
+    let tiles = tile_hashes(&from_shp, &["glb"]);
+    assert!(!tiles.is_empty());
+    for (id, _) in tiles {
+        let (mut a, bin_a) = glb_parts(&from_gpkg.join(format!("tiles/{id}.glb")));
+        let (mut b, bin_b) = glb_parts(&from_shp.join(format!("tiles/{id}.glb")));
+        assert_eq!(bin_a, bin_b, "{id}");
+        let sources = "/extensions/EXT_structural_metadata/schema/enums/source/values";
+        let names = |v: &serde_json::Value| -> Vec<String> {
+            v.pointer(sources).map_or(Vec::new(), |s| {
+                s.as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|e| e["name"].as_str().unwrap().to_string())
+                    .collect()
+            })
+        };
+        let (na, nb) = (names(&a), names(&b));
+        assert_eq!(
+            na.iter()
+                .map(|n| n.replace("town.gpkg", "lots.shp"))
+                .collect::<Vec<_>>(),
+            nb,
+            "{id}"
+        );
+        for v in [&mut a, &mut b] {
+            if let Some(s) = v.pointer_mut(sources) {
+                *s = serde_json::Value::Null;
+            }
+        }
+        assert_eq!(a, b, "{id}");
+    }
+}
+
+#[test]
+fn a_geopackage_layer_is_found_by_its_name_and_a_wrong_one_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _) = town_gpkg(dir.path());
+    // No `layer`: the layer named as the role.
+    let p = dir.path().join("roles.toml");
+    std::fs::write(
+        &p,
+        "[layers.lots]\nfile = \"town.gpkg\"\n[layers.blocks]\nfile = \"town.gpkg\"\n\
+         [layers.streets]\nfile = \"town.gpkg\"\n",
+    )
+    .unwrap();
+    build_ok(
+        &input,
+        &dir.path().join("o"),
+        &["--quiet", "--params", p.to_str().unwrap()],
+    );
+    std::fs::write(
+        &p,
+        "[layers.lots]\nfile = \"town.gpkg\"\nlayer = \"parcels\"\n",
+    )
+    .unwrap();
+    let o = build_cmd(
+        &input,
+        &dir.path().join("o2"),
+        &["--params", p.to_str().unwrap()],
+    )
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("town.gpkg")
+            && err.contains("no feature layer `parcels`")
+            && err.contains("`lots`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn geojson_in_lon_lat_and_in_a_named_crs_builds() {
+    let dir = tempfile::tempdir().unwrap();
+    let fixture = fixture("kyoto-small");
+    for (name, extra) in [("lonlat", vec!["-lco", "RFC7946=YES"]), ("named", vec![])] {
+        let input = dir.path().join(name);
+        std::fs::create_dir_all(&input).unwrap();
+        for layer in ["lots", "blocks", "streets"] {
+            let out = input.join(format!("{layer}.geojson"));
+            let shp = fixture.join(format!("{layer}.shp"));
+            let mut args = vec!["-f", "GeoJSON"];
+            args.extend(extra.iter().copied());
+            args.extend([out.to_str().unwrap(), shp.to_str().unwrap()]);
+            ogr2ogr(&args);
+        }
+        std::fs::copy(fixture.join("lots.csv"), input.join("lots.csv")).unwrap();
+        let p = dir.path().join(format!("{name}.toml"));
+        std::fs::write(
+            &p,
+            "[layers.lots]\nfile = \"lots.geojson\"\n[layers.blocks]\nfile = \"blocks.geojson\"\n\
+             [layers.streets]\nfile = \"streets.geojson\"\n",
+        )
+        .unwrap();
+        let report = build_ok(
+            &input,
+            &dir.path().join(format!("out-{name}")),
+            &["--quiet", "--params", p.to_str().unwrap()],
+        );
+        let lots = report["accounting"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|a| a["role"] == "lots")
+            .unwrap()
+            .clone();
+        assert_eq!(lots["read"], 400, "{name}: {lots}");
+        assert_eq!(lots["unaccounted"], 0, "{name}: {lots}");
+        assert!(lots["built"].as_u64().unwrap() > 300, "{name}: {lots}");
+    }
+}
+
+#[test]
+fn a_geopackage_from_elsewhere_runs_nothing_and_reads_no_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, params) = town_gpkg(dir.path());
+    let gpkg = input.join("town.gpkg");
+    // A view named as a layer (here one that would recurse forever if it were read), and a
+    // geometry blob that lies about its ring's size.
+    let sql = "CREATE VIEW forever AS WITH RECURSIVE n(x) AS (SELECT 1 UNION ALL SELECT x + 1 \
+               FROM n) SELECT x AS fid, NULL AS geom FROM n; \
+               INSERT INTO gpkg_contents (table_name, data_type, identifier, srs_id) VALUES \
+               ('forever', 'features', 'forever', 0); \
+               INSERT INTO gpkg_geometry_columns VALUES ('forever', 'geom', 'POLYGON', 0, 0, 0); \
+               UPDATE lots SET geom = X'4750000100000000010300000001000000FFFFFF7F' WHERE fid = 1;";
+    assert!(hostile_sql(&gpkg, sql), "the hostile package was made");
+    let p = dir.path().join("view.toml");
+    std::fs::write(
+        &p,
+        "[layers.lots]\nfile = \"town.gpkg\"\nlayer = \"forever\"\n",
+    )
+    .unwrap();
+    let o = build_cmd(
+        &input,
+        &dir.path().join("o"),
+        &["--params", p.to_str().unwrap()],
+    )
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("`forever` is a view, not a table"), "{err}");
+    // The lying blob: lot 1 is read as empty and skipped, with a warning; the rest builds.
+    let report = build_ok(
+        &input,
+        &dir.path().join("o3"),
+        &["--quiet", "--params", params.to_str().unwrap()],
+    );
+    let text = serde_json::to_string(&report).unwrap();
+    assert!(text.contains("could not be decoded"), "{text}");
+    // A FIFO named as the package is refused, not waited on.
+    let fifo = input.join("fifo.gpkg");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    std::fs::write(&p, "[layers.lots]\nfile = \"fifo.gpkg\"\n").unwrap();
+    let o = build_cmd(
+        &input,
+        &dir.path().join("o4"),
+        &["--params", p.to_str().unwrap()],
+    )
+    .output()
+    .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("fifo.gpkg"));
+}
+
+/// Runs `sql` on the package with the sqlite3 of Python's standard library (the test's own
+/// hands, not the build's), its R-tree triggers dropped first (they call GDAL's functions);
+/// whether it went through.
+fn hostile_sql(gpkg: &Path, sql: &str) -> bool {
+    let script = "import sqlite3,sys\nc=sqlite3.connect(sys.argv[1])\n\
+                  for (n,) in c.execute(\"SELECT name FROM sqlite_master WHERE type='trigger'\").fetchall():\n\
+                  \x20   c.execute('DROP TRIGGER \"%s\"' % n)\n\
+                  c.executescript(sys.argv[2])\nc.commit()\n";
+    Command::new("python3")
+        .args(["-c", script, gpkg.to_str().unwrap(), sql])
+        .status()
+        .is_ok_and(|s| s.success())
+}
