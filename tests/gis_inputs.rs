@@ -110,6 +110,121 @@ fn a_geopackage_of_the_town_builds_the_shapefiles_tiles() {
     }
 }
 
+/// Writes each layer of `gpkg` as GeoJSON beside it with every coordinate's every bit
+/// (Python's json writes the shortest text that reads back as the same double; GDAL's
+/// GeoJSON writer rounds some to 15 digits: -109616.40000000001 became -109616.4), naming
+/// its CRS as GDAL does.
+fn exact_geojson(gpkg: &Path, layers: &[&str]) {
+    let script = r#"
+import json, sqlite3, struct, sys
+c = sqlite3.connect(sys.argv[1])
+def geom(w, o):
+    t = struct.unpack('<I', w[o + 1:o + 5])[0]; o += 5
+    def pts(o):
+        n = struct.unpack('<I', w[o:o + 4])[0]; o += 4
+        return [list(struct.unpack('<dd', w[o + 16 * i:o + 16 * i + 16])) for i in range(n)], o + 16 * n
+    def rings(o):
+        n = struct.unpack('<I', w[o:o + 4])[0]; o += 4; out = []
+        for _ in range(n):
+            r, o = pts(o); out.append(r)
+        return out, o
+    if t == 2: c, o = pts(o); return {'type': 'LineString', 'coordinates': c}, o
+    if t == 3: c, o = rings(o); return {'type': 'Polygon', 'coordinates': c}, o
+    n = struct.unpack('<I', w[o:o + 4])[0]; o += 4; parts = []
+    for _ in range(n):
+        g, o = geom(w, o); parts.append(g['coordinates'])
+    return {'type': {5: 'MultiLineString', 6: 'MultiPolygon'}[t], 'coordinates': parts}, o
+for layer in sys.argv[2:]:
+    cur = c.execute('SELECT * FROM "%s" ORDER BY fid' % layer)
+    names = [d[0] for d in cur.description]
+    feats = []
+    for row in cur:
+        props = {n: v for n, v in zip(names, row) if n not in ('fid', 'geom')}
+        b = row[names.index('geom')]
+        env = {0: 0, 1: 32, 2: 48, 3: 48, 4: 64}[(b[3] >> 1) & 7]
+        g, _ = geom(b[8 + env:], 0)
+        feats.append({'type': 'Feature', 'properties': props, 'geometry': g})
+    fc = {'type': 'FeatureCollection', 'name': layer,
+          'crs': {'type': 'name', 'properties': {'name': 'urn:ogc:def:crs:EPSG::6674'}},
+          'features': feats}
+    with open(sys.argv[1].rsplit('/', 1)[0] + '/' + layer + '.geojson', 'w') as f:
+        json.dump(fc, f, ensure_ascii=False)
+"#;
+    let mut args = vec!["-c", script, gpkg.to_str().unwrap()];
+    args.extend(layers);
+    let o = Command::new("python3").args(&args).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn geojson_of_the_town_builds_the_shapefiles_tiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _) = town_gpkg(dir.path());
+    exact_geojson(&input.join("town.gpkg"), &["lots", "blocks", "streets"]);
+    std::fs::remove_file(input.join("town.gpkg")).unwrap();
+    let p = dir.path().join("json.toml");
+    std::fs::write(
+        &p,
+        "[layers.lots]\nfile = \"lots.geojson\"\n[layers.blocks]\nfile = \"blocks.geojson\"\n\
+         [layers.streets]\nfile = \"streets.geojson\"\n",
+    )
+    .unwrap();
+    let from_json = dir.path().join("json");
+    build_ok(
+        &input,
+        &from_json,
+        &["--quiet", "--params", p.to_str().unwrap()],
+    );
+    let from_shp = dir.path().join("shp");
+    build_ok(&fixture("kyoto-small"), &from_shp, &["--quiet"]);
+    assert_eq!(
+        tile_hashes(&from_json, &["obj"]),
+        tile_hashes(&from_shp, &["obj"])
+    );
+}
+
+#[test]
+fn a_geopackage_attributes_table_is_joined_as_the_csv_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, params) = town_gpkg(dir.path());
+    let csv = input.join("lots.csv");
+    let gpkg = input.join("town.gpkg");
+    ogr2ogr(&[
+        "-f",
+        "GPKG",
+        "-update",
+        "-nln",
+        "lot_attributes",
+        gpkg.to_str().unwrap(),
+        csv.to_str().unwrap(),
+    ]);
+    std::fs::remove_file(&csv).unwrap();
+    let text = std::fs::read_to_string(&params).unwrap().replace(
+        "layer = \"lots\"\n",
+        "layer = \"lots\"\ntable = \"town.gpkg\"\nsheet = \"lot_attributes\"\n",
+    );
+    std::fs::write(&params, text).unwrap();
+    let joined = dir.path().join("joined");
+    let report = build_ok(
+        &input,
+        &joined,
+        &["--quiet", "--params", params.to_str().unwrap()],
+    );
+    let t = &report["tables"][0];
+    assert_eq!(
+        (t["rows"].as_u64(), t["matched"].as_u64()),
+        (Some(3), Some(2)),
+        "{t}"
+    );
+    assert!(t["file"].as_str().unwrap().ends_with("town.gpkg"), "{t}");
+    let from_shp = dir.path().join("shp");
+    build_ok(&fixture("kyoto-small"), &from_shp, &["--quiet"]);
+    assert_eq!(
+        tile_hashes(&joined, &["obj"]),
+        tile_hashes(&from_shp, &["obj"])
+    );
+}
+
 #[test]
 fn a_geopackage_layer_is_found_by_its_name_and_a_wrong_one_is_named() {
     let dir = tempfile::tempdir().unwrap();

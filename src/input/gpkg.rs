@@ -110,16 +110,7 @@ fn read_table(path: &Path, table: &str) -> Result<Layer, InputError> {
         .map_err(at("no geometry column in gpkg_geometry_columns"))?;
     let prj = crs_of(&conn, srs);
     // The columns: the integer primary key is the feature id, not an attribute.
-    let mut st = conn
-        .prepare(&format!("PRAGMA table_info({})", quote(table)))
-        .map_err(at("cannot read its columns"))?;
-    let cols: Vec<(String, bool)> = st
-        .query_map([], |r| {
-            Ok((r.get::<_, String>(1)?, r.get::<_, i64>(5)? > 0))
-        })
-        .map_err(at("cannot read its columns"))?
-        .collect::<Result<_, _>>()
-        .map_err(at("cannot read its columns"))?;
+    let cols = columns(&conn, table).map_err(at("cannot read its columns"))?;
     let pk = cols.iter().find(|c| c.1).map(|c| c.0.clone());
     let fields: Vec<String> = (cols.iter())
         .filter(|(n, is_pk)| !is_pk && *n != geom)
@@ -181,6 +172,79 @@ fn read_table(path: &Path, table: &str) -> Result<Layer, InputError> {
         warnings,
         deleted: Vec::new(),
     })
+}
+
+/// The rows of the attributes table `name` of the GeoPackage at `path` (`""`: its only
+/// attributes table): its column names (the primary key left out) and each row's values as
+/// text, numbered as a spreadsheet numbers them (the header is row 1).
+pub fn attribute_rows(
+    path: &Path,
+    name: &str,
+) -> Result<(Vec<String>, Vec<(usize, Vec<String>)>), InputError> {
+    let all = tables(path)?;
+    let attributes: Vec<&String> = (all.iter())
+        .filter(|(_, t)| t == "attributes")
+        .map(|(n, _)| n)
+        .collect();
+    let table = match name.trim() {
+        "" if attributes.len() == 1 => attributes[0].clone(),
+        "" => {
+            return Err(layer_err(
+                path,
+                format!(
+                    "it holds {} attribute tables ({}): name one with `sheet = \"...\"`",
+                    attributes.len(),
+                    list(&attributes)
+                ),
+            ))
+        }
+        n if all.iter().any(|(t, _)| t == n) => n.to_string(),
+        n => {
+            return Err(layer_err(
+                path,
+                format!(
+                    "it has no table `{n}` (its attribute tables: {})",
+                    list(&attributes)
+                ),
+            ))
+        }
+    };
+    let conn = open(path)?;
+    let err = |e: rusqlite::Error| layer_err(path, format!("table `{table}`: {e}"));
+    let cols = columns(&conn, &table).map_err(err)?;
+    let names: Vec<String> = cols.iter().filter(|c| !c.1).map(|c| c.0.clone()).collect();
+    let select: Vec<String> = names.iter().map(|n| quote(n)).collect();
+    let order = cols
+        .iter()
+        .find(|c| c.1)
+        .map_or("rowid".to_string(), |c| quote(&c.0));
+    let sql = format!(
+        "SELECT {} FROM {} ORDER BY {order}",
+        select.join(", "),
+        quote(&table)
+    );
+    let mut st = conn.prepare(&sql).map_err(err)?;
+    let mut rows = st.query([]).map_err(err)?;
+    let mut out = Vec::new();
+    while let Some(row) = rows.next().map_err(err)? {
+        let values = (0..names.len())
+            .map(|i| row.get_ref(i).map(text))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(err)?;
+        out.push((out.len() + 2, values));
+    }
+    Ok((names, out))
+}
+
+/// A table's columns: each name and whether it is the primary key.
+fn columns(conn: &Connection, table: &str) -> rusqlite::Result<Vec<(String, bool)>> {
+    let mut st = conn.prepare(&format!("PRAGMA table_info({})", quote(table)))?;
+    let cols = st
+        .query_map([], |r| {
+            Ok((r.get::<_, String>(1)?, r.get::<_, i64>(5)? > 0))
+        })?
+        .collect();
+    cols
 }
 
 /// The WKT of the GeoPackage's spatial reference `srs`: an EPSG code's own definition

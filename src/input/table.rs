@@ -136,6 +136,14 @@ pub fn find_and_read(
     if base.trim().is_empty() {
         return Ok(None);
     }
+    // A GeoPackage's attributes table (`sheet` names it, as it names a workbook's sheet).
+    if base.trim().to_lowercase().ends_with(".gpkg") {
+        let path = dir.join(base.trim());
+        if !path.exists() {
+            return Ok(None);
+        }
+        return read_gpkg(&path, sheet, id_field).map(Some);
+    }
     let csv = dir.join(format!("{base}.csv"));
     let xlsx = dir.join(format!("{base}.xlsx"));
     if csv.exists() {
@@ -160,6 +168,21 @@ pub fn find_and_read(
     } else {
         Ok(None)
     }
+}
+
+/// Reads a GeoPackage's attributes table, as a workbook's sheet is read.
+fn read_gpkg(path: &Path, table: &str, id_field: &str) -> Result<Table, InputError> {
+    let (headers, rows) = super::gpkg::attribute_rows(path, table)?;
+    let id_col = headers.iter().position(|h| h == id_field).ok_or_else(|| {
+        table_error(
+            path,
+            format!(
+                "no id column `{id_field}` (columns: {}); set `layers.lots.fields.id`",
+                headers.join(", ")
+            ),
+        )
+    })?;
+    Table::assemble(path, &headers, id_col, rows)
 }
 
 /// The largest CSV table read (a million lots' attributes are about 100 MB).
