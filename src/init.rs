@@ -1,4 +1,5 @@
-//! `edo-city init <dir>`: inspects a directory of shapefiles and writes a starting parameter
+//! `edo-city init <dir>`: inspects a directory of GIS layers (shapefiles, every feature layer
+//! of a GeoPackage, GeoJSON files) and writes a starting parameter
 //! file with its guesses (which layer is the lots, the streets, ...; which field is the id),
 //! every layer found listed in comments with its type, count, CRS, encoding and fields.
 //! The guesses are a start for the user to correct, never applied silently to a build.
@@ -8,11 +9,13 @@ use std::path::{Path, PathBuf};
 
 use crate::input::shp;
 
-/// One shapefile found under the directory.
+/// One layer found under the directory.
 #[derive(Debug, Clone)]
 pub struct Found {
     /// Path relative to the directory, with `/`.
     pub rel: String,
+    /// The layer of a GeoPackage (other files hold one).
+    pub layer: Option<String>,
     /// What the layer holds: polygon, polyline, point, ...
     pub kind: &'static str,
     /// Its number of features.
@@ -44,7 +47,7 @@ const MAX_DEPTH: usize = 8;
 /// The shapefiles under `dir`, sorted. Symbolic links to directories are not followed (a
 /// link to `/` would walk the whole file system, a link to `..` loop), and neither is a
 /// folder deeper than [`MAX_DEPTH`]; the links left out are returned, for the user to see.
-fn find_shapefiles(dir: &Path) -> (Vec<PathBuf>, Vec<PathBuf>) {
+fn find_layer_files(dir: &Path) -> (Vec<PathBuf>, Vec<PathBuf>) {
     let mut out = Vec::new();
     let mut links = Vec::new();
     let mut stack = vec![(dir.to_path_buf(), 0usize)];
@@ -61,7 +64,7 @@ fn find_shapefiles(dir: &Path) -> (Vec<PathBuf>, Vec<PathBuf>) {
                 if depth < MAX_DEPTH {
                     stack.push((p, depth + 1));
                 }
-            } else if p.extension().is_some_and(|x| x.eq_ignore_ascii_case("shp")) {
+            } else if is_layer_file(&p) {
                 out.push(p);
             }
         }
@@ -71,12 +74,60 @@ fn find_shapefiles(dir: &Path) -> (Vec<PathBuf>, Vec<PathBuf>) {
     (out, links)
 }
 
-/// Reads what `init` needs of every shapefile under `dir`; unreadable ones are listed with
+/// Whether `path` is a file `init` reads: a shapefile, a GeoPackage, a `.geojson`, or a
+/// `.json` that begins as GeoJSON does (not every JSON file is a layer).
+fn is_layer_file(path: &Path) -> bool {
+    let ext = path
+        .extension()
+        .map(|x| x.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "shp" | "gpkg" | "geojson" => true,
+        "json" => {
+            use std::io::Read;
+            let mut head = Vec::new();
+            crate::bounded::file(path)
+                .and_then(|f| f.take(4096).read_to_end(&mut head))
+                .is_ok()
+                && String::from_utf8_lossy(&head).contains("\"FeatureCollection\"")
+        }
+        _ => false,
+    }
+}
+
+/// Every layer of the file at `path`: a GeoPackage's feature tables, else the file's one.
+fn layers_of(path: &Path) -> Vec<(Option<String>, Result<shp::Layer, String>)> {
+    use crate::input::gpkg;
+    let ext = path
+        .extension()
+        .map(|x| x.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "gpkg" => match gpkg::tables(path) {
+            Ok(tables) => tables
+                .into_iter()
+                .filter(|(_, kind)| kind == "features")
+                .map(|(name, _)| {
+                    let layer = gpkg::read_layer(path, &name, "").map_err(|e| e.to_string());
+                    (Some(name), layer)
+                })
+                .collect(),
+            Err(e) => vec![(None, Err(e.to_string()))],
+        },
+        "geojson" | "json" => vec![(
+            None,
+            crate::input::read_geojson(path).map_err(|e| e.to_string()),
+        )],
+        _ => vec![(None, shp::read_layer(path, "").map_err(|e| e.to_string()))],
+    }
+}
+
+/// Reads what `init` needs of every layer under `dir`; unreadable ones are listed with
 /// their error instead.
 pub fn inspect(dir: &Path) -> (Vec<Found>, Vec<String>) {
     let mut found = Vec::new();
     let mut problems = Vec::new();
-    let (paths, links) = find_shapefiles(dir);
+    let (paths, links) = find_layer_files(dir);
     for link in links {
         problems.push(format!(
             "{}: a link to a directory, not followed (give its target as a directory of its \
@@ -90,45 +141,74 @@ pub fn inspect(dir: &Path) -> (Vec<Found>, Vec<String>) {
             .unwrap_or(&path)
             .to_string_lossy()
             .replace('\\', "/");
-        match shp::read_layer(&path, "") {
-            Ok(layer) => {
-                let kind = layer
-                    .features
-                    .iter()
-                    .map(|f| crate::input::geometry::shape_kind(&f.shape))
-                    .find(|k| *k != "null shape")
-                    .unwrap_or("empty");
-                let crs = layer
-                    .prj
-                    .as_deref()
-                    .and_then(|w| w.split('"').nth(1).map(String::from))
-                    .unwrap_or_else(|| "no .prj".into());
-                found.push(Found {
-                    rel,
-                    kind,
-                    count: layer.features.len(),
-                    fields: layer.fields,
-                    encoding: layer.encoding,
-                    crs,
-                });
+        for (layer_name, read) in layers_of(&path) {
+            let shown = match &layer_name {
+                Some(l) => format!("{rel} layer {l}"),
+                None => rel.clone(),
+            };
+            match read {
+                Ok(layer) => {
+                    let kind = layer
+                        .features
+                        .iter()
+                        .map(|f| crate::input::geometry::shape_kind(&f.shape))
+                        .find(|k| *k != "null shape")
+                        .unwrap_or("empty");
+                    let crs = layer
+                        .prj
+                        .as_deref()
+                        .and_then(|w| w.split('"').nth(1).map(String::from))
+                        .unwrap_or_else(|| "no .prj".into());
+                    found.push(Found {
+                        rel: rel.clone(),
+                        layer: layer_name,
+                        kind,
+                        count: layer.features.len(),
+                        fields: layer.fields,
+                        encoding: layer.encoding,
+                        crs,
+                    });
+                }
+                Err(e) => problems.push(format!("{shown}: {e}")),
             }
-            Err(e) => problems.push(format!("{rel}: {e}")),
         }
     }
     (found, problems)
 }
 
-fn name_score(rel: &str, words: &[&str]) -> usize {
-    let l = rel.to_lowercase();
+fn name_score(f: &Found, words: &[&str]) -> usize {
+    let l = match &f.layer {
+        // A GeoPackage's layer by its own name: the file's is the town's.
+        Some(layer) => layer.to_lowercase(),
+        None => f.rel.to_lowercase(),
+    };
     words.iter().filter(|w| l.contains(*w)).count()
+}
+
+impl Found {
+    /// The lines that name this layer in a `[layers.*]` table.
+    fn file_lines(&self) -> String {
+        match &self.layer {
+            Some(l) => format!("file = {:?}\nlayer = {:?}", self.rel, l),
+            None => format!("file = {:?}", self.rel),
+        }
+    }
+
+    /// The file and layer as the list of layers found shows them.
+    fn shown(&self) -> String {
+        match &self.layer {
+            Some(l) => format!("{} layer {l}", self.rel),
+            None => self.rel.clone(),
+        }
+    }
 }
 
 fn pick<'a>(found: &'a [Found], kind: &str, words: &[&str], avoid: &[&str]) -> Option<&'a Found> {
     found
         .iter()
-        .filter(|f| f.kind == kind && name_score(&f.rel, avoid) == 0)
-        .filter(|f| name_score(&f.rel, words) > 0)
-        .max_by_key(|f| (name_score(&f.rel, words), f.count))
+        .filter(|f| f.kind == kind && name_score(f, avoid) == 0)
+        .filter(|f| name_score(f, words) > 0)
+        .max_by_key(|f| (name_score(f, words), f.count))
 }
 
 fn field<'a>(f: &'a Found, candidates: &[&str]) -> Option<&'a str> {
@@ -190,7 +270,7 @@ pub fn params_text(dir: &Path) -> String {
     );
     let widths = found.iter().find(|f| {
         f.kind == "polyline"
-            && Some(f.rel.as_str()) != streets.map(|s| s.rel.as_str())
+            && Some(f.shown()) != streets.map(Found::shown)
             && field(f, &["road_width", "width", "幅員"]).is_some()
     });
 
@@ -208,7 +288,7 @@ pub fn params_text(dir: &Path) -> String {
     let _ = writeln!(s, "[layers.lots]");
     match lots {
         Some(l) => {
-            let _ = writeln!(s, "file = {}", quote(&l.rel));
+            let _ = writeln!(s, "{}", l.file_lines());
             let _ = writeln!(s, "[layers.lots.fields]");
             let id = field(l, ID_FIELDS).unwrap_or("id");
             let _ = writeln!(s, "id = {}", quote(id));
@@ -228,7 +308,7 @@ pub fn params_text(dir: &Path) -> String {
     let _ = writeln!(s, "\n[layers.footprints]");
     match footprints {
         Some(f) => {
-            let _ = writeln!(s, "file = {}", quote(&f.rel));
+            let _ = writeln!(s, "{}", f.file_lines());
             let _ = writeln!(s, "[layers.footprints.fields]");
             let _ = writeln!(s, "id = {}", quote(field(f, ID_FIELDS).unwrap_or("id")));
             let h = field(f, &["lod1_h", "height", "高さ", "measuredheight"]).unwrap_or("");
@@ -246,30 +326,23 @@ pub fn params_text(dir: &Path) -> String {
             let _ = writeln!(s, "file = \"\"");
         }
     }
+    let none = "file = \"\"".to_string();
     let _ = writeln!(s, "\n[layers.blocks]");
-    let _ = writeln!(
-        s,
-        "file = {}",
-        quote(blocks.map(|b| b.rel.as_str()).unwrap_or(""))
-    );
+    let _ = writeln!(s, "{}", blocks.map_or(none.clone(), Found::file_lines));
     let _ = writeln!(s, "\n[layers.streets]");
-    let _ = writeln!(
-        s,
-        "file = {}",
-        quote(streets.map(|b| b.rel.as_str()).unwrap_or(""))
-    );
+    let _ = writeln!(s, "{}", streets.map_or(none, Found::file_lines));
     if let Some(w) = streets.and_then(|st| field(st, &["width", "road_width", "幅員"])) {
         let _ = writeln!(s, "width_field = {}", quote(w));
     }
     if let Some(w) = widths {
         let _ = writeln!(s, "\n[layers.street_widths]");
-        let _ = writeln!(s, "file = {}", quote(&w.rel));
+        let _ = writeln!(s, "{}", w.file_lines());
         let wf = field(w, &["road_width", "width", "幅員"]).unwrap_or("width");
         let _ = writeln!(s, "width_field = {}", quote(wf));
     }
     if let Some(d) = districts {
         let _ = writeln!(s, "\n[layers.districts]");
-        let _ = writeln!(s, "file = {}", quote(&d.rel));
+        let _ = writeln!(s, "{}", d.file_lines());
         let id = field(d, &["name", "disname", "district", "id", "districtid"]).unwrap_or("id");
         let _ = writeln!(s, "id_field = {}", quote(id));
     }
@@ -278,7 +351,7 @@ pub fn params_text(dir: &Path) -> String {
         let _ = writeln!(
             s,
             "#   {}  {} x{}  CRS {}  text {}\n#     fields: {}",
-            f.rel,
+            f.shown(),
             f.kind,
             f.count,
             f.crs,
@@ -290,7 +363,11 @@ pub fn params_text(dir: &Path) -> String {
         let _ = writeln!(s, "#   could not read {p}");
     }
     if found.is_empty() {
-        let _ = writeln!(s, "#   (no shapefiles under {})", dir.display());
+        let _ = writeln!(
+            s,
+            "#   (no shapefiles, GeoPackages or GeoJSON files under {})",
+            dir.display()
+        );
     }
     s
 }

@@ -375,3 +375,46 @@ fn hostile_sql(gpkg: &Path, sql: &str) -> bool {
         .status()
         .is_ok_and(|s| s.success())
 }
+
+#[test]
+fn a_directory_holding_only_a_geopackage_is_named_by_build_and_read_by_init() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _) = town_gpkg(dir.path());
+    for table in ["lots.csv", "links.csv"] {
+        std::fs::remove_file(input.join(table)).unwrap();
+    }
+    let o = build_cmd(&input, &dir.path().join("o"), &[])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("the directory holds town.gpkg") && err.contains("edo-city init"),
+        "{err}"
+    );
+    let params = dir.path().join("init.toml");
+    let o = edo_city()
+        .arg("init")
+        .arg(&input)
+        .arg("-o")
+        .arg(&params)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&params).unwrap();
+    for role in ["lots", "blocks", "streets"] {
+        assert!(
+            text.contains(&format!("file = \"town.gpkg\"\nlayer = \"{role}\"")),
+            "{text}"
+        );
+    }
+    let report = build_ok(
+        &input,
+        &dir.path().join("built"),
+        &["--quiet", "--params", params.to_str().unwrap()],
+    );
+    assert!(
+        report["accounting"][0]["built"].as_u64().unwrap() > 300,
+        "{report}"
+    );
+}

@@ -119,8 +119,9 @@ fn open(
         }
         return Err(InputError::Missing(format!(
             "no {role} layer: {} does not exist (set `layers.{role}.file` in the parameter file \
-             to the right path, or to \"\" if there is no such layer)",
-            path.display()
+             to the right path, or to \"\" if there is no such layer){}",
+            path.display(),
+            other_layer_files(dir)
         )));
     }
     let layer = read(&path, layer, role, encoding)?;
@@ -132,6 +133,30 @@ fn open(
         reproject: false,
         against_winding: Default::default(),
     }))
+}
+
+/// A hint naming the GeoPackages and GeoJSON files in `dir`, when it holds any: a person
+/// whose town is in one has not named it yet.
+fn other_layer_files(dir: &Path) -> String {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return String::new();
+    };
+    let mut names: Vec<String> = entries
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| Format::of(Path::new(n)) != Format::Shapefile)
+        .collect();
+    names.sort();
+    names.truncate(5);
+    match names.first() {
+        None => String::new(),
+        Some(first) => format!(
+            "; the directory holds {}: name one, e.g. `file = {first:?}` (and `layer = \"...\"` \
+             for a GeoPackage), or let `edo-city init {}` write the parameter file",
+            names.join(", "),
+            dir.display()
+        ),
+    }
 }
 
 /// Reads the layer at `path` by its kind: a GeoPackage's `layer`, a GeoJSON file, else a
