@@ -83,14 +83,7 @@ fn is_layer_file(path: &Path) -> bool {
         .unwrap_or_default();
     match ext.as_str() {
         "shp" | "gpkg" | "geojson" => true,
-        "json" => {
-            use std::io::Read;
-            let mut head = Vec::new();
-            crate::bounded::file(path)
-                .and_then(|f| f.take(4096).read_to_end(&mut head))
-                .is_ok()
-                && String::from_utf8_lossy(&head).contains("\"FeatureCollection\"")
-        }
+        "json" => crate::input::looks_like_geojson(path),
         _ => false,
     }
 }

@@ -78,6 +78,16 @@ pub fn read_layer(path: &Path) -> Result<Layer, InputError> {
     })
 }
 
+/// Whether the file at `path` begins as a GeoJSON FeatureCollection does (a `.json` file
+/// is not always a layer): its first 4 KiB name one. A FIFO or device is no layer.
+pub fn looks_like_geojson(path: &Path) -> bool {
+    let mut head = Vec::new();
+    crate::bounded::file(path)
+        .and_then(|f| f.take(4096).read_to_end(&mut head))
+        .is_ok()
+        && String::from_utf8_lossy(&head).contains("\"FeatureCollection\"")
+}
+
 /// The EPSG code of a 2008-style named `crs` member in the file's beginning, if any
 /// (`urn:ogc:def:crs:EPSG::6674`, `EPSG:6674`; CRS84 is WGS 84).
 fn named_crs(head: &str) -> Option<u16> {
@@ -119,7 +129,7 @@ mod tests {
 
 #[cfg(test)]
 mod precision {
-    use super::super::features::Collector;
+    use crate::input::features::Collector;
 
     #[test]
     fn coordinates_are_read_to_the_last_bit() {

@@ -180,10 +180,7 @@ pub type Row = (usize, Vec<String>);
 /// The rows of the attributes table `name` of the GeoPackage at `path` (`""`: its only
 /// attributes table): its column names (the primary key left out) and each row's values as
 /// text, numbered as a spreadsheet numbers them (the header is row 1).
-pub fn attribute_rows(
-    path: &Path,
-    name: &str,
-) -> Result<(Vec<String>, Vec<Row>), InputError> {
+pub fn attribute_rows(path: &Path, name: &str) -> Result<(Vec<String>, Vec<Row>), InputError> {
     let all = tables(path)?;
     let attributes: Vec<&String> = (all.iter())
         .filter(|(_, t)| t == "attributes")

@@ -8,7 +8,7 @@
 
 /// Coordinate reference systems (in [`crate::geom::crs`]: the tileset uses them too).
 pub use crate::geom::crs;
-pub use geojson::read_layer as read_geojson;
+pub use geojson::{looks_like_geojson, read_layer as read_geojson};
 pub use landmarks::models_dir;
 pub mod dem;
 pub mod fields;

@@ -96,34 +96,62 @@ pub struct ParamDoc {
 pub fn catalogue() -> Vec<ParamDoc> {
     let doc: toml_edit::DocumentMut = DEFAULT_TOML.parse().expect("the shipped defaults parse");
     let mut out = Vec::new();
-    walk(doc.as_table(), "", &mut out);
+    walk(doc.as_table(), "", "", &mut out);
     out
 }
 
-fn walk(table: &toml_edit::Table, at: &str, out: &mut Vec<ParamDoc>) {
+/// The parameters of `table` (at the key `at`) into `out`. A key's doc is the comment
+/// above it and the one beside it; a key with no comment above it that follows the one
+/// before without a blank line is of that key's group and shares its comment (`x_field`,
+/// `y_field` under the comment that says what both are); a key of no group has the comment
+/// of its table, `section`, the one above the table's header.
+fn walk(table: &toml_edit::Table, at: &str, section_doc: &str, out: &mut Vec<ParamDoc>) {
     let section = match at {
         "" => "general",
         s => s,
     };
+    let mut group = String::new();
     for (name, item) in table.iter() {
         let key = match at {
             "" => name.to_string(),
             _ => format!("{at}.{name}"),
         };
-        let above = table
+        let raw = table
             .key(name)
             .and_then(|k| k.leaf_decor().prefix())
             .and_then(|p| p.as_str())
-            .map(comment)
             .unwrap_or_default();
+        let above = comment(raw);
+        if !above.is_empty() {
+            group = above.clone();
+        } else if raw.lines().any(|l| l.trim().is_empty()) {
+            group.clear();
+        }
+        // A key's own comment (above or beside) is its doc; else its group's, else its
+        // table's.
+        let own_or_group = |beside: &str| {
+            let own = [above.as_str(), beside].join("\n").trim().to_string();
+            match (own.is_empty(), group.is_empty()) {
+                (false, _) => own,
+                (true, false) => group.clone(),
+                (true, true) => section_doc.to_string(),
+            }
+        };
         match item {
-            toml_edit::Item::Table(t) if !WHOLE.contains(&name) => walk(t, &key, out),
+            toml_edit::Item::Table(t) if !WHOLE.contains(&name) => {
+                let own = table_doc(t);
+                let inherited = match own.is_empty() {
+                    true => section_doc.to_string(),
+                    false => own,
+                };
+                walk(t, &key, &inherited, out);
+            }
             toml_edit::Item::Table(t) => out.push(ParamDoc {
                 key,
                 section: section.to_string(),
                 kind: "table",
                 default: json_of(&t.clone().into_inline_table().into()),
-                doc: [table_doc(t), above].concat().trim().to_string(),
+                doc: own_or_group(&table_doc(t)),
             }),
             toml_edit::Item::Value(v) => {
                 let beside = v.decor().suffix().and_then(|s| s.as_str()).map(comment);
@@ -132,10 +160,7 @@ fn walk(table: &toml_edit::Table, at: &str, out: &mut Vec<ParamDoc>) {
                     section: section.to_string(),
                     kind: kind_of(v),
                     default: json_of(v),
-                    doc: [above, beside.unwrap_or_default()]
-                        .join("\n")
-                        .trim()
-                        .to_string(),
+                    doc: own_or_group(&beside.unwrap_or_default()),
                 });
             }
             _ => {}
@@ -274,5 +299,56 @@ mod tests {
             assert!(!v.is_null() || unset, "{} is no parameter", p.key);
         }
         assert!(all.len() > 100, "{}", all.len());
+    }
+}
+
+#[cfg(test)]
+mod every_key_explained {
+    use super::catalogue;
+
+    /// Every row of the workbench's panel says what its key does (issue 76: 90 of 186 had
+    /// no doc): each key's comment in params/default.toml, above or beside it, else the
+    /// comment of the group of keys it follows without a blank line, else its table's.
+    #[test]
+    fn every_parameter_has_a_doc() {
+        let all = catalogue();
+        let missing: Vec<&str> = (all.iter())
+            .filter(|p| p.doc.trim().is_empty())
+            .map(|p| p.key.as_str())
+            .collect();
+        assert!(missing.is_empty(), "no doc: {}", missing.join(", "));
+        let doc = |k: &str| {
+            all.iter()
+                .find(|p| p.key == k)
+                .unwrap_or_else(|| panic!("{k}"))
+                .doc
+                .clone()
+        };
+        // The keys the issue named, each with words of its own.
+        assert!(
+            doc("output.formats").contains("\"obj\""),
+            "{}",
+            doc("output.formats")
+        );
+        assert!(
+            doc("kura.enabled").contains("storehouses"),
+            "{}",
+            doc("kura.enabled")
+        );
+        assert!(
+            doc("trees.height").contains("metres"),
+            "{}",
+            doc("trees.height")
+        );
+        for layer in ["lots", "blocks", "streets", "people", "trees", "footprints"] {
+            let d = doc(&format!("layers.{layer}.encoding"));
+            assert!(d.contains("encoding"), "layers.{layer}.encoding: {d}");
+        }
+        // A key with a comment beside it is not given its group's as well.
+        assert!(!doc("ground.texture_size").contains("centrelines"));
+        assert_eq!(
+            doc("kura.min_width"),
+            "a narrower lot shrinks its kura down to this, then gets none"
+        );
     }
 }
