@@ -1,5 +1,5 @@
 //! `edo-city init <dir>`: inspects a directory of GIS layers (shapefiles, every feature layer
-//! of a GeoPackage, GeoJSON files) and writes a starting parameter
+//! of a GeoPackage, GeoJSON and FlatGeobuf files) and writes a starting parameter
 //! file with its guesses (which layer is the lots, the streets, ...; which field is the id),
 //! every layer found listed in comments with its type, count, CRS, encoding and fields.
 //! The guesses are a start for the user to correct, never applied silently to a build.
@@ -82,7 +82,7 @@ fn is_layer_file(path: &Path) -> bool {
         .map(|x| x.to_string_lossy().to_lowercase())
         .unwrap_or_default();
     match ext.as_str() {
-        "shp" | "gpkg" | "geojson" => true,
+        "shp" | "gpkg" | "geojson" | "fgb" => true,
         "json" => crate::input::looks_like_geojson(path),
         _ => false,
     }
@@ -110,6 +110,10 @@ fn layers_of(path: &Path) -> Vec<(Option<String>, Result<shp::Layer, String>)> {
         "geojson" | "json" => vec![(
             None,
             crate::input::read_geojson(path).map_err(|e| e.to_string()),
+        )],
+        "fgb" => vec![(
+            None,
+            crate::input::read_flatgeobuf(path).map_err(|e| e.to_string()),
         )],
         _ => vec![(None, shp::read_layer(path, "").map_err(|e| e.to_string()))],
     }

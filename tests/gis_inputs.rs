@@ -418,3 +418,120 @@ fn a_directory_holding_only_a_geopackage_is_named_by_build_and_read_by_init() {
         "{report}"
     );
 }
+
+/// The example town's lots, blocks and streets as FlatGeobuf files (`more` options to GDAL's
+/// writer), with its tables; the parameter file naming them.
+fn town_fgb(dir: &Path, more: &[&str]) -> (PathBuf, PathBuf) {
+    let input = dir.join("fgb");
+    std::fs::create_dir_all(&input).unwrap();
+    let fixture = fixture("kyoto-small");
+    for layer in ["lots", "blocks", "streets"] {
+        let out = input.join(format!("{layer}.fgb"));
+        let shp = fixture.join(format!("{layer}.shp"));
+        let mut args = vec!["-f", "FlatGeobuf"];
+        args.extend(more);
+        args.extend([out.to_str().unwrap(), shp.to_str().unwrap()]);
+        ogr2ogr(&args);
+    }
+    for table in ["lots.csv", "links.csv"] {
+        std::fs::copy(fixture.join(table), input.join(table)).unwrap();
+    }
+    let params = dir.join("fgb.toml");
+    std::fs::write(
+        &params,
+        "[layers.lots]\nfile = \"lots.fgb\"\n[layers.blocks]\nfile = \"blocks.fgb\"\n\
+         [layers.streets]\nfile = \"streets.fgb\"\n",
+    )
+    .unwrap();
+    (input, params)
+}
+
+#[test]
+fn flatgeobuf_of_the_town_builds_the_shapefiles_tiles() {
+    let dir = tempfile::tempdir().unwrap();
+    // Without GDAL's spatial index the features keep the shapefile's order, and so do the
+    // draws that follow it: every OBJ tile byte for byte.
+    let (input, params) = town_fgb(dir.path(), &["-lco", "SPATIAL_INDEX=NO"]);
+    let from_fgb = dir.path().join("from-fgb");
+    build_ok(
+        &input,
+        &from_fgb,
+        &["--quiet", "--params", params.to_str().unwrap()],
+    );
+    let from_shp = dir.path().join("shp");
+    build_ok(&fixture("kyoto-small"), &from_shp, &["--quiet"]);
+    assert_eq!(
+        tile_hashes(&from_fgb, &["obj"]),
+        tile_hashes(&from_shp, &["obj"])
+    );
+    // With it (GDAL's default), GDAL writes the features in the index's order: the file's
+    // records are others, and every lot is still built.
+    let indexed = tempfile::tempdir().unwrap();
+    let (input, params) = town_fgb(indexed.path(), &[]);
+    let report = build_ok(
+        &input,
+        &indexed.path().join("o"),
+        &["--quiet", "--params", params.to_str().unwrap()],
+    );
+    let lots = &report["accounting"][0];
+    assert_eq!(
+        (lots["read"].as_u64(), lots["unaccounted"].as_u64()),
+        (Some(400), Some(0)),
+        "{lots}"
+    );
+}
+
+#[test]
+fn a_flatgeobuf_whose_feature_lies_about_its_length_is_refused_before_it_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, params) = town_fgb(dir.path(), &["-lco", "SPATIAL_INDEX=NO"]);
+    let lots = input.join("lots.fgb");
+    let mut bytes = std::fs::read(&lots).unwrap();
+    let header = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
+    // The first feature says it is 4 GiB long.
+    let at = 12 + header;
+    bytes[at..at + 4].copy_from_slice(&0xffff_fff0u32.to_le_bytes());
+    std::fs::write(&lots, &bytes).unwrap();
+    let o = build_cmd(
+        &input,
+        &dir.path().join("o"),
+        &["--params", params.to_str().unwrap()],
+    )
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("lots.fgb") && err.contains("feature 0 says it is 4294967280 bytes"),
+        "{err}"
+    );
+    // Cut short: the header's count is not what the file holds.
+    let mut bytes = std::fs::read(fixture_fgb(dir.path())).unwrap();
+    bytes.truncate(bytes.len() - 10);
+    std::fs::write(&lots, &bytes).unwrap();
+    let o = build_cmd(
+        &input,
+        &dir.path().join("o2"),
+        &["--params", params.to_str().unwrap()],
+    )
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("cut short"), "{err}");
+}
+
+/// A fresh FlatGeobuf of the example town's lots, without an index.
+fn fixture_fgb(dir: &Path) -> PathBuf {
+    let out = dir.join("fresh-lots.fgb");
+    let shp = fixture("kyoto-small").join("lots.shp");
+    ogr2ogr(&[
+        "-f",
+        "FlatGeobuf",
+        "-lco",
+        "SPATIAL_INDEX=NO",
+        out.to_str().unwrap(),
+        shp.to_str().unwrap(),
+    ]);
+    out
+}

@@ -159,12 +159,13 @@ fn other_layer_files(dir: &Path) -> String {
     }
 }
 
-/// Reads the layer at `path` by its kind: a GeoPackage's `layer`, a GeoJSON file, else a
-/// shapefile (`encoding` is a DBF's).
+/// Reads the layer at `path` by its kind: a GeoPackage's `layer`, a GeoJSON or FlatGeobuf
+/// file, else a shapefile (`encoding` is a DBF's).
 fn read(path: &Path, layer: &str, role: &str, encoding: &str) -> Result<shp::Layer, InputError> {
     match Format::of(path) {
         Format::GeoPackage => super::gpkg::read_layer(path, layer, role),
         Format::GeoJson => super::geojson::read_layer(path),
+        Format::FlatGeobuf => super::fgb::read_layer(path),
         Format::Shapefile => shp::read_layer(path, encoding),
     }
 }
@@ -175,6 +176,7 @@ pub enum Format {
     Shapefile,
     GeoPackage,
     GeoJson,
+    FlatGeobuf,
 }
 
 impl Format {
@@ -187,6 +189,7 @@ impl Format {
         match ext.as_str() {
             "gpkg" => Format::GeoPackage,
             "geojson" | "json" => Format::GeoJson,
+            "fgb" => Format::FlatGeobuf,
             _ => Format::Shapefile,
         }
     }

@@ -8,6 +8,7 @@
 
 /// Coordinate reference systems (in [`crate::geom::crs`]: the tileset uses them too).
 pub use crate::geom::crs;
+pub use fgb::read_layer as read_flatgeobuf;
 pub use geojson::{looks_like_geojson, read_layer as read_geojson};
 pub use landmarks::models_dir;
 pub mod dem;
@@ -22,6 +23,7 @@ pub mod widths;
 mod areas;
 mod designs;
 mod features;
+mod fgb;
 mod geojson;
 pub mod gpkg;
 mod landmarks;
