@@ -218,12 +218,36 @@ pub const MAX_SHARDS: usize = 10_000;
 /// The most worker threads a build starts (`-j`).
 pub const MAX_THREADS: usize = 1024;
 
+/// Refuses a build whose overrides lie inside its own output directory: a build's plan.gpkg
+/// edited in QGIS and named as the overrides of the next build into the same --out would be
+/// written over by the build that reads it (issue 77).
+fn reads_no_file_it_writes(opts: &BuildOptions) -> Result<(), BuildError> {
+    let name = &opts.params.input.overrides;
+    if name.is_empty() {
+        return Ok(());
+    }
+    let (Ok(file), Ok(out)) = (
+        std::fs::canonicalize(name),
+        std::fs::canonicalize(&opts.out),
+    ) else {
+        return Ok(());
+    };
+    match file.starts_with(&out) {
+        true => Err(BuildError::ReadsItsOutput {
+            path: name.clone(),
+            out: opts.out.display().to_string(),
+        }),
+        false => Ok(()),
+    }
+}
+
 /// Runs the pipeline.
 pub fn build(opts: &BuildOptions, progress: &dyn Progress) -> Result<BuildOutcome, BuildError> {
     let t0 = Instant::now();
     if opts.threads > MAX_THREADS {
         return Err(OptionsError::Threads(opts.threads).into());
     }
+    reads_no_file_it_writes(opts)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .build()

@@ -535,3 +535,88 @@ fn fixture_fgb(dir: &Path) -> PathBuf {
     ]);
     out
 }
+
+/// `sql` run on a copy of a build's plan.gpkg at `to`, as a person's edit in QGIS would
+/// change it.
+fn edited_plan(plan: &Path, to: &Path, sql: &str) {
+    std::fs::copy(plan, to).unwrap();
+    assert!(hostile_sql(to, sql), "the edit was made");
+}
+
+#[test]
+fn a_plan_gpkg_edited_in_qgis_is_read_back_as_overrides() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = dir.path().join("first");
+    build_ok(&fixture("kyoto-small"), &first, &["--quiet"]);
+    let before = tile_hashes(&first, &["obj", "glb"]);
+    // Lot 9 made a sangai in the lots layer of the build's plan.gpkg.
+    let edited = dir.path().join("edited.gpkg");
+    edited_plan(
+        &first.join("plan.gpkg"),
+        &edited,
+        "UPDATE lots SET type = 'sangai' WHERE id = '9';",
+    );
+    let params = dir.path().join("qgis.toml");
+    std::fs::write(&params, "[input]\noverrides = \"edited.gpkg\"\n").unwrap();
+    let second = dir.path().join("second");
+    let report = build_ok(
+        &fixture("kyoto-small"),
+        &second,
+        &["--quiet", "--params", params.to_str().unwrap()],
+    );
+    let after = tile_hashes(&second, &["obj", "glb"]);
+    let changed: Vec<&String> = (before.iter().zip(&after))
+        .filter(|(a, b)| a != b)
+        .map(|(a, _)| &a.0)
+        .collect();
+    assert_eq!(changed.len(), 2, "one tile, as OBJ and GLB: {changed:?}");
+    assert!(changed.iter().all(|t| **t == *changed[0]), "{changed:?}");
+    let table = (report["tables"].as_array().unwrap().iter())
+        .find(|t| t["file"] == "edited.gpkg")
+        .unwrap_or_else(|| panic!("{}", report["tables"]));
+    assert!(table["rows"].as_u64().unwrap() >= 400, "{table}");
+    // A lot the input does not have, and a use that is none: the build's own messages.
+    for (sql, says) in [
+        (
+            "UPDATE lots SET id = 'lost' WHERE id = '9';",
+            "no lot has the id `lost`",
+        ),
+        (
+            "UPDATE lots SET use = 'castle' WHERE id = '9';",
+            "`castle` is not a lot use",
+        ),
+    ] {
+        edited_plan(&first.join("plan.gpkg"), &edited, sql);
+        let o = build_cmd(
+            &fixture("kyoto-small"),
+            &dir.path().join("refused"),
+            &["--params", params.to_str().unwrap()],
+        )
+        .output()
+        .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains(says) && err.contains("edited.gpkg"), "{err}");
+    }
+    // The build's own plan.gpkg named as its overrides: refused, never written over.
+    std::fs::write(
+        &params,
+        format!(
+            "[input]\noverrides = {:?}\n",
+            first.join("plan.gpkg").display().to_string()
+        ),
+    )
+    .unwrap();
+    let plan_before = std::fs::read(first.join("plan.gpkg")).unwrap();
+    let o = build_cmd(
+        &fixture("kyoto-small"),
+        &first,
+        &["--force", "--params", params.to_str().unwrap()],
+    )
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("lies inside its --out"), "{err}");
+    assert_eq!(std::fs::read(first.join("plan.gpkg")).unwrap(), plan_before);
+}

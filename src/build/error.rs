@@ -45,6 +45,18 @@ pub enum BuildError {
     /// A file to write names one the build must not write over.
     #[error(transparent)]
     Target(#[from] crate::output::target::Refused),
+    /// The overrides lie inside the directory the build writes.
+    #[error(
+        "{path} is read by this build as its overrides and lies inside its --out ({out}), \
+         which the build writes over: copy it out first (in QGIS: Export > Save Features As, \
+         beside the parameter file) and name the copy, or build into another --out"
+    )]
+    ReadsItsOutput {
+        /// The overrides as the parameter file names them.
+        path: String,
+        /// The output directory.
+        out: String,
+    },
     /// The build a command works on cannot be read again.
     #[error(transparent)]
     Replay(#[from] super::ReplayError),

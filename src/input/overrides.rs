@@ -157,6 +157,11 @@ pub(super) fn read(
     if name.is_empty() {
         return Ok(None);
     }
+    if name.to_lowercase().ends_with(".gpkg") {
+        let label = label_of(name);
+        return from_geopackage(Path::new(name), &input.overrides_layer, &label)
+            .map(|rows| Some((label, rows)));
+    }
     let text = crate::bounded::read_text(Path::new(name), MAX_OVERRIDES_BYTES).map_err(|e| {
         InputError::Table {
             file: name.to_string(),
@@ -168,6 +173,70 @@ pub(super) fn read(
     })?;
     let label = label_of(name);
     Ok(Some((label.clone(), parse(&text, &label)?)))
+}
+
+/// The columns of a GeoPackage layer read as overrides, and the field each gives: a
+/// build's plan.gpkg names a lot's machiya type `type`, a person's own layer may say `mtype`.
+const GPKG_FIELDS: [(&str, &str); 5] = [
+    ("type", "mtype"),
+    ("mtype", "mtype"),
+    ("use", "use"),
+    ("district", "district"),
+    ("storeys", "storeys"),
+];
+
+/// The overrides a GeoPackage layer gives (a build's plan.gpkg edited in QGIS, issue 77):
+/// for each row, its lot (`id`) and each of [`GPKG_FIELDS`] it fills, one override each,
+/// checked as a CSV row is. A lot given the values the build decided builds as it did, so
+/// only the lots changed in QGIS change.
+fn from_geopackage(path: &Path, layer: &str, label: &str) -> Result<Vec<Override>, InputError> {
+    let layer = match layer.trim() {
+        "" => "lots",
+        l => l,
+    };
+    let (headers, rows) = super::gpkg::attribute_rows(path, layer)?;
+    let bad = |row: usize, message: String| InputError::Table {
+        file: label.to_string(),
+        message: format!("layer `{layer}` row {row}: {message}"),
+    };
+    let id = ["id", "lot"]
+        .iter()
+        .find_map(|c| headers.iter().position(|h| h == c))
+        .ok_or_else(|| {
+            bad(
+                1,
+                format!("no `id` column (columns: {})", headers.join(", ")),
+            )
+        })?;
+    let columns: Vec<(usize, &str)> = (headers.iter().enumerate())
+        .filter_map(|(i, h)| {
+            (GPKG_FIELDS.iter())
+                .find(|(c, _)| c == h)
+                .map(|(_, field)| (i, *field))
+        })
+        .collect();
+    let mut out = Vec::new();
+    for (row, values) in rows {
+        let lot = values.get(id).map_or("", |v| v.trim());
+        for &(i, field) in &columns {
+            let value = values.get(i).map_or("", |v| v.trim());
+            if value.is_empty() || lot.is_empty() {
+                continue;
+            }
+            if out.len() >= MAX_ROWS {
+                return Err(bad(row, format!("more than {MAX_ROWS} overrides")));
+            }
+            let o = Override {
+                lot: lot.to_string(),
+                field: field.to_string(),
+                value: value.to_string(),
+                row,
+            };
+            check(&o).map_err(|m| bad(row, m))?;
+            out.push(o);
+        }
+    }
+    Ok(out)
 }
 
 /// The overrides file by its name alone: it may lie outside the input, and a build publishes

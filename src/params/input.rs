@@ -11,6 +11,10 @@ pub struct InputParams {
     /// directory of the parameter file that names it, as `garden.designs` is.
     #[serde(default)]
     pub overrides: String,
+    /// With a GeoPackage `overrides` (a build's plan.gpkg edited in QGIS): the layer whose
+    /// rows are the overrides; "" = `lots`.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub overrides_layer: String,
     /// The overrides given in memory instead of read from `overrides` (the workbench's
     /// edits not saved yet, which a build must show as `build --params` will once they
     /// are): never in a parameter file or a manifest.
@@ -35,5 +39,6 @@ pub(super) mod partial {
     #[allow(dead_code)]
     pub struct Input {
         overrides: Option<String>,
+        overrides_layer: Option<String>,
     }
 }
