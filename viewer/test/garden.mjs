@@ -130,12 +130,22 @@ try {
       garden.corner[1] + (garden.size[0] / 2) * Math.sin(garden.angle) + (garden.size[1] / 2) * Math.cos(garden.angle),
       garden.ground,
     ]);
-    await page.waitForFunction(() => window.edoCity.ready);
-    out.stone_nodes = await page.evaluate(() => {
+    const stones = () => {
       let n = 0;
       window.edoCity.scene.traverse((o) => { if (o.userData.kind === 'stone' && o.visible) n += 1; });
       return n;
-    });
+    };
+    // `ready` can hold for a frame before the new view's leaves are asked for (the tiles'
+    // progress is still the old view's 1): wait for the stones themselves, two minutes at
+    // most, so a slow machine is not taken for a garden that was not built.
+    await page
+      .waitForFunction(() => {
+        let n = 0;
+        window.edoCity.scene.traverse((o) => { if (o.userData.kind === 'stone' && o.visible) n += 1; });
+        return window.edoCity.ready && n > 0;
+      }, null, { timeout: 120000 })
+      .catch(() => null);
+    out.stone_nodes = await page.evaluate(stones);
     if (arg4) await page.screenshot({ path: `${arg4}/garden-kept.jpg`, type: 'jpeg', quality: 85 });
   } else if (phase === 'time') {
     const population = Number(arg4);
