@@ -620,3 +620,98 @@ fn a_plan_gpkg_edited_in_qgis_is_read_back_as_overrides() {
     assert!(err.contains("lies inside its --out"), "{err}");
     assert_eq!(std::fs::read(first.join("plan.gpkg")).unwrap(), plan_before);
 }
+
+/// The real-data cut `set` (fixtures/real) built with its example parameter file, and again
+/// with every shapefile it names converted by `ogr2ogr` to `format` (one GeoPackage of all
+/// of them, or a FlatGeobuf each, without GDAL's index): the OBJ tiles of both builds.
+fn real_in(
+    set: &str,
+    example: &str,
+    format: &str,
+) -> (Vec<(String, String)>, Vec<(String, String)>) {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    let copied = Command::new("cp")
+        .arg("-r")
+        .arg(repo.join("fixtures/real").join(set))
+        .arg(&input)
+        .status()
+        .unwrap();
+    assert!(copied.success());
+    // The example's layers rewritten to the converted files (Python's tomllib reads it; the
+    // text is edited so that its comments and order stay).
+    let script = r#"
+import subprocess, sys, tomllib
+example, fmt, input_dir, out_toml, repo = sys.argv[1:6]
+params = tomllib.load(open(example, 'rb'))
+text = open(example).read()
+first = True
+for role, t in params.get('layers', {}).items():
+    f = t.get('file', '')
+    if not f.endswith('.shp'):
+        continue
+    if fmt == 'gpkg':
+        args = ['ogr2ogr', '-f', 'GPKG', '-nln', role] + ([] if first else ['-update'])
+        args += [input_dir + '/town.gpkg', input_dir + '/' + f]
+        new = 'file = "town.gpkg"\nlayer = "%s"' % role
+    else:
+        # FlatGeobuf holds one geometry type a layer: mixed lines and multi-lines are
+        # written as multi-lines.
+        args = ['ogr2ogr', '-f', 'FlatGeobuf', '-lco', 'SPATIAL_INDEX=NO',
+                '-nlt', 'PROMOTE_TO_MULTI', input_dir + '/' + role + '.fgb', input_dir + '/' + f]
+        new = 'file = "%s.fgb"' % role
+    subprocess.run(args, check=True, capture_output=True)
+    first = False
+    text = text.replace('file = "%s"' % f, new)
+text = text.replace('models_dir = "fixtures/', 'models_dir = "%s/fixtures/' % repo)
+open(out_toml, 'w').write(text)
+"#;
+    let example = repo.join("params/examples").join(format!("{example}.toml"));
+    let shp_params = dir.path().join("shp.toml");
+    let converted = dir.path().join("converted.toml");
+    let text = std::fs::read_to_string(&example).unwrap().replace(
+        "models_dir = \"fixtures/",
+        &format!("models_dir = \"{}/fixtures/", repo.display()),
+    );
+    std::fs::write(&shp_params, text).unwrap();
+    let o = Command::new("python3")
+        .args(["-c", script])
+        .arg(&example)
+        .arg(format)
+        .arg(&input)
+        .arg(&converted)
+        .arg(repo)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let a = dir.path().join("from-shp");
+    build_ok(
+        &input,
+        &a,
+        &["--quiet", "--params", shp_params.to_str().unwrap()],
+    );
+    let b = dir.path().join("converted");
+    build_ok(
+        &input,
+        &b,
+        &["--quiet", "--params", converted.to_str().unwrap()],
+    );
+    (tile_hashes(&a, &["obj"]), tile_hashes(&b, &["obj"]))
+}
+
+#[test]
+fn the_real_data_cut_builds_the_same_tiles_from_a_geopackage_and_flatgeobuf() {
+    // Chino: Shift_JIS parcels, multi-part road lines, split lines carrying widths,
+    // districts and landmarks; Osaka: PLATEAU footprints on road surfaces.
+    for (set, example) in [
+        ("chino_plateau_devpermit", "chino"),
+        ("osaka_plateau", "osaka"),
+    ] {
+        for format in ["gpkg", "fgb"] {
+            let (shp, converted) = real_in(set, example, format);
+            assert!(!shp.is_empty(), "{set}");
+            assert_eq!(shp, converted, "{set} from {format}");
+        }
+    }
+}
