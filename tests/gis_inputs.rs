@@ -621,14 +621,13 @@ fn a_plan_gpkg_edited_in_qgis_is_read_back_as_overrides() {
     assert_eq!(std::fs::read(first.join("plan.gpkg")).unwrap(), plan_before);
 }
 
+/// Each tile's id and the sha256 of its files, as `tile_hashes` lists them.
+type Hashes = Vec<(String, String)>;
+
 /// The real-data cut `set` (fixtures/real) built with its example parameter file, and again
 /// with every shapefile it names converted by `ogr2ogr` to `format` (one GeoPackage of all
 /// of them, or a FlatGeobuf each, without GDAL's index): the OBJ tiles of both builds.
-fn real_in(
-    set: &str,
-    example: &str,
-    format: &str,
-) -> (Vec<(String, String)>, Vec<(String, String)>) {
+fn real_in(set: &str, example: &str, format: &str) -> (Hashes, Hashes) {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("in");
