@@ -53,6 +53,24 @@ fn token(port: u16) -> String {
     t["token"].as_str().unwrap().to_string()
 }
 
+/// The example town built by the CLI with the parameter file `params` into `dir/name`
+/// (GLB tiles): what a saved hypothesis gives.
+fn cli_build(dir: &Path, name: &str, params: &Path) -> PathBuf {
+    let out = dir.join(name);
+    build_ok(
+        &fixture("kyoto-small"),
+        &out,
+        &[
+            "--quiet",
+            "--format",
+            "glb",
+            "--params",
+            params.to_str().unwrap(),
+        ],
+    );
+    out
+}
+
 /// The example town built once into `dir/out`, and a parameter file `dir/hyp.toml`.
 fn town(dir: &Path, params: &str) -> (PathBuf, PathBuf) {
     let out = dir.join("out");
@@ -139,18 +157,8 @@ fn a_save_during_a_failing_edit_writes_only_what_built() {
     let rows = std::fs::read_to_string(dir.path().join("hyp.overrides.csv")).unwrap();
     assert_eq!(rows, "lot,field,value\n9,mtype,sangai\n");
     // What was saved builds.
-    let again = dir.path().join("again");
-    build_ok(
-        &fixture("kyoto-small"),
-        &again,
-        &[
-            "--quiet",
-            "--format",
-            "glb",
-            "--params",
-            params.to_str().unwrap(),
-        ],
-    );
+    let again = cli_build(dir.path(), "again", &params);
+    assert!(again.join("manifest.json").is_file());
 }
 
 #[test]
@@ -305,18 +313,7 @@ fn a_cli_build_of_out_under_the_workbench_is_noticed() {
     let s = idle(port);
     assert!(s["notice"].as_str().unwrap().contains("another run"), "{s}");
     assert_eq!(post(port, &token, "/api/edit/save", json!({})).0, 200);
-    let cli = dir.path().join("cli");
-    build_ok(
-        &fixture("kyoto-small"),
-        &cli,
-        &[
-            "--quiet",
-            "--format",
-            "glb",
-            "--params",
-            params.to_str().unwrap(),
-        ],
-    );
+    let cli = cli_build(dir.path(), "cli", &params);
     assert_eq!(tile_hashes(&out, &["glb"]), tile_hashes(&cli, &["glb"]));
 }
 
@@ -370,18 +367,7 @@ fn the_largest_seed_rerolls_and_a_formula_is_saved_as_text() {
     let rows = std::fs::read_to_string(dir.path().join("hyp.overrides.csv")).unwrap();
     assert!(rows.contains("9,district,\"'=HYPERLINK"), "{rows}");
     // Read back as it went in: the build of the saved file is what was served.
-    let cli = dir.path().join("cli");
-    build_ok(
-        &fixture("kyoto-small"),
-        &cli,
-        &[
-            "--quiet",
-            "--format",
-            "glb",
-            "--params",
-            params.to_str().unwrap(),
-        ],
-    );
+    let cli = cli_build(dir.path(), "cli", &params);
     assert_eq!(tile_hashes(&out, &["glb"]), tile_hashes(&cli, &["glb"]));
 }
 

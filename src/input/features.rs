@@ -13,7 +13,9 @@ use geozero::{ColumnValue, CoordDimensions, FeatureProcessor, GeomProcessor, Pro
 use shapefile::{Point, PointZ, PolygonRing, Shape};
 
 use super::shp::Feature;
+use super::InputError;
 use crate::model::Attrs;
+use std::path::Path;
 
 /// The most points reserved ahead for one part, whatever its header says.
 const RESERVE: usize = 4096;
@@ -158,6 +160,29 @@ impl Collector {
         if let Some(p) = self.geometry.part.take() {
             self.geometry.parts.push(p);
         }
+    }
+}
+
+/// Opens the regular file `path` of a layer of at most `cap` bytes (`format` names its
+/// kind, `hint` says what to do with a larger one): the file and its length.
+pub fn open_layer(
+    path: &Path,
+    cap: u64,
+    format: &str,
+    hint: &str,
+) -> std::result::Result<(std::fs::File, u64), InputError> {
+    let err = |message: String| InputError::Layer {
+        file: path.display().to_string(),
+        message,
+    };
+    let (file, meta) =
+        crate::bounded::open(path).map_err(|e| err(format!("cannot open it: {e}")))?;
+    match meta.len() > cap {
+        true => Err(err(format!(
+            "{} bytes, more than the {cap} a {format} layer may have{hint}",
+            meta.len()
+        ))),
+        false => Ok((file, meta.len())),
     }
 }
 

@@ -29,14 +29,7 @@ pub fn read_layer(path: &Path) -> Result<Layer, InputError> {
         file: path.display().to_string(),
         message,
     };
-    let (file, meta) =
-        crate::bounded::open(path).map_err(|e| err(format!("cannot open it: {e}")))?;
-    if meta.len() > MAX_BYTES {
-        return Err(err(format!(
-            "{} bytes, more than the {MAX_BYTES} a FlatGeobuf layer may have",
-            meta.len()
-        )));
-    }
+    let (file, len) = super::features::open_layer(path, MAX_BYTES, "FlatGeobuf", "")?;
     let mut r = BufReader::with_capacity(1 << 20, file);
     let fgb = FgbReader::open(&mut r)
         .map_err(|e| err(format!("not a FlatGeobuf file edo-city can read: {e}")))?;
@@ -49,7 +42,7 @@ pub fn read_layer(path: &Path) -> Result<Layer, InputError> {
         .map(|c| c.iter().map(|c| c.name().to_string()).collect())
         .unwrap_or_default();
     let (file, _) = crate::bounded::open(path).map_err(|e| err(format!("cannot open it: {e}")))?;
-    let found = walk(file, meta.len(), declared, node).map_err(err)?;
+    let found = walk(file, len, declared, node).map_err(err)?;
     let mut c = Collector::default();
     let mut iter = fgb
         .select_all_seq()

@@ -27,16 +27,11 @@ pub fn read_layer(path: &Path) -> Result<Layer, InputError> {
         file: path.display().to_string(),
         message,
     };
-    let (file, meta) =
-        crate::bounded::open(path).map_err(|e| err(format!("cannot open it: {e}")))?;
-    if meta.len() > MAX_BYTES {
-        return Err(err(format!(
-            "{} bytes, more than the {MAX_BYTES} a GeoJSON layer may have: save it as a \
-             GeoPackage (ogr2ogr -f GPKG town.gpkg {})",
-            meta.len(),
-            path.display()
-        )));
-    }
+    let hint = format!(
+        ": save it as a GeoPackage (ogr2ogr -f GPKG town.gpkg {})",
+        path.display()
+    );
+    let (file, _) = super::features::open_layer(path, MAX_BYTES, "GeoJSON", &hint)?;
     let mut head = Vec::new();
     (&file)
         .take(HEAD)
