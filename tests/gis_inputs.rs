@@ -714,3 +714,83 @@ fn the_real_data_cut_builds_the_same_tiles_from_a_geopackage_and_flatgeobuf() {
         }
     }
 }
+
+#[test]
+fn three_d_lots_from_a_geopackage_build_as_three_d_shapefiles_do() {
+    // The example town's lots given a z of 7 m (GDAL's -zfield takes it from a field; here
+    // a constant column made first), written as a 3D shapefile and as a 3D GeoPackage:
+    // both build the same tiles, each house on its lot's lowest z.
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in3d");
+    std::fs::create_dir_all(&input).unwrap();
+    let fixture = fixture("kyoto-small");
+    let lots = fixture.join("lots.shp");
+    let sql = "SELECT *, 7.0 AS z FROM lots";
+    ogr2ogr(&[
+        "-f",
+        "ESRI Shapefile",
+        "-dialect",
+        "SQLite",
+        "-sql",
+        sql,
+        "-zfield",
+        "z",
+        "-dim",
+        "XYZ",
+        input.join("lots.shp").to_str().unwrap(),
+        lots.to_str().unwrap(),
+    ]);
+    let gpkg = input.join("town.gpkg");
+    ogr2ogr(&[
+        "-f",
+        "GPKG",
+        "-nln",
+        "lots",
+        gpkg.to_str().unwrap(),
+        input.join("lots.shp").to_str().unwrap(),
+    ]);
+    for f in [
+        "blocks.shp",
+        "blocks.shx",
+        "blocks.dbf",
+        "blocks.prj",
+        "blocks.cpg",
+        "streets.shp",
+        "streets.shx",
+        "streets.dbf",
+        "streets.prj",
+        "streets.cpg",
+        "lots.csv",
+    ] {
+        std::fs::copy(fixture.join(f), input.join(f)).unwrap();
+    }
+    let info = Command::new("ogrinfo")
+        .args(["-so", "-al", gpkg.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        String::from_utf8_lossy(&info.stdout).contains("3D Polygon"),
+        "a 3D layer"
+    );
+    let from_shp = dir.path().join("shp3d");
+    build_ok(&input, &from_shp, &["--quiet"]);
+    let p = dir.path().join("gpkg3d.toml");
+    std::fs::write(&p, "[layers.lots]\nfile = \"town.gpkg\"\n").unwrap();
+    let from_gpkg = dir.path().join("gpkg3d");
+    build_ok(
+        &input,
+        &from_gpkg,
+        &["--quiet", "--params", p.to_str().unwrap()],
+    );
+    assert_eq!(
+        tile_hashes(&from_gpkg, &["obj"]),
+        tile_hashes(&from_shp, &["obj"])
+    );
+    // And the z is taken: the 2D town's tiles are other.
+    let flat = dir.path().join("flat");
+    build_ok(&fixture, &flat, &["--quiet", "--format", "obj"]);
+    assert_ne!(
+        tile_hashes(&from_shp, &["obj"]),
+        tile_hashes(&flat, &["obj"])
+    );
+}
