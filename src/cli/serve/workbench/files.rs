@@ -66,6 +66,21 @@ impl Files {
             Some(serde_json::Value::String(f)) if !f.is_empty() => dir.join(f),
             _ => dir.join(format!("{stem}.overrides.csv")),
         };
+        // A GeoPackage of overrides (a plan.gpkg edited in QGIS) is read by builds, but the
+        // workbench writes its edits as CSV rows: it would write them over the package.
+        if overrides
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("gpkg"))
+        {
+            anyhow::bail!(
+                "--edit {}: its overrides are a GeoPackage ({}), which builds read but the \
+                 workbench cannot write its lot edits to: start `serve --edit` on a parameter \
+                 file whose `[input] overrides` names a CSV table (or nothing), or set the \
+                 GeoPackage's changes in the page by lot",
+                params.display(),
+                overrides.display()
+            );
+        }
         Ok(Files {
             history: dir.join(format!("{stem}.history.jsonl")),
             overrides,

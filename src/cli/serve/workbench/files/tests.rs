@@ -193,6 +193,15 @@ fn a_killed_saves_temporaries_are_swept_and_nothing_else() {
 }
 
 #[test]
+fn overrides_in_a_geopackage_are_not_the_workbenchs_to_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("hyp.toml");
+    std::fs::write(&p, "[input]\noverrides = \"corrections.gpkg\"\n").unwrap();
+    let e = Files::of(&p).err().unwrap().to_string();
+    assert!(e.contains("its overrides are a GeoPackage"), "{e}");
+}
+
+#[test]
 fn a_file_that_is_not_text_is_named_for_what_it_is() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("lots.shp");
