@@ -794,3 +794,40 @@ fn three_d_lots_from_a_geopackage_build_as_three_d_shapefiles_do() {
         tile_hashes(&flat, &["obj"])
     );
 }
+
+#[test]
+fn a_geopackage_in_the_wrong_crs_is_named_for_its_own_spatial_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("wrong");
+    std::fs::create_dir_all(&input).unwrap();
+    let gpkg = input.join("town.gpkg");
+    // Metres assigned WGS84 degrees (a slip in QGIS's Assign Projection).
+    let lots = fixture("kyoto-small").join("lots.shp");
+    ogr2ogr(&[
+        "-f",
+        "GPKG",
+        "-nln",
+        "lots",
+        "-a_srs",
+        "EPSG:4326",
+        gpkg.to_str().unwrap(),
+        lots.to_str().unwrap(),
+    ]);
+    let p = dir.path().join("wrong.toml");
+    std::fs::write(&p, "[layers.lots]\nfile = \"town.gpkg\"\n[layers.blocks]\nfile = \"\"\n[layers.streets]\nfile = \"\"\n").unwrap();
+    let o = build_cmd(
+        &input,
+        &dir.path().join("o"),
+        &["--params", p.to_str().unwrap()],
+    )
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("town.gpkg")
+            && err.contains("its GeoPackage spatial reference says longitude/latitude"),
+        "{err}"
+    );
+    assert!(!err.contains(".prj"), "{err}");
+}

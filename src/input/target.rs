@@ -47,7 +47,7 @@ pub(super) fn degrees_in_metres(
     let coords = layer_coords(o);
     if !coords.is_empty() && crs::looks_like_degrees(coords) {
         let source = match o.layer.prj {
-            Some(_) => "its .prj".to_string(),
+            Some(_) => format!("its {}", said_by(o)),
             None => format!("`crs` = {}", params.crs),
         };
         warnings.push(crate::model::Warning::layer(
@@ -55,11 +55,32 @@ pub(super) fn degrees_in_metres(
             &o.file,
             format!(
             "{}: every coordinate lies within +-180 / +-90, like longitude/latitude in degrees, \
-             but {source} says projected metres ({}); if they are degrees, replace the .prj \
-             with a WGS84 one or remove it",
-            o.file, said.definition
+             but {source} says projected metres ({}); if they are degrees, {}",
+            o.file,
+            said.definition,
+            match is_shapefile(o) {
+                true => "replace the .prj with a WGS84 one or remove it",
+                false => "assign the layer WGS84 in QGIS (Layer > Assign Projection) and save it again",
+            }
         ),
         ));
+    }
+}
+
+/// Whether the layer is a shapefile (its CRS in a `.prj` beside it).
+fn is_shapefile(o: &Opened) -> bool {
+    super::layers::Format::of(&o.layer.path) == super::layers::Format::Shapefile
+}
+
+/// What says a layer's CRS, for a message: a shapefile's `.prj`, a GeoPackage's spatial
+/// reference, GeoJSON's CRS, a FlatGeobuf header.
+fn said_by(o: &Opened) -> &'static str {
+    use super::layers::Format;
+    match Format::of(&o.layer.path) {
+        Format::Shapefile => ".prj",
+        Format::GeoPackage => "GeoPackage spatial reference",
+        Format::GeoJson => "CRS (RFC 7946: longitude/latitude, or the `crs` member)",
+        Format::FlatGeobuf => "header's CRS",
     }
 }
 
@@ -78,13 +99,24 @@ fn metres_in_degrees(o: &Opened) -> Result<(), InputError> {
         None => Ok(()),
         Some(c) => Err(InputError::Layer {
             file: o.file.clone(),
-            message: format!(
-                "its .prj says longitude/latitude degrees ({}) but a coordinate is ({}, {}), \
-                 far past +-180 / +-90: the numbers are projected metres and the .prj belongs \
-                 to another file; put the layer's own .prj beside it, or remove the .prj and \
-                 set `crs` to the CRS the numbers are in",
-                src.definition, c.x, c.y
-            ),
+            message: match is_shapefile(o) {
+                true => format!(
+                    "its .prj says longitude/latitude degrees ({}) but a coordinate is ({}, {}), \
+                     far past +-180 / +-90: the numbers are projected metres and the .prj \
+                     belongs to another file; put the layer's own .prj beside it, or remove \
+                     the .prj and set `crs` to the CRS the numbers are in",
+                    src.definition, c.x, c.y
+                ),
+                false => format!(
+                    "its {} says longitude/latitude degrees ({}) but a coordinate is ({}, {}), \
+                     far past +-180 / +-90: the numbers are projected metres; assign the layer \
+                     the CRS they are in (in QGIS: Layer > Assign Projection) and save it again",
+                    said_by(o),
+                    src.definition,
+                    c.x,
+                    c.y
+                ),
+            },
         }),
     }
 }
@@ -112,9 +144,19 @@ pub(super) fn resolve_crs(
             degrees_in_metres(o, params, warnings);
         }
         o.src = match &o.layer.prj {
-            Some(wkt) => Some(Crs::from_wkt(wkt).map_err(|m| InputError::Layer {
-                file: o.file.replace(".shp", ".prj"),
-                message: format!("{m}; fix the .prj or remove it and set `crs`"),
+            Some(wkt) => Some(Crs::from_wkt(wkt).map_err(|m| match is_shapefile(o) {
+                true => InputError::Layer {
+                    file: o.file.replace(".shp", ".prj"),
+                    message: format!("{m}; fix the .prj or remove it and set `crs`"),
+                },
+                false => InputError::Layer {
+                    file: o.file.clone(),
+                    message: format!(
+                        "its {}: {m}; assign the layer a CRS edo-city knows (an EPSG code) in \
+                         QGIS and save it again",
+                        said_by(o)
+                    ),
+                },
             })?),
             None if !params.crs.trim().is_empty() => {
                 warnings.push(
