@@ -50,6 +50,40 @@ fn town_gpkg(dir: &Path) -> (PathBuf, PathBuf) {
     (input, params)
 }
 
+/// A parameter file's text naming the example town's lots, blocks and streets as
+/// `<role>.<ext>` (one file a layer: GeoJSON, FlatGeobuf).
+fn one_file_a_layer(ext: &str) -> String {
+    ["lots", "blocks", "streets"]
+        .map(|role| format!("[layers.{role}]\nfile = \"{role}.{ext}\"\n"))
+        .concat()
+}
+
+/// Builds `input` with `params` into `dir/converted` and the example town's shapefiles into
+/// `dir/shp`, and asserts their OBJ tiles are the same bytes; both directories.
+fn builds_the_shapefiles_obj(dir: &Path, input: &Path, params: &Path) -> (PathBuf, PathBuf) {
+    let converted = dir.join("converted");
+    build_ok(
+        input,
+        &converted,
+        &["--quiet", "--params", params.to_str().unwrap()],
+    );
+    let from_shp = dir.join("shp");
+    build_ok(&fixture("kyoto-small"), &from_shp, &["--quiet"]);
+    assert_eq!(
+        tile_hashes(&converted, &["obj"]),
+        tile_hashes(&from_shp, &["obj"])
+    );
+    (converted, from_shp)
+}
+
+/// Builds `input` into `out` with `args`, which must be refused (exit 2); what it said.
+fn refused(input: &Path, out: &Path, args: &[&str]) -> String {
+    let o = build_cmd(input, out, args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    err
+}
+
 /// A GLB's JSON chunk and its binary chunk.
 fn glb_parts(path: &Path) -> (serde_json::Value, Vec<u8>) {
     let b = std::fs::read(path).unwrap();
@@ -62,19 +96,8 @@ fn glb_parts(path: &Path) -> (serde_json::Value, Vec<u8>) {
 fn a_geopackage_of_the_town_builds_the_shapefiles_tiles() {
     let dir = tempfile::tempdir().unwrap();
     let (input, params) = town_gpkg(dir.path());
-    let from_gpkg = dir.path().join("gpkg");
-    build_ok(
-        &input,
-        &from_gpkg,
-        &["--quiet", "--params", params.to_str().unwrap()],
-    );
-    let from_shp = dir.path().join("shp");
-    build_ok(&fixture("kyoto-small"), &from_shp, &["--quiet"]);
     // Every OBJ tile byte for byte.
-    assert_eq!(
-        tile_hashes(&from_gpkg, &["obj"]),
-        tile_hashes(&from_shp, &["obj"])
-    );
+    let (from_gpkg, from_shp) = builds_the_shapefiles_obj(dir.path(), &input, &params);
     // Every GLB: the same binary chunk; its metadata's list of source files names the
     // GeoPackage instead of lots.shp, and nothing else differs.
     let tiles = tile_hashes(&from_shp, &["glb"]);
@@ -163,24 +186,8 @@ fn geojson_of_the_town_builds_the_shapefiles_tiles() {
     exact_geojson(&input.join("town.gpkg"), &["lots", "blocks", "streets"]);
     std::fs::remove_file(input.join("town.gpkg")).unwrap();
     let p = dir.path().join("json.toml");
-    std::fs::write(
-        &p,
-        "[layers.lots]\nfile = \"lots.geojson\"\n[layers.blocks]\nfile = \"blocks.geojson\"\n\
-         [layers.streets]\nfile = \"streets.geojson\"\n",
-    )
-    .unwrap();
-    let from_json = dir.path().join("json");
-    build_ok(
-        &input,
-        &from_json,
-        &["--quiet", "--params", p.to_str().unwrap()],
-    );
-    let from_shp = dir.path().join("shp");
-    build_ok(&fixture("kyoto-small"), &from_shp, &["--quiet"]);
-    assert_eq!(
-        tile_hashes(&from_json, &["obj"]),
-        tile_hashes(&from_shp, &["obj"])
-    );
+    std::fs::write(&p, one_file_a_layer("geojson")).unwrap();
+    builds_the_shapefiles_obj(dir.path(), &input, &p);
 }
 
 #[test]
@@ -204,12 +211,8 @@ fn a_geopackage_attributes_table_is_joined_as_the_csv_is() {
         "layer = \"lots\"\ntable = \"town.gpkg\"\nsheet = \"lot_attributes\"\n",
     );
     std::fs::write(&params, text).unwrap();
-    let joined = dir.path().join("joined");
-    let report = build_ok(
-        &input,
-        &joined,
-        &["--quiet", "--params", params.to_str().unwrap()],
-    );
+    let (joined, _) = builds_the_shapefiles_obj(dir.path(), &input, &params);
+    let report = read_json(&joined.join("report.json"));
     let t = &report["tables"][0];
     assert_eq!(
         (t["rows"].as_u64(), t["matched"].as_u64()),
@@ -217,12 +220,6 @@ fn a_geopackage_attributes_table_is_joined_as_the_csv_is() {
         "{t}"
     );
     assert!(t["file"].as_str().unwrap().ends_with("town.gpkg"), "{t}");
-    let from_shp = dir.path().join("shp");
-    build_ok(&fixture("kyoto-small"), &from_shp, &["--quiet"]);
-    assert_eq!(
-        tile_hashes(&joined, &["obj"]),
-        tile_hashes(&from_shp, &["obj"])
-    );
 }
 
 #[test]
@@ -247,15 +244,11 @@ fn a_geopackage_layer_is_found_by_its_name_and_a_wrong_one_is_named() {
         "[layers.lots]\nfile = \"town.gpkg\"\nlayer = \"parcels\"\n",
     )
     .unwrap();
-    let o = build_cmd(
+    let err = refused(
         &input,
         &dir.path().join("o2"),
         &["--params", p.to_str().unwrap()],
-    )
-    .output()
-    .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    );
     assert!(
         err.contains("town.gpkg")
             && err.contains("no feature layer `parcels`")
@@ -281,12 +274,7 @@ fn geojson_in_lon_lat_and_in_a_named_crs_builds() {
         }
         std::fs::copy(fixture.join("lots.csv"), input.join("lots.csv")).unwrap();
         let p = dir.path().join(format!("{name}.toml"));
-        std::fs::write(
-            &p,
-            "[layers.lots]\nfile = \"lots.geojson\"\n[layers.blocks]\nfile = \"blocks.geojson\"\n\
-             [layers.streets]\nfile = \"streets.geojson\"\n",
-        )
-        .unwrap();
+        std::fs::write(&p, one_file_a_layer("geojson")).unwrap();
         let report = build_ok(
             &input,
             &dir.path().join(format!("out-{name}")),
@@ -325,15 +313,11 @@ fn a_geopackage_from_elsewhere_runs_nothing_and_reads_no_view() {
         "[layers.lots]\nfile = \"town.gpkg\"\nlayer = \"forever\"\n",
     )
     .unwrap();
-    let o = build_cmd(
+    let err = refused(
         &input,
         &dir.path().join("o"),
         &["--params", p.to_str().unwrap()],
-    )
-    .output()
-    .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    );
     assert!(err.contains("`forever` is a view, not a table"), "{err}");
     // The lying blob: lot 1 is read as empty and skipped, with a warning; the rest builds.
     let report = build_ok(
@@ -351,15 +335,12 @@ fn a_geopackage_from_elsewhere_runs_nothing_and_reads_no_view() {
         .unwrap()
         .success());
     std::fs::write(&p, "[layers.lots]\nfile = \"fifo.gpkg\"\n").unwrap();
-    let o = build_cmd(
+    let err = refused(
         &input,
         &dir.path().join("o4"),
         &["--params", p.to_str().unwrap()],
-    )
-    .output()
-    .unwrap();
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("fifo.gpkg"));
+    );
+    assert!(err.contains("fifo.gpkg"), "{err}");
 }
 
 /// Runs `sql` on the package with the sqlite3 of Python's standard library (the test's own
@@ -383,11 +364,7 @@ fn a_directory_holding_only_a_geopackage_is_named_by_build_and_read_by_init() {
     for table in ["lots.csv", "links.csv"] {
         std::fs::remove_file(input.join(table)).unwrap();
     }
-    let o = build_cmd(&input, &dir.path().join("o"), &[])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = refused(&input, &dir.path().join("o"), &[]);
     assert!(
         err.contains("the directory holds town.gpkg") && err.contains("edo-city init"),
         "{err}"
@@ -437,12 +414,7 @@ fn town_fgb(dir: &Path, more: &[&str]) -> (PathBuf, PathBuf) {
         std::fs::copy(fixture.join(table), input.join(table)).unwrap();
     }
     let params = dir.join("fgb.toml");
-    std::fs::write(
-        &params,
-        "[layers.lots]\nfile = \"lots.fgb\"\n[layers.blocks]\nfile = \"blocks.fgb\"\n\
-         [layers.streets]\nfile = \"streets.fgb\"\n",
-    )
-    .unwrap();
+    std::fs::write(&params, one_file_a_layer("fgb")).unwrap();
     (input, params)
 }
 
@@ -452,18 +424,7 @@ fn flatgeobuf_of_the_town_builds_the_shapefiles_tiles() {
     // Without GDAL's spatial index the features keep the shapefile's order, and so do the
     // draws that follow it: every OBJ tile byte for byte.
     let (input, params) = town_fgb(dir.path(), &["-lco", "SPATIAL_INDEX=NO"]);
-    let from_fgb = dir.path().join("from-fgb");
-    build_ok(
-        &input,
-        &from_fgb,
-        &["--quiet", "--params", params.to_str().unwrap()],
-    );
-    let from_shp = dir.path().join("shp");
-    build_ok(&fixture("kyoto-small"), &from_shp, &["--quiet"]);
-    assert_eq!(
-        tile_hashes(&from_fgb, &["obj"]),
-        tile_hashes(&from_shp, &["obj"])
-    );
+    builds_the_shapefiles_obj(dir.path(), &input, &params);
     // With it (GDAL's default), GDAL writes the features in the index's order: the file's
     // records are others, and every lot is still built.
     let indexed = tempfile::tempdir().unwrap();
@@ -492,15 +453,11 @@ fn a_flatgeobuf_whose_feature_lies_about_its_length_is_refused_before_it_is_read
     let at = 12 + header;
     bytes[at..at + 4].copy_from_slice(&0xffff_fff0u32.to_le_bytes());
     std::fs::write(&lots, &bytes).unwrap();
-    let o = build_cmd(
+    let err = refused(
         &input,
         &dir.path().join("o"),
         &["--params", params.to_str().unwrap()],
-    )
-    .output()
-    .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    );
     assert!(
         err.contains("lots.fgb") && err.contains("feature 0 says it is 4294967280 bytes"),
         "{err}"
@@ -509,15 +466,11 @@ fn a_flatgeobuf_whose_feature_lies_about_its_length_is_refused_before_it_is_read
     let mut bytes = std::fs::read(fixture_fgb(dir.path())).unwrap();
     bytes.truncate(bytes.len() - 10);
     std::fs::write(&lots, &bytes).unwrap();
-    let o = build_cmd(
+    let err = refused(
         &input,
         &dir.path().join("o2"),
         &["--params", params.to_str().unwrap()],
-    )
-    .output()
-    .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    );
     assert!(err.contains("cut short"), "{err}");
 }
 
@@ -587,15 +540,11 @@ fn a_plan_gpkg_edited_in_qgis_is_read_back_as_overrides() {
         ),
     ] {
         edited_plan(&first.join("plan.gpkg"), &edited, sql);
-        let o = build_cmd(
+        let err = refused(
             &fixture("kyoto-small"),
             &dir.path().join("refused"),
             &["--params", params.to_str().unwrap()],
-        )
-        .output()
-        .unwrap();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{err}");
+        );
         assert!(err.contains(says) && err.contains("edited.gpkg"), "{err}");
     }
     // The build's own plan.gpkg named as its overrides: refused, never written over.
@@ -608,15 +557,11 @@ fn a_plan_gpkg_edited_in_qgis_is_read_back_as_overrides() {
     )
     .unwrap();
     let plan_before = std::fs::read(first.join("plan.gpkg")).unwrap();
-    let o = build_cmd(
+    let err = refused(
         &fixture("kyoto-small"),
         &first,
         &["--force", "--params", params.to_str().unwrap()],
-    )
-    .output()
-    .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    );
     assert!(err.contains("lies inside its --out"), "{err}");
     assert_eq!(std::fs::read(first.join("plan.gpkg")).unwrap(), plan_before);
 }
@@ -815,15 +760,11 @@ fn a_geopackage_in_the_wrong_crs_is_named_for_its_own_spatial_reference() {
     ]);
     let p = dir.path().join("wrong.toml");
     std::fs::write(&p, "[layers.lots]\nfile = \"town.gpkg\"\n[layers.blocks]\nfile = \"\"\n[layers.streets]\nfile = \"\"\n").unwrap();
-    let o = build_cmd(
+    let err = refused(
         &input,
         &dir.path().join("o"),
         &["--params", p.to_str().unwrap()],
-    )
-    .output()
-    .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    );
     assert!(
         err.contains("town.gpkg")
             && err.contains("its GeoPackage spatial reference says longitude/latitude"),

@@ -6,33 +6,9 @@
 
 mod common;
 
-use std::path::Path;
-
-use common::designer::{ask, ask_with, error};
+use common::designer::{ask, error, post_to as post, serve_edit};
 use common::*;
 use serde_json::{json, Value};
-
-/// A POST of the page holding `token` to `route`, as the viewer sends it.
-fn post(port: u16, token: &str, route: &str, body: Value) -> (u16, Value) {
-    ask_with(
-        port,
-        &[("X-Edo-City-Token", token)],
-        "POST",
-        route,
-        &body.to_string(),
-    )
-}
-
-fn serve_edit(dir: &Path, outs: &[&Path], params: &Path) -> (Server, u16) {
-    let input = fixture("kyoto-small");
-    let more = [
-        "--edit".as_ref(),
-        params.as_os_str(),
-        "--input".as_ref(),
-        input.as_os_str(),
-    ];
-    common::designer::serve_with(dir, outs, &more)
-}
 
 /// Waits for the server's first build (every tile, to know what each is made from).
 fn settled(port: u16) -> Value {

@@ -11,30 +11,9 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use common::designer::{ask, ask_with, error};
+use common::designer::{ask, ask_with, error, page as token, post_to as post, serve_edit};
 use common::*;
 use serde_json::{json, Value};
-
-fn post(port: u16, token: &str, route: &str, body: Value) -> (u16, Value) {
-    ask_with(
-        port,
-        &[("X-Edo-City-Token", token)],
-        "POST",
-        route,
-        &body.to_string(),
-    )
-}
-
-fn serve_edit(dir: &Path, out: &Path, params: &Path) -> (Server, u16) {
-    let input = fixture("kyoto-small");
-    let more = [
-        "--edit".as_ref(),
-        params.as_os_str(),
-        "--input".as_ref(),
-        input.as_os_str(),
-    ];
-    common::designer::serve_with(dir, &[out], &more)
-}
 
 /// Waits until no build runs and none is asked for; the status then.
 fn idle(port: u16) -> Value {
@@ -46,11 +25,6 @@ fn idle(port: u16) -> Value {
         std::thread::sleep(Duration::from_millis(100));
     }
     panic!("the builds did not end");
-}
-
-fn token(port: u16) -> String {
-    let (_, t) = ask(port, "GET", "/api/token", "");
-    t["token"].as_str().unwrap().to_string()
 }
 
 /// The example town built by the CLI with the parameter file `params` into `dir/name`
@@ -93,7 +67,7 @@ fn a_failed_first_build_keeps_the_persons_hypothesis_and_writes_nothing() {
     let rows = "lot,field,value\n9,mtype,sangai\n10,use,buke\nlost-lot,mtype,hiraya\n";
     let table = dir.path().join("hyp.overrides.csv");
     std::fs::write(&table, rows).unwrap();
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     let s = idle(port);
     assert!(
         s["error"].as_str().unwrap().contains("lost-lot"),
@@ -128,7 +102,7 @@ fn a_failed_first_build_keeps_the_persons_hypothesis_and_writes_nothing() {
 fn a_save_during_a_failing_edit_writes_only_what_built() {
     let dir = tempfile::tempdir().unwrap();
     let (out, params) = town(dir.path(), "seed = 1\n");
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     idle(port);
     let token = token(port);
     let (status, _) = post(
@@ -165,7 +139,7 @@ fn a_save_during_a_failing_edit_writes_only_what_built() {
 fn edits_made_on_a_failing_build_are_answered_and_the_next_edit_builds() {
     let dir = tempfile::tempdir().unwrap();
     let (out, params) = town(dir.path(), "seed = 1\n");
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     idle(port);
     let token = token(port);
     let edits: Vec<_> = [
@@ -205,7 +179,7 @@ fn edits_made_on_a_failing_build_are_answered_and_the_next_edit_builds() {
 fn a_row_added_to_the_table_by_hand_is_never_dropped() {
     let dir = tempfile::tempdir().unwrap();
     let (out, params) = town(dir.path(), "seed = 1\n");
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     idle(port);
     let token = token(port);
     post(
@@ -234,7 +208,7 @@ fn a_row_added_to_the_table_by_hand_is_never_dropped() {
 fn a_page_sets_no_file_of_the_workbench_and_no_path_outside() {
     let dir = tempfile::tempdir().unwrap();
     let (out, params) = town(dir.path(), "seed = 1\n");
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     idle(port);
     let token = token(port);
     let set = |key: &str, value: Value| {
@@ -284,7 +258,7 @@ fn a_page_sets_no_file_of_the_workbench_and_no_path_outside() {
 fn a_cli_build_of_out_under_the_workbench_is_noticed() {
     let dir = tempfile::tempdir().unwrap();
     let (out, params) = town(dir.path(), "seed = 1\n");
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     idle(port);
     let tiles = tile_hashes(&out, &["glb"]).len();
     let other = dir.path().join("seed2.toml");
@@ -321,7 +295,7 @@ fn a_cli_build_of_out_under_the_workbench_is_noticed() {
 fn a_flood_of_token_requests_locks_no_page_out() {
     let dir = tempfile::tempdir().unwrap();
     let (out, params) = town(dir.path(), "seed = 1\n");
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     idle(port);
     let token = token(port);
     // Another site's `<img src>`: refused at once.
@@ -348,7 +322,7 @@ fn a_flood_of_token_requests_locks_no_page_out() {
 fn the_largest_seed_rerolls_and_a_formula_is_saved_as_text() {
     let dir = tempfile::tempdir().unwrap();
     let (out, params) = town(dir.path(), &format!("seed = {}\n", i64::MAX));
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     idle(port);
     let token = token(port);
     let (status, a) = post(port, &token, "/api/edit/reroll", json!({}));
@@ -410,7 +384,7 @@ fn serve_reads_a_parameter_file_within_the_bound_build_reads_it() {
 fn a_save_that_fails_writes_nothing_and_the_next_save_goes_through() {
     let dir = tempfile::tempdir().unwrap();
     let (out, params) = town(dir.path(), "# mine\nseed = 1\n");
-    let (_server, port) = serve_edit(dir.path(), &out, &params);
+    let (_server, port) = serve_edit(dir.path(), &[&out], &params);
     idle(port);
     let token = token(port);
     post(

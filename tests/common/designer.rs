@@ -72,6 +72,32 @@ pub fn post(port: u16, token: &str, route: &str, body: Value) -> (u16, Value) {
     )
 }
 
+/// A POST to `route` (the whole path) of the page holding `token`, as the viewer sends it.
+#[allow(dead_code)]
+pub fn post_to(port: u16, token: &str, route: &str, body: Value) -> (u16, Value) {
+    ask_with(
+        port,
+        &[("X-Edo-City-Token", token)],
+        "POST",
+        route,
+        &body.to_string(),
+    )
+}
+
+/// `edo-city serve OUTS --edit PARAMS --input fixtures/kyoto-small` with a stand-in viewer in
+/// `dir/viewer`: the server and its port.
+#[allow(dead_code)]
+pub fn serve_edit(dir: &Path, outs: &[&Path], params: &Path) -> (super::Server, u16) {
+    let input = super::fixture("kyoto-small");
+    let more = [
+        "--edit".as_ref(),
+        params.as_os_str(),
+        "--input".as_ref(),
+        input.as_os_str(),
+    ];
+    serve_with(dir, outs, &more)
+}
+
 /// The status and `error` text of an answer.
 pub fn error((status, v): (u16, Value)) -> (u16, String) {
     (status, v["error"].as_str().unwrap_or("").to_string())
