@@ -44,19 +44,21 @@ impl Workbench {
             };
             let result = self.build(&hyp, before);
             // What changed, lot by lot, off the lock: the pages' polls go on meanwhile.
+            // OUT's manifest read once: its fingerprint, and the origin the outlines need.
+            let after = self.manifest_bytes();
+            let manifest = after.as_deref().map(fingerprint);
             let t_lots = Instant::now();
             let new_lots = result
                 .as_ref()
                 .ok()
                 .map(|_| plan_lots(&self.place.out).unwrap_or_default());
             let changed_lots = match &new_lots {
-                Some(new) => self.outlines(lot_differences(&lots, new)),
+                Some(new) => outlines(lot_differences(&lots, new), origin(after.as_deref())),
                 None => Vec::new(),
             };
             if let Ok((_, made, timings)) = &result {
                 log_rebuild(rev, made.len(), t.elapsed(), timings, t_lots.elapsed());
             }
-            let manifest = self.manifest();
             let result = result.map(|(marks, made, _)| (marks, made));
             let mut s = self.lock();
             s.busy = false;
@@ -83,7 +85,6 @@ impl Workbench {
                     s.last_ms = t.elapsed().as_millis() as u64;
                     s.fingerprints = Arc::new(marks);
                     s.manifest = manifest;
-                    s.failed = None;
                 }
                 Err(message) => failed(&mut s, rev, message),
             }
@@ -116,35 +117,19 @@ impl Workbench {
         Ok((marks, made, outcome.timings))
     }
 
-    /// The sha256 of OUT's manifest as it is now (`None`: none, or unreadable).
+    /// OUT's manifest as it is now (`None`: none, or unreadable).
+    fn manifest_bytes(&self) -> Option<Vec<u8>> {
+        edo_city::bounded::read(&self.place.out.join("manifest.json"), 2 << 30).ok()
+    }
+
+    /// The sha256 of OUT's manifest as it is now.
     fn manifest(&self) -> Option<[u8; 32]> {
-        let path = self.place.out.join("manifest.json");
-        let bytes = edo_city::bounded::read(&path, 2 << 30).ok()?;
-        Some(Sha256::digest(&bytes).into())
+        self.manifest_bytes().as_deref().map(fingerprint)
     }
 
     /// Whether OUT's manifest is no longer the one the workbench's last build wrote.
     pub(super) fn out_changed(&self, s: &State) -> bool {
         s.manifest.is_some() && s.manifest != self.manifest()
-    }
-
-    /// The lots' rings moved to metres from the build's origin (the viewer's frame).
-    fn outlines(&self, mut lots: Vec<LotDiff>) -> Vec<LotDiff> {
-        let origin = edo_city::bounded::read(&self.place.out.join("manifest.json"), 2 << 30)
-            .ok()
-            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
-            .map_or([0.0, 0.0], |m| {
-                [
-                    m["origin"][0].as_f64().unwrap_or(0.0),
-                    m["origin"][1].as_f64().unwrap_or(0.0),
-                ]
-            });
-        for l in &mut lots {
-            for p in &mut l.ring {
-                *p = [p[0] - origin[0], p[1] - origin[1]];
-            }
-        }
-        lots
     }
 
     /// The lots where served build `h` and the hypothesis as built disagree (type, kura,
@@ -161,8 +146,36 @@ impl Workbench {
         })?;
         let other = plan_lots(dir).map_err(|e| refuse(422, e.to_string()))?;
         let now = self.lock().lots.clone();
-        Ok(self.outlines(lot_differences(&other, &now)))
+        let origin = origin(self.manifest_bytes().as_deref());
+        Ok(outlines(lot_differences(&other, &now), origin))
     }
+}
+
+/// A manifest's fingerprint: the sha256 of its bytes.
+fn fingerprint(bytes: &[u8]) -> [u8; 32] {
+    Sha256::digest(bytes).into()
+}
+
+/// The output origin a manifest gives (0, 0 without one).
+fn origin(manifest: Option<&[u8]>) -> [f64; 2] {
+    manifest
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(b).ok())
+        .map_or([0.0, 0.0], |m| {
+            [
+                m["origin"][0].as_f64().unwrap_or(0.0),
+                m["origin"][1].as_f64().unwrap_or(0.0),
+            ]
+        })
+}
+
+/// The lots' rings moved to metres from the build's `origin` (the viewer's frame).
+fn outlines(mut lots: Vec<LotDiff>, origin: [f64; 2]) -> Vec<LotDiff> {
+    for l in &mut lots {
+        for p in &mut l.ring {
+            *p = [p[0] - origin[0], p[1] - origin[1]];
+        }
+    }
+    lots
 }
 
 /// The build of revision `rev` failed with `message`: the hypothesis goes back to the last
@@ -176,11 +189,10 @@ fn failed(s: &mut State, rev: u64, message: String) {
         upto: s.requested,
         message,
     };
-    s.failures.push_back(f.clone());
+    s.failures.push_back(f);
     if s.failures.len() > MAX_FAILURES {
         s.failures.pop_front();
     }
-    s.failed = Some(f);
     let back = s.good.clone().unwrap_or_else(|| s.saved.clone());
     while let Some(top) = s.undo.pop() {
         if top == back {
@@ -258,8 +270,16 @@ mod tests {
         }
         assert!(f.message_for(on_top).contains("on top of revision 2"));
         // The next edit builds on what OUT holds.
+        assert_eq!(
+            s.error().map(|e| e.rev),
+            Some(failing),
+            "the status shows it"
+        );
         let next = edit(&mut s, hyp(5));
         assert!(next > f.upto);
+        // Its build succeeds: no error shows.
+        s.built = next;
+        assert!(s.error().is_none());
         assert_eq!(s.undo.pop(), Some(hyp(1)));
     }
 }

@@ -89,8 +89,6 @@ struct State {
     requested: u64,
     built: u64,
     tried: u64,
-    /// The last build's failure, while no build has succeeded since.
-    failed: Option<Failure>,
     /// The latest failures, newest last, for the requests still waiting on them.
     failures: VecDeque<Failure>,
     busy: bool,
@@ -109,6 +107,12 @@ struct State {
 }
 
 impl State {
+    /// The last build's failure, while no build has succeeded since (a success builds a
+    /// revision past every one a failure took back).
+    fn error(&self) -> Option<&Failure> {
+        self.failures.back().filter(|f| f.upto > self.built)
+    }
+
     /// Before the first build: the hypothesis on disk, nothing built yet.
     fn new(saved: Hypothesis, disk: Disk, lots: Arc<PlanLots>) -> State {
         State {
@@ -121,7 +125,6 @@ impl State {
             requested: 1,
             built: 0,
             tried: 0,
-            failed: None,
             failures: VecDeque::new(),
             busy: false,
             changed_tiles: Vec::new(),
@@ -447,7 +450,7 @@ impl Workbench {
             "changedTiles": s.changed_tiles,
             "changedLots": s.changed_lots,
             "lastMs": s.last_ms,
-            "error": s.failed.as_ref().map(|f| f.message.clone()),
+            "error": s.error().map(|f| f.message.clone()),
             "notice": s.notice,
             "saved": s.saved == s.now,
             "undo": s.undo.len(),
