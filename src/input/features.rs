@@ -54,12 +54,11 @@ struct Building {
 #[derive(Default)]
 pub struct Collector {
     pub features: Vec<Feature>,
-    pub fields: Vec<String>,
     /// Geometries a shapefile cannot hold, by kind, read as empty.
     pub unsupported: std::collections::BTreeMap<&'static str, usize>,
     geometry: Building,
     attrs: Vec<(std::sync::Arc<str>, String)>,
-    /// Each field's name, shared by every feature's attributes.
+    /// Each field's name in the order first met, shared by every feature's attributes.
     names: Vec<std::sync::Arc<str>>,
 }
 
@@ -112,12 +111,16 @@ impl Collector {
         })
     }
 
+    /// The fields' names in the order they were first met.
+    pub fn fields(&self) -> Vec<String> {
+        self.names.iter().map(|n| n.to_string()).collect()
+    }
+
     /// One attribute of the feature begun last, as text.
     pub fn attribute(&mut self, name: &str, value: String) {
         let shared = match self.names.iter().find(|n| &***n == name) {
             Some(n) => n.clone(),
             None => {
-                self.fields.push(name.to_string());
                 self.names.push(name.into());
                 self.names[self.names.len() - 1].clone()
             }

@@ -45,8 +45,9 @@ pub fn read_layer(path: &Path) -> Result<Layer, InputError> {
                 "its `crs` names EPSG:{code}, which edo-city does not know"
             ))
         })?;
-    let (file, _) = crate::bounded::open(path).map_err(|e| err(format!("cannot open it: {e}")))?;
-    let reader = std::io::BufReader::with_capacity(1 << 20, file.take(MAX_BYTES));
+    // The beginning already read, then the rest of the same file: it is opened and read once.
+    let rest = file.take(MAX_BYTES - head.len() as u64);
+    let reader = std::io::BufReader::with_capacity(1 << 20, head.as_slice().chain(rest));
     let mut c = Collector::default();
     geozero::geojson::read_geojson_fc(reader, &mut c).map_err(|e| {
         err(format!(
@@ -67,7 +68,7 @@ pub fn read_layer(path: &Path) -> Result<Layer, InputError> {
         features: std::mem::take(&mut c.features),
         encoding: "UTF-8 (GeoJSON)".into(),
         text_encoding: Some(encoding_rs::UTF_8),
-        fields: std::mem::take(&mut c.fields),
+        fields: c.fields(),
         prj: Some(prj),
         warnings,
     })

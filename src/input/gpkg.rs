@@ -31,7 +31,11 @@ const STEP: i32 = 100_000;
 /// The tables of a GeoPackage that hold features or attributes, in `gpkg_contents`' order:
 /// `(name, data_type)`.
 pub fn tables(path: &Path) -> Result<Vec<(String, String)>, InputError> {
-    let conn = open(path)?;
+    tables_in(&open(path)?, path)
+}
+
+/// [`tables`] of the package `conn` has open (`path` for messages).
+fn tables_in(conn: &Connection, path: &Path) -> Result<Vec<(String, String)>, InputError> {
     let err = |e: rusqlite::Error| layer_err(path, format!("cannot list its tables: {e}"));
     let mut st = conn
         .prepare("SELECT table_name, data_type FROM gpkg_contents ORDER BY rowid")
@@ -45,7 +49,8 @@ pub fn tables(path: &Path) -> Result<Vec<(String, String)>, InputError> {
 /// Reads the features table `layer` of the GeoPackage at `path` (`""`: its only one, else
 /// the one named `role`).
 pub fn read_layer(path: &Path, layer: &str, role: &str) -> Result<Layer, InputError> {
-    let all = tables(path)?;
+    let conn = open(path)?;
+    let all = tables_in(&conn, path)?;
     let features: Vec<&String> = (all.iter())
         .filter(|(_, t)| t == "features")
         .map(|(n, _)| n)
@@ -75,11 +80,10 @@ pub fn read_layer(path: &Path, layer: &str, role: &str) -> Result<Layer, InputEr
             ))
         }
     };
-    read_table(path, &name)
+    read_table(&conn, path, &name)
 }
 
-fn read_table(path: &Path, table: &str) -> Result<Layer, InputError> {
-    let conn = open(path)?;
+fn read_table(conn: &Connection, path: &Path, table: &str) -> Result<Layer, InputError> {
     let at = |what: &str| {
         let what = what.to_string();
         move |e: rusqlite::Error| layer_err(path, format!("layer `{table}`: {what}: {e}"))
@@ -108,9 +112,9 @@ fn read_table(path: &Path, table: &str) -> Result<Layer, InputError> {
             |r| Ok((r.get(0)?, r.get(1)?)),
         )
         .map_err(at("no geometry column in gpkg_geometry_columns"))?;
-    let prj = crs_of(&conn, srs);
+    let prj = crs_of(conn, srs);
     // The columns: the integer primary key is the feature id, not an attribute.
-    let cols = columns(&conn, table).map_err(at("cannot read its columns"))?;
+    let cols = columns(conn, table).map_err(at("cannot read its columns"))?;
     let pk = cols.iter().find(|c| c.1).map(|c| c.0.clone());
     let fields: Vec<String> = (cols.iter())
         .filter(|(n, is_pk)| !is_pk && *n != geom)
@@ -181,7 +185,8 @@ pub type Row = (usize, Vec<String>);
 /// attributes table): its column names (the primary key left out) and each row's values as
 /// text, numbered as a spreadsheet numbers them (the header is row 1).
 pub fn attribute_rows(path: &Path, name: &str) -> Result<(Vec<String>, Vec<Row>), InputError> {
-    let all = tables(path)?;
+    let conn = open(path)?;
+    let all = tables_in(&conn, path)?;
     let attributes: Vec<&String> = (all.iter())
         .filter(|(_, t)| t == "attributes")
         .map(|(n, _)| n)
@@ -209,7 +214,6 @@ pub fn attribute_rows(path: &Path, name: &str) -> Result<(Vec<String>, Vec<Row>)
             ))
         }
     };
-    let conn = open(path)?;
     let err = |e: rusqlite::Error| layer_err(path, format!("table `{table}`: {e}"));
     let cols = columns(&conn, &table).map_err(err)?;
     let names: Vec<String> = cols.iter().filter(|c| !c.1).map(|c| c.0.clone()).collect();
