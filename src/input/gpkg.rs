@@ -36,7 +36,15 @@ pub fn tables(path: &Path) -> Result<Vec<(String, String)>, InputError> {
 
 /// [`tables`] of the package `conn` has open (`path` for messages).
 fn tables_in(conn: &Connection, path: &Path) -> Result<Vec<(String, String)>, InputError> {
-    let err = |e: rusqlite::Error| layer_err(path, format!("cannot list its tables: {e}"));
+    let err = |e: rusqlite::Error| {
+        layer_err(
+            path,
+            format!(
+                "cannot list its tables: {e} (a GeoPackage cut short or damaged, or another \
+                 SQLite file: save the layers again from QGIS as a GeoPackage)"
+            ),
+        )
+    };
     let mut st = conn
         .prepare("SELECT table_name, data_type FROM gpkg_contents ORDER BY rowid")
         .map_err(err)?;
